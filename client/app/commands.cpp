@@ -1,0 +1,140 @@
+#include "commands.hpp"
+
+#include <chrono>
+#include <iostream>
+#include <thread>
+
+#include "colorlab/client/api_client.hpp"
+#include "colorlab/core/error.hpp"
+#include "colorlab/protocol/states.hpp"
+#include "format.hpp"
+
+namespace colorlab::cli {
+
+using nlohmann::json;
+
+namespace {
+
+client::ApiClient make_client(const GlobalOptions& g) {
+  client::Endpoint e;
+  if (!g.socket.empty()) {
+    e.unix_socket = g.socket;
+  } else {
+    e = client::Endpoint::from_url(g.url);
+  }
+  return client::ApiClient(e);
+}
+
+void print(const GlobalOptions& g, const json& j, std::string (*human)(const json&)) {
+  if (g.json) {
+    std::cout << j.dump(2) << "\n";
+  } else {
+    std::cout << human(j);
+  }
+}
+
+// key=value → JSON value: numbers and booleans as such, everything else a string.
+json parse_param_value(const std::string& text) {
+  auto j = json::parse(text, nullptr, false);
+  if (!j.is_discarded() && (j.is_number() || j.is_boolean() || j.is_array() || j.is_object())) return j;
+  return text;
+}
+
+struct RunOptions {
+  std::string campaign;
+  std::vector<std::string> params;
+  bool detach = false;
+  bool id_only = false;
+  std::string idempotency_key;
+};
+
+int run_campaign(const GlobalOptions& g, const RunOptions& o) {
+  auto api = make_client(g);
+  json params = json::object();
+  for (const auto& p : o.params) {
+    auto eq = p.find('=');
+    if (eq == std::string::npos || eq == 0) {
+      throw Error(ErrorClass::bad_parameter, "--param '" + p + "' is not KEY=VALUE");
+    }
+    params[p.substr(0, eq)] = parse_param_value(p.substr(eq + 1));
+  }
+  std::map<std::string, std::string> headers;
+  if (!o.idempotency_key.empty()) headers["Idempotency-Key"] = o.idempotency_key;
+  json execution = api.post("/v1/executions", {{"campaign", o.campaign}, {"params", params}}, headers);
+  std::string id = execution["id"];
+  std::string run_id = execution["run_id"];
+  if (o.detach) {
+    if (o.id_only) {
+      std::cout << run_id << "\n";
+    } else {
+      print(g, execution, format_execution);
+    }
+    return 0;
+  }
+  std::string last_line;
+  for (;;) {
+    execution = api.get("/v1/executions/" + id);
+    auto status = protocol::execution_status_from_string(execution.value("status", std::string()));
+    if (!o.id_only && !g.json) {
+      std::string line = format_execution(execution);
+      if (line != last_line) std::cerr << line;
+      last_line = line;
+    }
+    if (status && protocol::is_terminal(*status)) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  json run = api.get("/v1/runs/" + run_id);
+  bool ok = execution["status"] == "finished_ok";
+  if (o.id_only) {
+    std::cout << run_id << "\n";
+    if (!ok) std::cerr << format_run(run);
+  } else {
+    print(g, run, format_run);
+  }
+  return ok ? 0 : 3;
+}
+
+}  // namespace
+
+void add_daemon_commands(CLI::App& app, GlobalOptions& global) {
+  auto* status = app.add_subcommand("status", "Show the daemon's version, API version and state");
+  status->callback([&global] {
+    print(global, make_client(global).get("/v1"), format_status);
+  });
+
+  auto* instruments = app.add_subcommand("instruments", "List instruments, their state and whether they are simulated");
+  instruments->callback([&global] { print(global, make_client(global).get("/v1/instruments"), format_instruments); });
+
+  auto* campaigns = app.add_subcommand("campaigns", "List the campaigns the daemon can run and their parameters");
+  campaigns->callback([&global] { print(global, make_client(global).get("/v1/campaigns"), format_campaigns); });
+
+  auto run_opts = std::make_shared<RunOptions>();
+  auto* run = app.add_subcommand("run", "Start a campaign and follow it to the end (exit 3 if it fails)");
+  run->add_option("campaign", run_opts->campaign, "campaign name, e.g. luminance-spot")->required();
+  run->add_option("-p,--param", run_opts->params, "campaign parameter KEY=VALUE (repeatable)");
+  run->add_flag("--detach", run_opts->detach, "return as soon as the campaign has started");
+  run->add_flag("--id-only", run_opts->id_only, "print only the run id (for scripts)");
+  run->add_option("--idempotency-key", run_opts->idempotency_key, "retry-safe key: the same key never starts twice");
+  run->callback([&global, run_opts] {
+    int rc = run_campaign(global, *run_opts);
+    if (rc != 0) throw CLI::RuntimeError(rc);
+  });
+
+  auto limit = std::make_shared<unsigned>(20);
+  auto cursor = std::make_shared<std::string>();
+  auto* runs = app.add_subcommand("runs", "List stored runs, newest first");
+  runs->add_option("--limit", *limit, "runs per page (1..300)");
+  runs->add_option("--cursor", *cursor, "continue from a previous page");
+  runs->callback([&global, limit, cursor] {
+    std::string target = "/v1/runs?limit=" + std::to_string(*limit);
+    if (!cursor->empty()) target += "&cursor=" + *cursor;
+    print(global, make_client(global).get(target), format_runs);
+  });
+
+  auto run_id = std::make_shared<std::string>();
+  auto* show = app.add_subcommand("show", "Show one run with its measurements");
+  show->add_option("run", *run_id, "run id")->required();
+  show->callback([&global, run_id] { print(global, make_client(global).get("/v1/runs/" + *run_id), format_run); });
+}
+
+}  // namespace colorlab::cli

@@ -1,0 +1,103 @@
+#include "format.hpp"
+
+#include <cstdio>
+#include <sstream>
+
+namespace colorlab::cli {
+
+using nlohmann::json;
+
+namespace {
+
+std::string str(const json& j, const char* key) {
+  if (!j.contains(key) || j[key].is_null()) return "-";
+  if (j[key].is_string()) return j[key].get<std::string>();
+  return j[key].dump();
+}
+
+std::string number(double v, int decimals = 2) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+  return buf;
+}
+
+}  // namespace
+
+std::string format_status(const json& root) {
+  std::ostringstream o;
+  o << "colorlabd " << str(root, "server_version") << " (API v" << str(root, "api_version") << ")";
+  if (root.value("simulated_lab", false)) o << " — SIMULATED LAB";
+  o << "\n  up since " << str(root, "started_at") << ", running executions: " << str(root, "running_executions") << "\n";
+  return o.str();
+}
+
+std::string format_instruments(const json& list) {
+  std::ostringstream o;
+  if (list["items"].empty()) return "no instruments configured\n";
+  for (const auto& i : list["items"]) {
+    o << str(i, "id") << "  " << str(i, "model") << "  [" << str(i, "state") << "]"
+      << (i.value("simulated", false) ? "  (simulated)" : "") << "\n    port " << str(i, "port");
+    if (i.contains("problem")) o << "\n    problem: " << i["problem"].get<std::string>();
+    o << "\n";
+  }
+  return o.str();
+}
+
+std::string format_campaigns(const json& list) {
+  std::ostringstream o;
+  for (const auto& c : list["items"]) {
+    o << str(c, "name") << "\n    " << str(c, "description") << "\n";
+    for (const auto& [k, v] : c["parameters"].items()) {
+      o << "    --param " << k << "=" << (v.contains("default") ? v["default"].dump() : "") << "\n";
+    }
+  }
+  return o.str();
+}
+
+std::string format_runs(const json& page) {
+  std::ostringstream o;
+  if (page["items"].empty()) return "no runs yet\n";
+  for (const auto& r : page["items"]) {
+    o << str(r, "id") << "  " << str(r, "campaign") << "  " << str(r, "status") << "  " << str(r, "created_at")
+      << (r.value("simulated", false) ? "  (simulated)" : "") << "\n";
+  }
+  if (page.contains("next_cursor") && !page["next_cursor"].is_null()) {
+    o << "more: colorlab runs --cursor " << page["next_cursor"].get<std::string>() << "\n";
+  }
+  return o.str();
+}
+
+std::string format_run(const json& r) {
+  std::ostringstream o;
+  o << "run " << str(r, "id") << "\n"
+    << "  campaign   " << str(r, "campaign") << "  params " << r["params"].dump() << "\n"
+    << "  status     " << str(r, "status") << "\n"
+    << "  data       " << (r.value("simulated", false) ? "SIMULATED instruments (not a measurement of the real lab)"
+                                                         : "real instruments")
+    << "\n"
+    << "  created    " << str(r, "created_at") << "\n"
+    << "  finished   " << str(r, "finished_at") << "\n";
+  if (r.contains("summary") && !r["summary"].is_null()) o << "  summary    " << r["summary"].dump() << "\n";
+  if (r.contains("error")) {
+    o << "  error      " << r["error"].value("detail", std::string()) << "\n";
+    if (r["error"].contains("hint")) o << "  hint       " << r["error"]["hint"].get<std::string>() << "\n";
+  }
+  if (r.contains("measurements")) {
+    o << "  measurements (" << r["measurements"].size() << "):\n";
+    for (const auto& m : r["measurements"]) {
+      o << "    " << str(m, "step") << "  " << str(m, "instrument_id") << "  " << str(m, "quantity") << "  ";
+      if (m["value"].is_number()) o << number(m["value"].get<double>()) << " " << str(m, "unit");
+      o << "  " << str(m, "measured_at") << "\n";
+    }
+  }
+  return o.str();
+}
+
+std::string format_execution(const json& e) {
+  std::ostringstream o;
+  o << "execution " << str(e, "id") << "  " << str(e, "campaign") << "  " << str(e, "status") << "  "
+    << number(100.0 * e.value("progress", 0.0), 0) << "%  " << str(e, "step") << "\n";
+  return o.str();
+}
+
+}  // namespace colorlab::cli

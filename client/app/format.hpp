@@ -1,0 +1,16 @@
+#pragma once
+// Human-readable renderings of API objects for the terminal; --json prints the objects instead.
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace colorlab::cli {
+
+std::string format_status(const nlohmann::json& root);
+std::string format_instruments(const nlohmann::json& list);
+std::string format_campaigns(const nlohmann::json& list);
+std::string format_runs(const nlohmann::json& page);
+std::string format_run(const nlohmann::json& run);
+std::string format_execution(const nlohmann::json& execution);
+
+}  // namespace colorlab::cli

@@ -1,0 +1,41 @@
+// colorlab: the command-line client of colorlabd, and the analysis front end.
+#include <clocale>
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+
+#include "colorlab/client/api_client.hpp"
+#include "colorlab/core/error.hpp"
+#include "commands.hpp"
+#ifdef COLORLAB_HAVE_ANALYZE
+#include "colorlab/cli/analyze_command.hpp"
+#endif
+
+int main(int argc, char** argv) {
+  std::setlocale(LC_ALL, "C");
+  CLI::App app{"colorlab — talk to colorlabd, and analyse colour data (see README.md)"};
+  app.require_subcommand(1);
+  colorlab::cli::GlobalOptions global;
+  app.add_option("--url", global.url, "daemon URL")->envname("COLORLAB_URL")->capture_default_str();
+  app.add_option("--socket", global.socket, "daemon Unix socket (instead of --url)")->envname("COLORLAB_SOCKET");
+  app.add_flag("--json", global.json, "print JSON instead of text");
+  colorlab::cli::add_daemon_commands(app, global);
+#ifdef COLORLAB_HAVE_ANALYZE
+  colorlab::cli::add_analyze_command(app);
+#endif
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const colorlab::client::ApiError& e) {
+    const auto& p = e.problem();
+    std::cerr << "colorlab: " << p.status << " " << p.title << ": " << p.detail << "\n";
+    if (!p.hint.empty()) std::cerr << "  hint: " << p.hint << "\n";
+    return 2;
+  } catch (const colorlab::Error& e) {
+    std::cerr << "colorlab: " << e.what() << "\n";
+    if (!e.hint().empty()) std::cerr << "  hint: " << e.hint() << "\n";
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,24 @@
+#pragma once
+// The v1 HTTP API (docs/API.md): routes requests to the store, the instruments and the
+// executions. Every error leaves as RFC 9457 problem+json.
+#include <string>
+
+#include "colorlab/campaigns/campaign.hpp"
+#include "colorlab/daemon/executions.hpp"
+#include "colorlab/http/message.hpp"
+#include "colorlab/store/store.hpp"
+
+namespace colorlab::daemon {
+
+struct ApiContext {
+  store::Store& store;
+  const campaigns::InstrumentSet& instruments;
+  const campaigns::CampaignRegistry& campaigns;
+  Executions& executions;
+  bool simulated_lab = false;
+  std::string started_at;
+};
+
+http::HttpResponse handle_api(ApiContext& ctx, const http::HttpRequest& req);
+
+}  // namespace colorlab::daemon

@@ -1,0 +1,175 @@
+#include "colorlab/daemon/api.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include "colorlab/core/error.hpp"
+#include "colorlab/protocol/api.hpp"
+#include "colorlab/protocol/problem.hpp"
+
+#ifndef COLORLAB_VERSION
+#define COLORLAB_VERSION "dev"
+#endif
+
+namespace colorlab::daemon {
+
+using http::HttpRequest;
+using http::HttpResponse;
+using nlohmann::json;
+
+namespace {
+
+HttpResponse from_error(const Error& e, const std::string& instance) {
+  auto p = protocol::problem_from_error(e);
+  p.instance = instance;
+  HttpResponse r;
+  r.status = p.status;
+  r.content_type = std::string(protocol::kContentProblem);
+  r.body = p.to_json().dump();
+  return r;
+}
+
+HttpResponse method_not_allowed(const HttpRequest& req, const std::string& allowed) {
+  auto r = HttpResponse::problem(405, "method-not-allowed", "Method not allowed",
+                                 req.method + " is not allowed on " + req.path, "allowed: " + allowed);
+  r.headers["Allow"] = allowed;
+  return r;
+}
+
+unsigned page_limit(const HttpRequest& req) {
+  auto it = req.query.find("limit");
+  if (it == req.query.end()) return protocol::kDefaultPageLimit;
+  try {
+    std::size_t used = 0;
+    long v = std::stol(it->second, &used);
+    if (used != it->second.size() || v < 1 || v > static_cast<long>(protocol::kMaxPageLimit)) throw std::out_of_range("limit");
+    return static_cast<unsigned>(v);
+  } catch (const std::exception&) {
+    throw Error(ErrorClass::bad_parameter,
+                "limit must be an integer from 1 to " + std::to_string(protocol::kMaxPageLimit));
+  }
+}
+
+HttpResponse get_root(ApiContext& ctx) {
+  json features = json::array({"instruments", "campaigns", "executions", "runs", "problem+json", "cursor-paging",
+                               "idempotency-key"});
+  return HttpResponse::json(200, {{"server", "colorlabd"},
+                                  {"server_version", COLORLAB_VERSION},
+                                  {"api_version", protocol::kApiVersion},
+                                  {"started_at", ctx.started_at},
+                                  {"simulated_lab", ctx.simulated_lab},
+                                  {"running_executions", ctx.executions.running()},
+                                  {"features", features},
+                                  {"limits", {{"max_request_body", protocol::kMaxRequestBody},
+                                              {"max_page_limit", protocol::kMaxPageLimit}}}});
+}
+
+HttpResponse get_instruments(ApiContext& ctx) {
+  json items = json::array();
+  for (const auto& i : ctx.instruments.all()) items.push_back(drivers::describe(*i));
+  return HttpResponse::json(200, {{"items", items}});
+}
+
+HttpResponse get_campaigns(ApiContext& ctx) {
+  json items = json::array();
+  for (const auto* c : ctx.campaigns.all()) {
+    items.push_back({{"name", c->name()}, {"description", c->description()}, {"parameters", c->parameters()}});
+  }
+  return HttpResponse::json(200, {{"items", items}});
+}
+
+HttpResponse post_execution(ApiContext& ctx, const HttpRequest& req) {
+  auto ct = req.header("content-type").value_or("");
+  if (ct.rfind("application/json", 0) != 0) {
+    return HttpResponse::problem(415, "unsupported-media-type", "Unsupported media type",
+                                 "POST /v1/executions takes application/json, got '" + ct + "'");
+  }
+  json body = json::parse(req.body, nullptr, false);
+  if (body.is_discarded()) {
+    return HttpResponse::problem(400, "bad-json", "Malformed JSON", "the request body is not valid JSON");
+  }
+  if (!body.is_object() || !body.contains("campaign") || !body["campaign"].is_string()) {
+    return HttpResponse::problem(400, "bad-request", "Invalid request",
+                                 "the body must be an object with a string 'campaign' (and optional 'params')",
+                                 "e.g. {\"campaign\": \"luminance-spot\", \"params\": {\"readings\": 3}}");
+  }
+  json params = body.value("params", json::object());
+  auto record = ctx.executions.start(body["campaign"].get<std::string>(), params, req.header("idempotency-key"));
+  auto r = HttpResponse::json(202, record.to_json());
+  r.headers["Location"] = std::string(protocol::kPrefix) + "/executions/" + record.id;
+  return r;
+}
+
+HttpResponse get_execution(ApiContext& ctx, const std::string& id) {
+  auto e = ctx.store.execution(id);
+  if (!e) throw Error(ErrorClass::not_found, "no execution with id '" + id + "'");
+  return HttpResponse::json(200, e->to_json());
+}
+
+HttpResponse get_runs(ApiContext& ctx, const HttpRequest& req) {
+  unsigned limit = page_limit(req);
+  std::optional<std::string> cursor;
+  if (auto it = req.query.find("cursor"); it != req.query.end()) cursor = it->second;
+  auto page = ctx.store.runs(limit, cursor);
+  json items = json::array();
+  for (const auto& r : page.runs) items.push_back(r.to_json());
+  json links = json::object();
+  links["next"] = page.next_cursor ? json(std::string(protocol::kPrefix) + "/runs?limit=" + std::to_string(limit) +
+                                          "&cursor=" + *page.next_cursor)
+                                   : json(nullptr);
+  return HttpResponse::json(200, {{"items", items}, {"links", links}, {"next_cursor", page.next_cursor ? json(*page.next_cursor) : json(nullptr)}});
+}
+
+HttpResponse get_run(ApiContext& ctx, const std::string& id) {
+  auto r = ctx.store.run(id);
+  if (!r) throw Error(ErrorClass::not_found, "no run with id '" + id + "'");
+  json j = r->to_json();
+  json ms = json::array();
+  for (const auto& m : ctx.store.measurements(id)) ms.push_back(m.to_json());
+  j["measurements"] = ms;
+  return HttpResponse::json(200, j);
+}
+
+}  // namespace
+
+HttpResponse handle_api(ApiContext& ctx, const HttpRequest& req) {
+  const std::string& p = req.path;
+  const std::string prefix(protocol::kPrefix);
+  try {
+    if (p == prefix || p == prefix + "/") {
+      if (req.method != "GET") return method_not_allowed(req, "GET");
+      return get_root(ctx);
+    }
+    if (p == prefix + "/instruments") {
+      if (req.method != "GET") return method_not_allowed(req, "GET");
+      return get_instruments(ctx);
+    }
+    if (p == prefix + "/campaigns") {
+      if (req.method != "GET") return method_not_allowed(req, "GET");
+      return get_campaigns(ctx);
+    }
+    if (p == prefix + "/executions") {
+      if (req.method != "POST") return method_not_allowed(req, "POST");
+      return post_execution(ctx, req);
+    }
+    const std::string exec_prefix = prefix + "/executions/";
+    if (p.rfind(exec_prefix, 0) == 0 && p.size() > exec_prefix.size() && p.find('/', exec_prefix.size()) == std::string::npos) {
+      if (req.method != "GET") return method_not_allowed(req, "GET");
+      return get_execution(ctx, p.substr(exec_prefix.size()));
+    }
+    if (p == prefix + "/runs") {
+      if (req.method != "GET") return method_not_allowed(req, "GET");
+      return get_runs(ctx, req);
+    }
+    const std::string run_prefix = prefix + "/runs/";
+    if (p.rfind(run_prefix, 0) == 0 && p.size() > run_prefix.size() && p.find('/', run_prefix.size()) == std::string::npos) {
+      if (req.method != "GET") return method_not_allowed(req, "GET");
+      return get_run(ctx, p.substr(run_prefix.size()));
+    }
+    return HttpResponse::problem(404, "not-found", "Not found", "no route for " + req.method + " " + p,
+                                 "GET /v1 lists the API's features; see docs/API.md");
+  } catch (const Error& e) {
+    return from_error(e, req.path);
+  }
+}
+
+}  // namespace colorlab::daemon

@@ -1,0 +1,130 @@
+#include "colorlab/daemon/config.hpp"
+
+#include <toml++/toml.h>
+
+#include "colorlab/core/error.hpp"
+#include "colorlab/protocol/api.hpp"
+
+namespace colorlab::daemon {
+
+std::filesystem::path DaemonConfig::database_path() const { return state_dir / std::string(protocol::kDatabaseName); }
+
+std::filesystem::path DaemonConfig::socket_path() const {
+  return unix_socket ? *unix_socket : state_dir / std::string(protocol::kSocketName);
+}
+
+DaemonConfig embedded_default_config() {
+  DaemonConfig c;
+  c.simulator.enabled = true;
+  return c;
+}
+
+void apply_listen(DaemonConfig& c, const std::string& host_port) {
+  auto colon = host_port.rfind(':');
+  if (colon == std::string::npos || colon == 0 || colon + 1 == host_port.size()) {
+    throw Error(ErrorClass::bad_parameter, "listen address '" + host_port + "' is not HOST:PORT",
+                "for example 127.0.0.1:8765");
+  }
+  std::string host = host_port.substr(0, colon);
+  if (host.size() > 2 && host.front() == '[' && host.back() == ']') host = host.substr(1, host.size() - 2);
+  int port = 0;
+  try {
+    std::size_t used = 0;
+    port = std::stoi(host_port.substr(colon + 1), &used);
+    if (used != host_port.size() - colon - 1) throw std::invalid_argument("port");
+  } catch (const std::exception&) {
+    port = -1;
+  }
+  if (port < 0 || port > 65535) {
+    throw Error(ErrorClass::bad_parameter, "listen port in '" + host_port + "' must be 0..65535");
+  }
+  c.listen_host = host;
+  c.listen_port = static_cast<unsigned short>(port);
+}
+
+namespace {
+
+[[noreturn]] void bad(const std::filesystem::path& file, const toml::source_region& where, const std::string& what) {
+  throw Error(ErrorClass::bad_parameter,
+              file.string() + ":" + std::to_string(where.begin.line) + ": " + what, "see docs/configuration.md");
+}
+
+nlohmann::json to_json(const toml::node& node) {
+  if (auto t = node.as_table()) {
+    nlohmann::json j = nlohmann::json::object();
+    for (const auto& [k, v] : *t) j[std::string(k.str())] = to_json(v);
+    return j;
+  }
+  if (auto a = node.as_array()) {
+    nlohmann::json j = nlohmann::json::array();
+    for (const auto& v : *a) j.push_back(to_json(v));
+    return j;
+  }
+  if (auto v = node.value<bool>(); node.is_boolean()) return *v;
+  if (auto v = node.value<int64_t>(); node.is_integer()) return *v;
+  if (auto v = node.value<double>(); node.is_floating_point()) return *v;
+  if (auto v = node.value<std::string>()) return *v;
+  return nullptr;
+}
+
+}  // namespace
+
+DaemonConfig load_config(const std::filesystem::path& file) {
+  toml::table root;
+  try {
+    root = toml::parse_file(file.string());
+  } catch (const toml::parse_error& e) {
+    throw Error(ErrorClass::bad_parameter,
+                file.string() + ":" + std::to_string(e.source().begin.line) + ": " + std::string(e.description()),
+                "fix the TOML syntax");
+  }
+  DaemonConfig c;
+  auto base = file.parent_path();
+  auto resolve = [&](const std::string& p) { return std::filesystem::path(p).is_absolute() ? std::filesystem::path(p) : base / p; };
+
+  for (const auto& [key, node] : root) {
+    std::string k(key.str());
+    if (k == "state_dir") {
+      auto v = node.value<std::string>();
+      if (!v) bad(file, node.source(), "state_dir must be a string");
+      c.state_dir = resolve(*v);
+    } else if (k == "listen") {
+      auto v = node.value<std::string>();
+      if (!v) bad(file, node.source(), "listen must be \"HOST:PORT\"");
+      apply_listen(c, *v);
+    } else if (k == "unix_socket") {
+      auto v = node.value<std::string>();
+      if (!v) bad(file, node.source(), "unix_socket must be a path");
+      c.unix_socket = resolve(*v);
+    } else if (k == "simulator") {
+      auto t = node.as_table();
+      if (!t) bad(file, node.source(), "[simulator] must be a table");
+      c.simulator.enabled = t->get("enabled") ? t->get("enabled")->value_or(true) : true;
+      if (auto v = (*t)["config"].value<std::string>()) c.simulator.config = resolve(*v);
+      if (auto v = (*t)["time_scale"].value<double>()) c.simulator.time_scale = *v;
+      if (auto v = (*t)["seed"].value<int64_t>()) c.simulator.seed = static_cast<std::uint64_t>(*v);
+    } else if (k == "instrument") {
+      auto arr = node.as_array();
+      if (!arr) bad(file, node.source(), "instruments are [[instrument]] tables");
+      for (const auto& item : *arr) {
+        auto t = item.as_table();
+        if (!t) bad(file, item.source(), "each [[instrument]] must be a table");
+        drivers::InstrumentConfig ic;
+        ic.id = (*t)["id"].value_or(std::string());
+        ic.kind = (*t)["kind"].value_or(std::string());
+        ic.port = (*t)["port"].value_or(std::string());
+        ic.simulated = (*t)["simulated"].value_or(false);
+        if (ic.id.empty() || ic.kind.empty() || ic.port.empty()) {
+          bad(file, item.source(), "[[instrument]] needs id, kind and port");
+        }
+        if (auto opts = (*t)["options"].as_table()) ic.options = to_json(*opts);
+        c.instruments.push_back(std::move(ic));
+      }
+    } else {
+      bad(file, node.source(), "unknown key '" + k + "'");
+    }
+  }
+  return c;
+}
+
+}  // namespace colorlab::daemon

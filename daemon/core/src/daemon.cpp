@@ -1,0 +1,105 @@
+#include "colorlab/daemon/daemon.hpp"
+
+#include <boost/asio/co_spawn.hpp>
+#include <boost/asio/detached.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/signal_set.hpp>
+#include <boost/asio/use_awaitable.hpp>
+
+#include "colorlab/core/error.hpp"
+#include "colorlab/core/ids.hpp"
+#include "colorlab/core/log.hpp"
+#include "colorlab/daemon/api.hpp"
+#include "colorlab/daemon/embedded_sim.hpp"
+#include "colorlab/daemon/executions.hpp"
+#include "colorlab/daemon/systemd_notify.hpp"
+#include "colorlab/http/server.hpp"
+
+namespace colorlab::daemon {
+
+namespace asio = boost::asio;
+
+struct Daemon::Impl {
+  DaemonConfig config;
+  asio::io_context io{1};
+  std::unique_ptr<EmbeddedSim> sim;
+  std::unique_ptr<store::Store> store;
+  campaigns::InstrumentSet instruments;
+  campaigns::CampaignRegistry campaigns = campaigns::CampaignRegistry::with_builtin_campaigns();
+  std::unique_ptr<Executions> executions;
+  std::unique_ptr<ApiContext> api;
+  std::unique_ptr<http::Server> server;
+  SystemdNotifier notifier{io};
+};
+
+Daemon::Daemon(DaemonConfig config) : impl_(std::make_unique<Impl>()) {
+  auto& d = *impl_;
+  d.config = std::move(config);
+  // The database first: if it is unusable, nothing else should start.
+  d.store = std::make_unique<store::Store>(d.config.database_path());
+
+  auto instrument_configs = d.config.instruments;
+  if (d.config.simulator.enabled) {
+    d.sim = std::make_unique<EmbeddedSim>(default_sim_binary(), d.config.simulator);
+    for (auto& c : d.sim->instruments()) instrument_configs.push_back(std::move(c));
+  }
+  for (const auto& c : instrument_configs) {
+    try {
+      d.instruments.add(drivers::make_instrument(d.io.get_executor(), c));
+    } catch (const Error& e) {
+      // One unusable entry must not keep the others (and the stored data) offline.
+      log::warning("colorlabd", std::string("instrument skipped: ") + e.what());
+    }
+  }
+  d.executions = std::make_unique<Executions>(d.io, *d.store, d.campaigns, d.instruments);
+  d.api = std::make_unique<ApiContext>(ApiContext{*d.store, d.instruments, d.campaigns, *d.executions,
+                                                  d.config.simulator.enabled, now_iso8601()});
+
+  http::ServerOptions so;
+  so.tcp_host = d.config.listen_host;
+  so.tcp_port = d.config.listen_port;
+  so.unix_socket = d.config.socket_path();
+  d.server = std::make_unique<http::Server>(d.io, so, [api = d.api.get()](const http::HttpRequest& req) {
+    return handle_api(*api, req);
+  });
+  d.server->start();
+}
+
+Daemon::~Daemon() = default;
+
+int Daemon::run() {
+  auto& d = *impl_;
+  // Connect instruments in the background: the API is useful (stored data) while they come up.
+  for (const auto& instrument : d.instruments.all()) {
+    asio::co_spawn(
+        d.io,
+        [instrument]() -> asio::awaitable<void> {
+          try {
+            co_await instrument->connect();
+            log::info("colorlabd", instrument->id() + " ready on " + instrument->identity().port);
+          } catch (const Error& e) {
+            log::warning("colorlabd", instrument->id() + ": " + e.what() + (e.hint().empty() ? "" : " — " + e.hint()));
+          }
+        },
+        asio::detached);
+  }
+
+  asio::signal_set signals(d.io, SIGINT, SIGTERM);
+  signals.async_wait([&](boost::system::error_code ec, int sig) {
+    if (ec) return;
+    log::info("colorlabd", "signal " + std::to_string(sig) + ": stopping");
+    d.notifier.stopping();
+    d.server->stop();
+    d.io.stop();
+  });
+
+  std::string where = d.config.listen_host + ":" + std::to_string(d.server->bound_port()) + " and " +
+                      d.config.socket_path().string();
+  d.notifier.ready("serving on " + where);
+  d.notifier.start_watchdog();
+  log::info("colorlabd", "serving the v1 API on " + where + (d.sim ? " (simulated lab)" : ""));
+  d.io.run();
+  return 0;
+}
+
+}  // namespace colorlab::daemon

@@ -1,0 +1,113 @@
+#pragma once
+// The daemon's persistent state. One writer connection, used from the daemon's event loop only.
+// Settings follow daemon-design-notes §6.2: WAL, synchronous=FULL (a committed measurement
+// survives power loss), busy_timeout, foreign keys, quick_check at open.
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "colorlab/protocol/states.hpp"
+#include "colorlab/store/sqlite.hpp"
+
+namespace colorlab::store {
+
+struct NewRun {
+  std::string campaign;
+  nlohmann::json params;
+  bool simulated = false;
+  nlohmann::json instruments;  // snapshot
+  std::optional<std::string> idempotency_key;
+};
+
+struct ExecutionRecord {
+  std::string id;
+  std::string run_id;
+  std::string campaign;
+  protocol::ExecutionStatus status = protocol::ExecutionStatus::waiting;
+  double progress = 0;
+  std::string step;
+  std::string created_at;
+  std::string updated_at;
+  nlohmann::json error;  // problem, or null
+  nlohmann::json to_json() const;
+};
+
+struct MeasurementRecord {
+  std::int64_t seq = 0;
+  std::string step;
+  std::string instrument_id;
+  bool simulated = false;
+  std::string quantity;
+  std::optional<double> value;
+  std::string unit;
+  nlohmann::json data;
+  std::string measured_at;
+  nlohmann::json to_json() const;
+};
+
+struct RunRecord {
+  std::int64_t seq = 0;
+  std::string id;
+  std::string campaign;
+  nlohmann::json params;
+  std::string status;
+  bool simulated = false;
+  nlohmann::json instruments;
+  std::string created_at;
+  std::optional<std::string> started_at, finished_at;
+  nlohmann::json summary;
+  nlohmann::json error;
+  nlohmann::json to_json() const;  // without measurements
+};
+
+struct RunPage {
+  std::vector<RunRecord> runs;
+  std::optional<std::string> next_cursor;
+};
+
+class Store {
+ public:
+  // Creates the directory and database as needed, migrates, checks integrity, and marks runs and
+  // executions that a previous process left unfinished as `interrupted`.
+  explicit Store(const std::filesystem::path& database_path);
+
+  // Creates a run and its execution in one transaction. With an idempotency key already used,
+  // returns the existing execution and created = false (a retried POST must not start a campaign twice).
+  struct Created {
+    ExecutionRecord execution;
+    bool created = false;
+  };
+  Created create_execution(const NewRun& run);
+  void update_execution(const std::string& execution_id, protocol::ExecutionStatus status, double progress,
+                        const std::string& step, const nlohmann::json& error = nullptr);
+  void finish_run(const std::string& run_id, protocol::ExecutionStatus status, const nlohmann::json& summary,
+                  const nlohmann::json& error);
+  void mark_run_started(const std::string& run_id);
+
+  // Durable on return (synchronous=FULL). A repeated step is refused with Error{conflict}.
+  void add_measurement(const std::string& run_id, const std::string& step, const std::string& instrument_id,
+                       bool simulated, const std::string& quantity, std::optional<double> value,
+                       const std::string& unit, const nlohmann::json& data);
+  bool has_measurement(const std::string& run_id, const std::string& step);
+
+  std::optional<ExecutionRecord> execution(const std::string& id);
+  std::optional<RunRecord> run(const std::string& id);
+  std::vector<MeasurementRecord> measurements(const std::string& run_id);
+  // Newest first; `cursor` is the opaque next_cursor of the previous page.
+  RunPage runs(unsigned limit, const std::optional<std::string>& cursor);
+
+  std::int64_t append_event(const std::string& topic, const nlohmann::json& payload);
+  int interrupted_at_open() const { return interrupted_at_open_; }
+
+ private:
+  RunRecord read_run(Statement& st);
+
+  Database db_;
+  int interrupted_at_open_ = 0;
+};
+
+}  // namespace colorlab::store

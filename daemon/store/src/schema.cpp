@@ -1,0 +1,97 @@
+#include "colorlab/store/schema.hpp"
+
+#include <array>
+#include <string>
+
+#include "colorlab/core/error.hpp"
+
+namespace colorlab::store {
+
+namespace {
+
+// migrations[i] takes the schema from version i to i + 1. Never edit a shipped entry; append.
+constexpr std::array<const char*, kSchemaVersion> kMigrations = {
+    // 0 -> 1: runs, their measurements, executions and the event log.
+    R"sql(
+CREATE TABLE runs (
+  seq          INTEGER PRIMARY KEY AUTOINCREMENT,  -- cursor for paging, never reused
+  id           TEXT NOT NULL UNIQUE,               -- UUIDv7
+  campaign     TEXT NOT NULL,
+  params       TEXT NOT NULL,                      -- JSON
+  status       TEXT NOT NULL,
+  simulated    INTEGER NOT NULL,                   -- 1 if any instrument was simulated
+  instruments  TEXT NOT NULL,                      -- JSON snapshot of the instruments used
+  created_at   TEXT NOT NULL,
+  started_at   TEXT,
+  finished_at  TEXT,
+  summary      TEXT,                               -- JSON
+  error        TEXT                                -- JSON problem
+);
+CREATE TABLE measurements (
+  run_id        TEXT NOT NULL REFERENCES runs(id),
+  seq           INTEGER NOT NULL,
+  step          TEXT NOT NULL,
+  instrument_id TEXT NOT NULL,
+  simulated     INTEGER NOT NULL,
+  quantity      TEXT NOT NULL,
+  value         REAL,
+  unit          TEXT,
+  data          TEXT,                              -- JSON
+  measured_at   TEXT NOT NULL,
+  PRIMARY KEY (run_id, step)
+) WITHOUT ROWID;
+CREATE INDEX measurements_by_seq ON measurements(run_id, seq);
+CREATE TABLE executions (
+  id              TEXT PRIMARY KEY,
+  run_id          TEXT NOT NULL REFERENCES runs(id),
+  campaign        TEXT NOT NULL,
+  status          TEXT NOT NULL,
+  progress        REAL NOT NULL DEFAULT 0,
+  step            TEXT NOT NULL DEFAULT '',
+  idempotency_key TEXT UNIQUE,
+  created_at      TEXT NOT NULL,
+  updated_at      TEXT NOT NULL,
+  error           TEXT
+);
+CREATE TABLE event_log (
+  seq     INTEGER PRIMARY KEY AUTOINCREMENT,
+  time    TEXT NOT NULL,
+  topic   TEXT NOT NULL,
+  payload TEXT NOT NULL
+);
+)sql",
+};
+
+int read_pragma_int(Database& db, const char* pragma) {
+  auto st = db.prepare(std::string("PRAGMA ") + pragma);
+  return st.step() ? static_cast<int>(st.int64(0)) : 0;
+}
+
+}  // namespace
+
+int schema_version(Database& db) { return read_pragma_int(db, "user_version"); }
+
+void migrate(Database& db) {
+  int version = schema_version(db);
+  int app_id = read_pragma_int(db, "application_id");
+  if (app_id != 0 && app_id != kApplicationId) {
+    throw Error(ErrorClass::io_error, "the database file belongs to another application (application_id " +
+                                          std::to_string(app_id) + ")",
+                "point --state at colorlab's own state directory");
+  }
+  if (version > kSchemaVersion) {
+    throw Error(ErrorClass::io_error,
+                "the database has schema version " + std::to_string(version) + ", newer than this colorlabd (" +
+                    std::to_string(kSchemaVersion) + ")",
+                "run a newer colorlabd; an older binary must not write a newer database");
+  }
+  for (int v = version; v < kSchemaVersion; ++v) {
+    Transaction tx(db);
+    db.exec(kMigrations[v]);
+    db.exec("PRAGMA user_version = " + std::to_string(v + 1));
+    db.exec("PRAGMA application_id = " + std::to_string(kApplicationId));
+    tx.commit();
+  }
+}
+
+}  // namespace colorlab::store

@@ -1,0 +1,307 @@
+#include "colorlab/store/store.hpp"
+
+#include <cmath>
+
+#include "colorlab/core/error.hpp"
+#include "colorlab/core/ids.hpp"
+#include "colorlab/core/log.hpp"
+#include "colorlab/store/schema.hpp"
+
+namespace colorlab::store {
+
+namespace fs = std::filesystem;
+using protocol::ExecutionStatus;
+
+namespace {
+
+nlohmann::json parse_json_column(const std::string& text) {
+  if (text.empty()) return nullptr;
+  return nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
+}
+
+std::string dump_or_empty(const nlohmann::json& j) { return j.is_null() ? std::string() : j.dump(); }
+
+}  // namespace
+
+nlohmann::json ExecutionRecord::to_json() const {
+  nlohmann::json j{{"id", id},         {"run_id", run_id},         {"campaign", campaign},
+                   {"status", protocol::to_string(status)},       {"progress", progress},
+                   {"step", step},     {"created_at", created_at}, {"updated_at", updated_at}};
+  if (!error.is_null()) j["error"] = error;
+  return j;
+}
+
+nlohmann::json MeasurementRecord::to_json() const {
+  nlohmann::json j{{"seq", seq},
+                   {"step", step},
+                   {"instrument_id", instrument_id},
+                   {"simulated", simulated},
+                   {"quantity", quantity},
+                   {"unit", unit},
+                   {"measured_at", measured_at}};
+  j["value"] = value ? nlohmann::json(*value) : nlohmann::json(nullptr);
+  if (!data.is_null()) j["data"] = data;
+  return j;
+}
+
+nlohmann::json RunRecord::to_json() const {
+  nlohmann::json j{{"id", id},
+                   {"campaign", campaign},
+                   {"params", params},
+                   {"status", status},
+                   {"simulated", simulated},
+                   {"instruments", instruments},
+                   {"created_at", created_at}};
+  j["started_at"] = started_at ? nlohmann::json(*started_at) : nlohmann::json(nullptr);
+  j["finished_at"] = finished_at ? nlohmann::json(*finished_at) : nlohmann::json(nullptr);
+  j["summary"] = summary;
+  if (!error.is_null()) j["error"] = error;
+  return j;
+}
+
+Store::Store(const fs::path& database_path) {
+  std::error_code ec;
+  fs::create_directories(database_path.parent_path().empty() ? fs::path(".") : database_path.parent_path(), ec);
+  if (ec) {
+    throw Error(ErrorClass::io_error, "cannot create state directory " + database_path.parent_path().string() + ": " +
+                                          ec.message());
+  }
+  db_ = Database(database_path.string(), false);
+  db_.exec("PRAGMA busy_timeout = 5000");
+  {
+    auto st = db_.prepare("PRAGMA journal_mode = WAL");
+    st.step();
+  }
+  db_.exec("PRAGMA synchronous = FULL");
+  db_.exec("PRAGMA foreign_keys = ON");
+  db_.exec("PRAGMA journal_size_limit = 67108864");
+  db_.exec("PRAGMA temp_store = MEMORY");
+  {
+    auto st = db_.prepare("PRAGMA quick_check");
+    if (st.step() && st.text(0) != "ok") {
+      throw Error(ErrorClass::io_error, "database " + database_path.string() + " failed quick_check: " + st.text(0),
+                  "restore from backup, or try: sqlite3 colorlab.db .recover");
+    }
+  }
+  migrate(db_);
+
+  // A previous process died with these unfinished: finalise them so no tool waits for them forever.
+  Transaction tx(db_);
+  std::string now = now_iso8601();
+  db_.prepare("UPDATE runs SET status = 'interrupted', finished_at = ?1 WHERE status IN ('waiting', 'running')")
+      .bind(1, std::string_view(now))
+      .run();
+  interrupted_at_open_ = db_.changes();
+  db_.prepare("UPDATE executions SET status = 'interrupted', updated_at = ?1 WHERE status IN ('waiting', 'running')")
+      .bind(1, std::string_view(now))
+      .run();
+  tx.commit();
+  if (interrupted_at_open_ > 0) {
+    log::warning("store", std::to_string(interrupted_at_open_) + " run(s) from a previous process marked interrupted");
+  }
+}
+
+Store::Created Store::create_execution(const NewRun& run) {
+  if (run.idempotency_key) {
+    auto st = db_.prepare("SELECT id FROM executions WHERE idempotency_key = ?1");
+    st.bind(1, std::string_view(*run.idempotency_key));
+    if (st.step()) return {*execution(st.text(0)), false};
+  }
+  ExecutionRecord e;
+  e.id = new_uuid_v7();
+  e.run_id = new_uuid_v7();
+  e.campaign = run.campaign;
+  e.created_at = e.updated_at = now_iso8601();
+
+  Transaction tx(db_);
+  db_.prepare(
+         "INSERT INTO runs (id, campaign, params, status, simulated, instruments, created_at) "
+         "VALUES (?1, ?2, ?3, 'waiting', ?4, ?5, ?6)")
+      .bind(1, std::string_view(e.run_id))
+      .bind(2, std::string_view(run.campaign))
+      .bind(3, std::string_view(run.params.dump()))
+      .bind(4, static_cast<std::int64_t>(run.simulated))
+      .bind(5, std::string_view(run.instruments.dump()))
+      .bind(6, std::string_view(e.created_at))
+      .run();
+  db_.prepare(
+         "INSERT INTO executions (id, run_id, campaign, status, idempotency_key, created_at, updated_at) "
+         "VALUES (?1, ?2, ?3, 'waiting', ?4, ?5, ?5)")
+      .bind(1, std::string_view(e.id))
+      .bind(2, std::string_view(e.run_id))
+      .bind(3, std::string_view(run.campaign))
+      .bind(4, run.idempotency_key)
+      .bind(5, std::string_view(e.created_at))
+      .run();
+  tx.commit();
+  append_event("execution", e.to_json());
+  return {e, true};
+}
+
+void Store::update_execution(const std::string& id, ExecutionStatus status, double progress, const std::string& step,
+                             const nlohmann::json& error) {
+  std::string now = now_iso8601();
+  db_.prepare("UPDATE executions SET status = ?2, progress = ?3, step = ?4, updated_at = ?5, error = ?6 WHERE id = ?1")
+      .bind(1, std::string_view(id))
+      .bind(2, protocol::to_string(status))
+      .bind(3, progress)
+      .bind(4, std::string_view(step))
+      .bind(5, std::string_view(now))
+      .bind(6, error.is_null() ? std::optional<std::string>() : std::optional<std::string>(error.dump()))
+      .run();
+}
+
+void Store::mark_run_started(const std::string& run_id) {
+  db_.prepare("UPDATE runs SET status = 'running', started_at = ?2 WHERE id = ?1")
+      .bind(1, std::string_view(run_id))
+      .bind(2, std::string_view(now_iso8601()))
+      .run();
+}
+
+void Store::finish_run(const std::string& run_id, ExecutionStatus status, const nlohmann::json& summary,
+                       const nlohmann::json& error) {
+  db_.prepare("UPDATE runs SET status = ?2, finished_at = ?3, summary = ?4, error = ?5 WHERE id = ?1")
+      .bind(1, std::string_view(run_id))
+      .bind(2, protocol::to_string(status))
+      .bind(3, std::string_view(now_iso8601()))
+      .bind(4, summary.is_null() ? std::optional<std::string>() : std::optional<std::string>(summary.dump()))
+      .bind(5, error.is_null() ? std::optional<std::string>() : std::optional<std::string>(error.dump()))
+      .run();
+}
+
+void Store::add_measurement(const std::string& run_id, const std::string& step, const std::string& instrument_id,
+                            bool simulated, const std::string& quantity, std::optional<double> value,
+                            const std::string& unit, const nlohmann::json& data) {
+  Transaction tx(db_);
+  std::int64_t seq = 0;
+  {
+    auto st = db_.prepare("SELECT COALESCE(MAX(seq), 0) + 1 FROM measurements WHERE run_id = ?1");
+    st.bind(1, std::string_view(run_id));
+    if (st.step()) seq = st.int64(0);
+  }
+  auto ins = db_.prepare(
+      "INSERT INTO measurements (run_id, seq, step, instrument_id, simulated, quantity, value, unit, data, measured_at) "
+      "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10)");
+  ins.bind(1, std::string_view(run_id))
+      .bind(2, seq)
+      .bind(3, std::string_view(step))
+      .bind(4, std::string_view(instrument_id))
+      .bind(5, static_cast<std::int64_t>(simulated))
+      .bind(6, std::string_view(quantity));
+  if (value && std::isfinite(*value)) {
+    ins.bind(7, *value);
+  } else {
+    ins.bind_null(7);
+  }
+  ins.bind(8, std::string_view(unit)).bind(9, std::string_view(dump_or_empty(data))).bind(10, std::string_view(now_iso8601()));
+  ins.run();
+  tx.commit();
+}
+
+bool Store::has_measurement(const std::string& run_id, const std::string& step) {
+  auto st = db_.prepare("SELECT 1 FROM measurements WHERE run_id = ?1 AND step = ?2");
+  st.bind(1, std::string_view(run_id)).bind(2, std::string_view(step));
+  return st.step();
+}
+
+std::optional<ExecutionRecord> Store::execution(const std::string& id) {
+  auto st = db_.prepare(
+      "SELECT id, run_id, campaign, status, progress, step, created_at, updated_at, error FROM executions WHERE id = ?1");
+  st.bind(1, std::string_view(id));
+  if (!st.step()) return std::nullopt;
+  ExecutionRecord e;
+  e.id = st.text(0);
+  e.run_id = st.text(1);
+  e.campaign = st.text(2);
+  e.status = protocol::execution_status_from_string(st.text(3)).value_or(ExecutionStatus::finished_error);
+  e.progress = st.real(4);
+  e.step = st.text(5);
+  e.created_at = st.text(6);
+  e.updated_at = st.text(7);
+  e.error = parse_json_column(st.text(8));
+  return e;
+}
+
+RunRecord Store::read_run(Statement& st) {
+  RunRecord r;
+  r.seq = st.int64(0);
+  r.id = st.text(1);
+  r.campaign = st.text(2);
+  r.params = parse_json_column(st.text(3));
+  r.status = st.text(4);
+  r.simulated = st.int64(5) != 0;
+  r.instruments = parse_json_column(st.text(6));
+  r.created_at = st.text(7);
+  if (!st.is_null(8)) r.started_at = st.text(8);
+  if (!st.is_null(9)) r.finished_at = st.text(9);
+  r.summary = parse_json_column(st.text(10));
+  r.error = parse_json_column(st.text(11));
+  return r;
+}
+
+static constexpr const char* kRunColumns =
+    "seq, id, campaign, params, status, simulated, instruments, created_at, started_at, finished_at, summary, error";
+
+std::optional<RunRecord> Store::run(const std::string& id) {
+  auto st = db_.prepare(std::string("SELECT ") + kRunColumns + " FROM runs WHERE id = ?1");
+  st.bind(1, std::string_view(id));
+  if (!st.step()) return std::nullopt;
+  return read_run(st);
+}
+
+std::vector<MeasurementRecord> Store::measurements(const std::string& run_id) {
+  auto st = db_.prepare(
+      "SELECT seq, step, instrument_id, simulated, quantity, value, unit, data, measured_at FROM measurements "
+      "WHERE run_id = ?1 ORDER BY seq");
+  st.bind(1, std::string_view(run_id));
+  std::vector<MeasurementRecord> out;
+  while (st.step()) {
+    MeasurementRecord m;
+    m.seq = st.int64(0);
+    m.step = st.text(1);
+    m.instrument_id = st.text(2);
+    m.simulated = st.int64(3) != 0;
+    m.quantity = st.text(4);
+    if (!st.is_null(5)) m.value = st.real(5);
+    m.unit = st.text(6);
+    m.data = parse_json_column(st.text(7));
+    m.measured_at = st.text(8);
+    out.push_back(std::move(m));
+  }
+  return out;
+}
+
+RunPage Store::runs(unsigned limit, const std::optional<std::string>& cursor) {
+  std::int64_t before = INT64_MAX;
+  if (cursor) {
+    try {
+      std::size_t used = 0;
+      before = std::stoll(*cursor, &used);
+      if (used != cursor->size() || before <= 0) throw std::invalid_argument("cursor");
+    } catch (const std::exception&) {
+      throw Error(ErrorClass::bad_parameter, "cursor '" + *cursor + "' is not a cursor this server issued",
+                  "use links.next from the previous page");
+    }
+  }
+  // Keyset paging: the cost of a page does not grow with how far back it is.
+  auto st = db_.prepare(std::string("SELECT ") + kRunColumns + " FROM runs WHERE seq < ?1 ORDER BY seq DESC LIMIT ?2");
+  st.bind(1, before).bind(2, static_cast<std::int64_t>(limit) + 1);
+  RunPage page;
+  while (st.step()) page.runs.push_back(read_run(st));
+  if (page.runs.size() > limit) {
+    page.runs.pop_back();
+    page.next_cursor = std::to_string(page.runs.back().seq);
+  }
+  return page;
+}
+
+std::int64_t Store::append_event(const std::string& topic, const nlohmann::json& payload) {
+  db_.prepare("INSERT INTO event_log (time, topic, payload) VALUES (?1, ?2, ?3)")
+      .bind(1, std::string_view(now_iso8601()))
+      .bind(2, std::string_view(topic))
+      .bind(3, std::string_view(payload.dump()))
+      .run();
+  return db_.last_insert_rowid();
+}
+
+}  // namespace colorlab::store

@@ -1,0 +1,31 @@
+#pragma once
+// RFC 9457 problem details with SiLA's error categories, so a client can tell a bad request
+// (validation) from an instrument failure (defined_execution) without parsing prose.
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "colorlab/core/error.hpp"
+
+namespace colorlab::protocol {
+
+enum class ProblemCategory { validation, defined_execution, undefined_execution, framework, connection };
+std::string_view to_string(ProblemCategory c);
+
+struct Problem {
+  int status = 500;
+  std::string code;    // stable, documented: "not-found", "bad-json", ...
+  std::string title;
+  std::string detail;
+  ProblemCategory category = ProblemCategory::framework;
+  std::string hint;
+  std::string instance;
+
+  nlohmann::json to_json() const;  // {type, title, status, detail, instance, category, code, hint}
+  static Problem from_json(const nlohmann::json& j);
+};
+
+// The HTTP status and category a colorlab::Error maps to.
+Problem problem_from_error(const Error& e);
+
+}  // namespace colorlab::protocol

@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# Installs colorlab's Debian 12 dependencies (as root, only what is missing), then configures and
+# builds the chosen preset. Idempotent: a second run installs nothing and rebuilds incrementally.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+preset="${1:-dev}"
+
+packages=(
+  # toolchain
+  g++ cmake ninja-build pkg-config git
+  # libraries
+  libboost-dev libsqlite3-dev libserialport-dev libhidapi-dev libusb-1.0-0-dev libraw-dev libaravis-dev
+  libgphoto2-dev liblcms2-dev libeigen3-dev nlohmann-json3-dev libtomlplusplus-dev libcli11-dev liblua5.4-dev
+  libtiff-dev libjpeg-dev libsystemd-dev libssl-dev libgtest-dev libgmock-dev libbenchmark-dev
+  # standard CIE data at run time
+  colord-data
+  # independent references and test tools
+  argyll aravis-tools aravis-tools-cli libraw-bin dcraw python3-numpy hyperfine sqlite3 curl util-linux procps
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if ((${#missing[@]})); then
+  if [[ $(id -u) -ne 0 ]]; then
+    echo "colorlab setup: missing Debian packages: ${missing[*]}" >&2
+    echo "run this script as root, or: sudo apt-get install ${missing[*]}" >&2
+    exit 1
+  fi
+  echo "colorlab setup: installing ${missing[*]}"
+  export DEBIAN_FRONTEND=noninteractive
+  apt-get update -qq
+  apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+if [[ ! -f build/CMakeCache.txt && "$preset" == dev ]] || [[ "$preset" != dev && ! -d "build-$preset" ]]; then
+  cmake --preset "$preset" >/dev/null
+fi
+cmake --build --preset "$preset" -j "$(nproc)"

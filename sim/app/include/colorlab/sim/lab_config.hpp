@@ -1,0 +1,35 @@
+#pragma once
+// The simulated lab's configuration (TOML; see docs/simulator.md). Every field has a default,
+// so an empty file, or none, gives the default lab with every instrument.
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace colorlab::sim {
+
+struct Ls110SimConfig {
+  bool enabled = true;
+  std::string id = "ls110";
+  int aim_row = 0;   // floor grid spot the meter is aimed at (row 0 = front)
+  int aim_col = 9;
+  nlohmann::json faults = nlohmann::json::object();
+};
+
+struct LabConfig {
+  std::uint64_t seed = 1;
+  double time_scale = 1.0;
+  std::vector<std::string> lamps_on{"D65"};
+  double dimmer_percent = 100.0;
+  std::optional<std::filesystem::path> chart_file;
+  std::optional<std::filesystem::path> control_socket;  // default: a fresh path under $XDG_RUNTIME_DIR or /tmp
+  Ls110SimConfig ls110;
+};
+
+// Throws Error{bad_parameter} naming file, line and key.
+LabConfig load_lab_config(const std::filesystem::path& file);
+
+}  // namespace colorlab::sim

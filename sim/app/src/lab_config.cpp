@@ -1,0 +1,113 @@
+#include "colorlab/sim/lab_config.hpp"
+
+#include <toml++/toml.h>
+
+#include "colorlab/core/error.hpp"
+
+namespace colorlab::sim {
+
+namespace {
+
+[[noreturn]] void bad(const std::filesystem::path& file, const toml::node& node, const std::string& what) {
+  throw Error(ErrorClass::bad_parameter, file.string() + ":" + std::to_string(node.source().begin.line) + ": " + what,
+              "see docs/simulator.md");
+}
+
+nlohmann::json to_json(const toml::node& node) {
+  if (auto t = node.as_table()) {
+    nlohmann::json j = nlohmann::json::object();
+    for (const auto& [k, v] : *t) j[std::string(k.str())] = to_json(v);
+    return j;
+  }
+  if (auto a = node.as_array()) {
+    nlohmann::json j = nlohmann::json::array();
+    for (const auto& v : *a) j.push_back(to_json(v));
+    return j;
+  }
+  if (node.is_boolean()) return *node.value<bool>();
+  if (node.is_integer()) return *node.value<int64_t>();
+  if (node.is_floating_point()) return *node.value<double>();
+  if (auto v = node.value<std::string>()) return *v;
+  return nullptr;
+}
+
+}  // namespace
+
+LabConfig load_lab_config(const std::filesystem::path& file) {
+  toml::table root;
+  try {
+    root = toml::parse_file(file.string());
+  } catch (const toml::parse_error& e) {
+    throw Error(ErrorClass::bad_parameter,
+                file.string() + ":" + std::to_string(e.source().begin.line) + ": " + std::string(e.description()));
+  }
+  LabConfig c;
+  auto base = file.parent_path();
+  for (const auto& [key, node] : root) {
+    std::string k(key.str());
+    if (k == "seed") {
+      auto v = node.value<int64_t>();
+      if (!v || *v < 0) bad(file, node, "seed must be a non-negative integer");
+      c.seed = static_cast<std::uint64_t>(*v);
+    } else if (k == "time_scale") {
+      auto v = node.value<double>();
+      if (!v || *v <= 0) bad(file, node, "time_scale must be a positive number");
+      c.time_scale = *v;
+    } else if (k == "control_socket") {
+      auto v = node.value<std::string>();
+      if (!v) bad(file, node, "control_socket must be a path");
+      c.control_socket = *v;
+    } else if (k == "scene") {
+      auto t = node.as_table();
+      if (!t) bad(file, node, "[scene] must be a table");
+      for (const auto& [sk, sn] : *t) {
+        std::string s(sk.str());
+        if (s == "lamps_on") {
+          auto a = sn.as_array();
+          if (!a) bad(file, sn, "lamps_on must be an array of lamp names");
+          c.lamps_on.clear();
+          for (const auto& l : *a) {
+            auto name = l.value<std::string>();
+            if (!name) bad(file, l, "lamp names are strings");
+            c.lamps_on.push_back(*name);
+          }
+        } else if (s == "dimmer") {
+          auto v = sn.value<double>();
+          if (!v || *v < 0 || *v > 100) bad(file, sn, "dimmer must be 0..100");
+          c.dimmer_percent = *v;
+        } else if (s == "chart_file") {
+          auto v = sn.value<std::string>();
+          if (!v) bad(file, sn, "chart_file must be a path");
+          c.chart_file = std::filesystem::path(*v).is_absolute() ? std::filesystem::path(*v) : base / *v;
+        } else {
+          bad(file, sn, "unknown key scene." + s);
+        }
+      }
+    } else if (k == "ls110") {
+      auto t = node.as_table();
+      if (!t) bad(file, node, "[ls110] must be a table");
+      for (const auto& [sk, sn] : *t) {
+        std::string s(sk.str());
+        if (s == "enabled") {
+          c.ls110.enabled = sn.value_or(true);
+        } else if (s == "id") {
+          c.ls110.id = sn.value_or(std::string("ls110"));
+        } else if (s == "aim") {
+          auto a = sn.as_array();
+          if (!a || a->size() != 2) bad(file, sn, "aim must be [row, col]");
+          c.ls110.aim_row = static_cast<int>((*a)[0].value_or(int64_t{0}));
+          c.ls110.aim_col = static_cast<int>((*a)[1].value_or(int64_t{0}));
+        } else if (s == "faults") {
+          c.ls110.faults = to_json(sn);
+        } else {
+          bad(file, sn, "unknown key ls110." + s);
+        }
+      }
+    } else {
+      bad(file, node, "unknown key '" + k + "'");
+    }
+  }
+  return c;
+}
+
+}  // namespace colorlab::sim

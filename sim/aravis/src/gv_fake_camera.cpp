@@ -1,0 +1,136 @@
+#include "colorlab/sim/aravis/gv_fake_camera.hpp"
+
+#include <arv.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+
+#include "colorlab/core/error.hpp"
+
+namespace colorlab::sim::aravis {
+
+namespace {
+
+// GenICam PFNC codes of the formats we add (12/16-bit samples in 16-bit little-endian containers).
+constexpr std::uint32_t kBayerRG12 = 0x01100011;
+constexpr std::uint32_t kBayerRG16 = 0x0110002F;
+constexpr std::uint32_t kMono16 = 0x01100007;
+
+std::string_view format_name(std::uint32_t pf) {
+  switch (pf) {
+    case kBayerRG12: return "BayerRG12";
+    case kBayerRG16: return "BayerRG16";
+    case kMono16: return "Mono16";
+    default: return {};
+  }
+}
+
+}  // namespace
+
+std::uint16_t test_pattern_value(int x, int y) {
+  const int cell = (y & 1) * 2 + (x & 1);
+  return static_cast<std::uint16_t>(1000 * cell + (x + 3 * y) % 997);
+}
+
+std::string GvFakeCamera::genicam_xml() {
+  ArvFakeCamera* probe = arv_fake_camera_new("xmlprobe");
+  size_t size = 0;
+  const char* xml = arv_fake_camera_get_genicam_xml(probe, &size);
+  std::string text(xml ? xml : "", xml ? size : 0);
+  g_object_unref(probe);
+  const std::string anchor = "<pValue>PixelFormatRegister</pValue>";
+  const auto at = text.find(anchor);
+  if (at == std::string::npos) {
+    throw Error(ErrorClass::internal, "Aravis's fake-camera GenICam XML has no PixelFormatRegister",
+                "this Aravis version differs from 0.8.26; update sim/aravis to its XML");
+  }
+  char entries[512];
+  std::snprintf(entries, sizeof entries,
+                "<EnumEntry Name=\"BayerRG12\" NameSpace=\"Standard\"><Value>%u</Value></EnumEntry>\n"
+                "\t\t<EnumEntry Name=\"BayerRG16\" NameSpace=\"Standard\"><Value>%u</Value></EnumEntry>\n\t\t",
+                kBayerRG12, kBayerRG16);
+  text.insert(at, entries);
+  return text;
+}
+
+struct GvFakeCamera::Impl {
+  GvFakeOptions options;
+  std::filesystem::path xml_file;
+  ArvGvFakeCamera* gv = nullptr;
+  ArvFakeCamera* fake = nullptr;
+  std::atomic<std::uint64_t> frames{0};
+
+  static void fill(ArvBuffer* buffer, void* self, guint32 exposure_us, guint32 gain, ArvPixelFormat pf) {
+    auto* impl = static_cast<Impl*>(self);
+    size_t reported = 0;
+    // Aravis reports 0 bytes here (the fake zeroes received_size before the fill) although the
+    // buffer holds a whole payload, so the size is computed from the region instead.
+    auto* data = static_cast<std::uint16_t*>(const_cast<void*>(arv_buffer_get_data(buffer, &reported)));
+    gint x = 0, y = 0, w = 0, h = 0;
+    arv_buffer_get_image_region(buffer, &x, &y, &w, &h);
+    const std::string_view name = format_name(pf);
+    if (!data || w <= 0 || h <= 0 || name.empty()) return;  // 8-bit formats keep Aravis's zeros
+    std::span<std::uint16_t> out(data, static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
+    FillRequest req{x, y, w, h, name, static_cast<double>(exposure_us), static_cast<double>(gain),
+                    arv_buffer_get_frame_id(buffer)};
+    if (impl->options.fill) {
+      try {
+        impl->options.fill(req, out);
+      } catch (...) {
+        std::fill(out.begin(), out.end(), 0);  // never let an exception unwind through Aravis's C thread
+      }
+    } else {
+      for (int r = 0; r < h; ++r) {
+        for (int c = 0; c < w; ++c) out[static_cast<std::size_t>(r * w + c)] = test_pattern_value(x + c, y + r);
+      }
+    }
+    impl->frames.fetch_add(1);
+  }
+
+  ~Impl() {
+    if (gv) g_object_unref(gv);
+    std::error_code ec;
+    if (!xml_file.empty()) std::filesystem::remove(xml_file, ec);
+  }
+};
+
+GvFakeCamera::GvFakeCamera(GvFakeOptions options) : impl_(std::make_unique<Impl>()) {
+  impl_->options = std::move(options);
+  auto& o = impl_->options;
+  if (o.serial.empty() || o.serial.size() > 15) {
+    throw Error(ErrorClass::bad_parameter, "GigE Vision serial '" + o.serial + "' must have 1..15 characters",
+                "shorten the serial in the simulator config");
+  }
+  impl_->xml_file = std::filesystem::temp_directory_path() /
+                    ("colorlab-gvfake-" + std::to_string(::getpid()) + "-" + o.serial + ".xml");
+  {
+    std::ofstream xml(impl_->xml_file);
+    xml << genicam_xml();
+    if (!xml) throw Error(ErrorClass::io_error, "cannot write " + impl_->xml_file.string(), "check /tmp");
+  }
+  impl_->gv = arv_gv_fake_camera_new_full(o.address.c_str(), o.serial.c_str(), impl_->xml_file.c_str());
+  if (!impl_->gv || !arv_gv_fake_camera_is_running(impl_->gv)) {
+    throw Error(ErrorClass::conflict,
+                "GigE Vision fake camera could not start on " + o.address + " (GVCP port 3956 in use?)",
+                "stop the other simulated GenICam camera (another colorlab-sim or a test) and retry");
+  }
+  impl_->fake = arv_gv_fake_camera_get_fake_camera(impl_->gv);
+  arv_fake_camera_write_register(impl_->fake, ARV_FAKE_CAMERA_REGISTER_SENSOR_WIDTH, static_cast<guint32>(o.sensor_width));
+  arv_fake_camera_write_register(impl_->fake, ARV_FAKE_CAMERA_REGISTER_SENSOR_HEIGHT, static_cast<guint32>(o.sensor_height));
+  arv_fake_camera_set_fill_pattern(impl_->fake, &Impl::fill, impl_.get());
+}
+
+GvFakeCamera::~GvFakeCamera() = default;
+
+const std::string& GvFakeCamera::address() const { return impl_->options.address; }
+const std::string& GvFakeCamera::serial() const { return impl_->options.serial; }
+std::uint64_t GvFakeCamera::frames_filled() const { return impl_->frames.load(); }
+
+void GvFakeCamera::stall() { arv_fake_camera_write_register(impl_->fake, ARV_FAKE_CAMERA_REGISTER_ACQUISITION, 0); }
+
+}  // namespace colorlab::sim::aravis

@@ -1,0 +1,108 @@
+#pragma once
+// Image formation of the simulated camera: the chart in the cabinet, seen through spectral sensitivities
+// (Canon EOS 20D curves when the shared data set is present, else a parametric default), turned into
+// electrons by aperture, shutter and ISO, and into a 12-bit RGGB frame with shot, read and dark noise,
+// PRNU and fixed-pattern offsets, hot/dead pixels and sensor dust (fixed per camera seed), vignetting,
+// black level and clipping.
+//
+// The noiseless image is computed once per (settings, scene state) and cached; a frame only adds noise,
+// seeded by (camera seed, frame_index), so any frame can be reproduced bit-exactly.
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "colorlab/sim/camera/raw_frame.hpp"
+#include "colorlab/sim/scene.hpp"
+
+namespace colorlab::sim::camera {
+
+struct CameraConfig {
+  int width = 3504;    // even
+  int height = 2336;   // even
+  std::optional<std::uint64_t> seed;  // default: the scene's "camera" stream
+  // CSV wavelength_nm,R,G,B. Unset: the shared set's Canon 20D curves when present, else parametric.
+  std::optional<std::filesystem::path> sensitivity_file;
+  bool force_parametric_sensitivities = false;
+  double chart_height_fraction = 0.8;  // of the frame height the chart fills
+  // Sensor (EOS-20D-like): DN per electron at ISO 100, full well, read noise, dark current.
+  double gain_dn_per_e_iso100 = 0.09;
+  double read_noise_e = 9.0;
+  double adc_noise_dn = 0.8;
+  double dark_current_e_per_s = 0.5;
+  double prnu_sigma = 0.006;           // pixel gain non-uniformity (relative)
+  double dsnu_sigma_dn = 0.5;          // pixel offset non-uniformity
+  double column_offset_sigma_dn = 0.3; // column fixed-pattern
+  double hot_pixel_fraction = 2e-5;
+  double dead_pixel_fraction = 1e-5;
+  int dust_specks = 6;                 // dust shadows, each on a patch
+  int threads = 2;                     // for rendering frames
+  // Electrons per (cd·s·m⁻²) of green-channel exposure L·t/N² (sets the overall brightness).
+  double electrons_per_exposure = 15500.0;
+};
+
+struct PatchRegion {
+  int x = 0, y = 0, width = 0, height = 0;  // pixels; the whole patch square
+};
+
+struct PixelDefect {
+  int x = 0, y = 0;
+  enum class Kind { hot, dead } kind = Kind::hot;
+};
+
+struct DustSpeck {
+  double x = 0, y = 0, radius = 0;  // pixels
+  double transmission = 1;          // < 1: darker
+  int patch = -1;
+};
+
+class CameraModel {
+ public:
+  CameraModel(std::shared_ptr<const Scene> scene, CameraConfig config = {});
+  ~CameraModel();
+  CameraModel(const CameraModel&) = delete;
+  CameraModel& operator=(const CameraModel&) = delete;
+
+  int width() const;
+  int height() const;
+  std::uint64_t seed() const;
+  const CameraConfig& config() const;
+
+  // Renders frame `frame_index` under the scene's current lamps, dimmer and warm-up. Thread-safe.
+  // Throws Error(bad_parameter) for non-positive f-number/shutter or ISO outside 50..3200.
+  RawFrame render(const CameraSettings& settings, std::uint64_t frame_index) const;
+  // Same, reusing `out`'s buffer.
+  void render_into(RawFrame& out, const CameraSettings& settings, std::uint64_t frame_index) const;
+
+  // Pixel rectangle of patch 0..139 (Chart order: A1, A2, ..., N10).
+  PatchRegion patch_region(int patch_index) const;
+  // Ground truth: noiseless mean counts (including the black level) of R, G, B pixels over the patch region,
+  // without PRNU, dust and defective pixels, for the scene's current state.
+  std::array<double, 3> ground_truth(int patch_index, const CameraSettings& settings) const;
+  std::vector<std::array<double, 3>> ground_truth(const CameraSettings& settings) const;
+
+  // Fixed per camera seed.
+  const std::vector<PixelDefect>& defects() const;
+  const std::vector<DustSpeck>& dust() const;
+
+  // Relative spectral sensitivities (R, G, B) on 380–730 nm / 5 nm, and their source ("file path" or "parametric").
+  const std::array<Spectrum, 3>& sensitivities() const;
+  const std::string& sensitivity_source() const;
+
+  // XYZ (D65-adapted, Y=1 white) → camera RGB (white-balanced to G=1 for D65) least-squares fit over the chart:
+  // what a DNG's ColorMatrix1 carries. Row-major 3×3.
+  std::array<double, 9> xyz_to_camera_d65() const;
+  // Camera RGB of a perfect white under the current lamps, normalised to G = 1 (a DNG's AsShotNeutral).
+  std::array<double, 3> as_shot_neutral() const;
+
+  // Temporal noise σ (DN) of a pixel with this mean signal above black (electrons → DN), for tests.
+  double temporal_sigma_dn(double signal_dn, const CameraSettings& settings) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace colorlab::sim::camera

@@ -1,0 +1,449 @@
+#include "colorlab/sim/camera/camera_model.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <mutex>
+#include <random>
+#include <string>
+#include <thread>
+
+#include "colorlab/analysis/colorimetry.hpp"
+#include "colorlab/core/error.hpp"
+#include "fast_random.hpp"
+#include "sensitivities.hpp"
+
+namespace colorlab::sim::camera {
+namespace {
+
+constexpr int surround_material = chart_patch_count;      // the chart's dark surround between patches
+constexpr int floor_material = chart_patch_count + 1;     // cabinet floor around the chart
+constexpr int material_count = chart_patch_count + 2;
+constexpr double surround_reflectance = 0.05;
+constexpr int noise_block_rows = 16;  // rows per independently seeded noise block
+constexpr int field_node_step = 16;   // px between exact field evaluations (the field is smooth)
+
+std::size_t lamp_index(Lamp l) { return static_cast<std::size_t>(l); }
+
+void check_settings(const CameraSettings& s) {
+  if (!(s.f_number > 0.0) || !std::isfinite(s.f_number))
+    throw Error(ErrorClass::bad_parameter, "camera f-number must be > 0, got " + std::to_string(s.f_number));
+  if (!(s.shutter_s > 0.0) || !std::isfinite(s.shutter_s))
+    throw Error(ErrorClass::bad_parameter, "camera shutter time must be > 0 s, got " + std::to_string(s.shutter_s));
+  if (s.iso < 50 || s.iso > 3200)
+    throw Error(ErrorClass::bad_parameter, "camera ISO must be within 50..3200, got " + std::to_string(s.iso));
+}
+
+bool same_settings(const CameraSettings& a, const CameraSettings& b) {
+  return a.f_number == b.f_number && a.shutter_s == b.shutter_s && a.iso == b.iso;
+}
+
+// Runs fn(first_row, end_row) for interleaved row blocks on `threads` threads; block i is always the same rows,
+// so results do not depend on the thread count.
+template <typename Fn>
+void for_row_blocks(int height, int threads, Fn&& fn) {
+  const int blocks = (height + noise_block_rows - 1) / noise_block_rows;
+  auto worker = [&](int t, int n) {
+    for (int b = t; b < blocks; b += n) fn(b, b * noise_block_rows, std::min(height, (b + 1) * noise_block_rows));
+  };
+  const int n = std::max(1, std::min(threads, blocks));
+  std::vector<std::thread> pool;
+  for (int t = 1; t < n; ++t) pool.emplace_back(worker, t, n);
+  worker(0, n);
+  for (auto& th : pool) th.join();
+}
+
+}  // namespace
+
+struct CameraModel::Impl {
+  std::shared_ptr<const Scene> scene;
+  CameraConfig config;
+  std::uint64_t seed = 0;
+  detail::Sensitivities sens;
+  double px_per_mm = 0, origin_x = 0, origin_y = 0;  // chart top-left in pixels
+  std::vector<Spectrum> material_reflectance;          // material_count
+  // response[lamp][material][channel]: green-normalised exposure per cd/m² of floor luminance.
+  std::array<std::vector<std::array<double, 3>>, 5> response;
+  std::vector<PatchRegion> regions;
+  std::vector<PixelDefect> defects;
+  std::vector<DustSpeck> dust;
+  std::vector<float> column_offset;
+
+  struct Precomputed {
+    CameraSettings settings;
+    std::uint64_t version = 0;
+    double gain = 0;  // DN per electron
+    std::vector<Lamp> lamps;
+    std::vector<std::vector<float>> signal_e;                  // per lamp on, warm-up 1
+    std::vector<float> base_dn;                                // black + offsets + dark signal
+    std::vector<float> var0;                                   // DN² from dark shot noise and read noise
+    std::vector<std::vector<std::array<double, 3>>> truth_e;   // per lamp: mean smooth electrons per patch
+    double dark_e = 0;
+  };
+  mutable std::mutex cache_mutex;
+  mutable std::shared_ptr<const Precomputed> cache;
+
+  int material_at(int x, int y) const {
+    const double cx = (x + 0.5 - origin_x) / px_per_mm, cy = (y + 0.5 - origin_y) / px_per_mm;
+    if (cx < 0 || cy < 0 || cx >= chart_width_mm || cy >= chart_height_mm) return floor_material;
+    const auto p = scene->chart().patch_at(cx, cy);
+    return p ? *p : surround_material;
+  }
+
+  std::pair<double, double> floor_mm(double x, double y) const {
+    return scene->chart_to_floor_mm((x - origin_x) / px_per_mm, (y - origin_y) / px_per_mm);
+  }
+
+  double vignetting(int x, int y, double f_number) const {
+    const double dx = x + 0.5 - config.width / 2.0, dy = y + 0.5 - config.height / 2.0;
+    const double r2 = (dx * dx + dy * dy) / (config.width * config.width / 4.0 + config.height * config.height / 4.0);
+    return 1.0 - (0.35 / f_number) * r2;  // natural vignetting eases as the lens is stopped down
+  }
+
+  double gain_dn_per_e(const CameraSettings& s) const { return config.gain_dn_per_e_iso100 * s.iso / 100.0; }
+
+  std::shared_ptr<const Precomputed> precomputed(const CameraSettings& settings) const;
+  std::shared_ptr<const Precomputed> build(const CameraSettings& settings, std::uint64_t version) const;
+  void place_defects_and_dust();
+};
+
+std::shared_ptr<const CameraModel::Impl::Precomputed> CameraModel::Impl::precomputed(const CameraSettings& s) const {
+  check_settings(s);
+  const std::uint64_t version = scene->state_version();
+  std::lock_guard lock(cache_mutex);
+  if (!cache || cache->version != version || !same_settings(cache->settings, s)) cache = build(s, version);
+  return cache;
+}
+
+std::shared_ptr<const CameraModel::Impl::Precomputed> CameraModel::Impl::build(const CameraSettings& s,
+                                                                              std::uint64_t version) const {
+  auto pre = std::make_shared<Precomputed>();
+  pre->settings = s;
+  pre->version = version;
+  pre->gain = gain_dn_per_e(s);
+  pre->lamps = scene->lamps_on();
+  const double dimmer = scene->dimmer();
+  const int W = config.width, H = config.height;
+  const std::size_t n = static_cast<std::size_t>(W) * static_cast<std::size_t>(H);
+  const double exposure = config.electrons_per_exposure * s.shutter_s / (s.f_number * s.f_number);
+  const double g = pre->gain;
+  pre->dark_e = config.dark_current_e_per_s * s.shutter_s;
+  const float read_var = static_cast<float>(g * g * config.read_noise_e * config.read_noise_e +
+                                            config.adc_noise_dn * config.adc_noise_dn);
+  const float black = 256.0f;
+
+  // The lamp field on a coarse node grid (it is smooth), bilinearly interpolated per pixel.
+  const int nx = W / field_node_step + 2, ny = H / field_node_step + 2;
+  std::vector<std::vector<double>> nodes(pre->lamps.size(), std::vector<double>(static_cast<std::size_t>(nx * ny)));
+  for (std::size_t li = 0; li < pre->lamps.size(); ++li)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        const auto [fx, fy] = floor_mm(i * field_node_step, j * field_node_step);
+        nodes[li][static_cast<std::size_t>(j * nx + i)] = scene->lamp_floor_luminance(pre->lamps[li], dimmer, fx, fy);
+      }
+
+  pre->signal_e.assign(pre->lamps.size(), std::vector<float>(n));
+  pre->base_dn.resize(n);
+  pre->var0.resize(n);
+  // Per-block partial sums for the truth, merged afterwards (blocks run on different threads).
+  const int blocks = (H + noise_block_rows - 1) / noise_block_rows;
+  std::vector<std::vector<std::vector<std::array<double, 4>>>> partial(
+      static_cast<std::size_t>(blocks),
+      std::vector<std::vector<std::array<double, 4>>>(pre->lamps.size(),
+                                                      std::vector<std::array<double, 4>>(chart_patch_count * 3)));
+  const std::uint64_t prnu_key = detail::splitmix64(seed ^ 0x5052'4E55ull);
+  const std::uint64_t dsnu_key = detail::splitmix64(seed ^ 0x4453'4E55ull);
+  const std::uint64_t dark_key = detail::splitmix64(seed ^ 0x4441'524Bull);
+
+  for_row_blocks(H, config.threads, [&](int block, int y0, int y1) {
+    for (int y = y0; y < y1; ++y) {
+      const int jy = y / field_node_step;
+      const double ty = double(y - jy * field_node_step) / field_node_step;
+      for (int x = 0; x < W; ++x) {
+        const std::size_t p = static_cast<std::size_t>(y) * W + x;
+        const int m = material_at(x, y);
+        const int c = rggb_channel(x, y);
+        const double vig = vignetting(x, y, s.f_number);
+        double pixel_gain = 1.0 + config.prnu_sigma * detail::hashed_normal(prnu_key + p);
+        for (const auto& d : dust) {
+          const double r2 = ((x + 0.5 - d.x) * (x + 0.5 - d.x) + (y + 0.5 - d.y) * (y + 0.5 - d.y)) / (d.radius * d.radius);
+          if (r2 < 1.0) pixel_gain *= 1.0 - (1.0 - d.transmission) * (1.0 - r2 * r2);  // soft-edged shadow
+        }
+        const int jx = x / field_node_step;
+        const double tx = double(x - jx * field_node_step) / field_node_step;
+        for (std::size_t li = 0; li < pre->lamps.size(); ++li) {
+          const auto& nd = nodes[li];
+          const std::size_t k = static_cast<std::size_t>(jy * nx + jx);
+          const double field = (nd[k] * (1 - tx) + nd[k + 1] * tx) * (1 - ty) +
+                               (nd[k + nx] * (1 - tx) + nd[k + nx + 1] * tx) * ty;
+          const double smooth = exposure * vig * field * response[lamp_index(pre->lamps[li])][static_cast<std::size_t>(m)][static_cast<std::size_t>(c)];
+          pre->signal_e[li][p] = static_cast<float>(smooth * pixel_gain);
+          if (m < chart_patch_count) {
+            auto& acc = partial[static_cast<std::size_t>(block)][li][static_cast<std::size_t>(m * 3 + c)];
+            acc[0] += smooth;
+            acc[1] += 1;
+          }
+        }
+        const double dark = pre->dark_e * std::max(0.0, 1.0 + 0.3 * detail::hashed_normal(dark_key + p));
+        const double offset = config.dsnu_sigma_dn * detail::hashed_normal(dsnu_key + p) + column_offset[static_cast<std::size_t>(x)];
+        pre->base_dn[p] = static_cast<float>(black + offset + g * dark);
+        pre->var0[p] = static_cast<float>(g * g * dark) + read_var;
+      }
+    }
+  });
+
+  // Defects are few; patch them in after the smooth pass.
+  std::mt19937_64 hot_rng(detail::splitmix64(seed ^ 0x484F54ull));
+  for (const auto& d : defects) {
+    const std::size_t p = static_cast<std::size_t>(d.y) * W + d.x;
+    if (d.kind == PixelDefect::Kind::dead) {
+      for (auto& sig : pre->signal_e) sig[p] = 0.0f;
+      pre->base_dn[p] = black;
+      pre->var0[p] = read_var;
+    } else {
+      // A hot pixel: a large leakage current (grows with exposure) on top of a stuck offset.
+      const double leak_e = std::uniform_real_distribution<double>(2e4, 2e5)(hot_rng) * s.shutter_s;
+      const double stuck_dn = std::uniform_real_distribution<double>(300, 2500)(hot_rng);
+      pre->base_dn[p] = static_cast<float>(black + stuck_dn + g * leak_e);
+      pre->var0[p] = static_cast<float>(g * g * leak_e) + read_var;
+    }
+  }
+
+  pre->truth_e.assign(pre->lamps.size(), std::vector<std::array<double, 3>>(chart_patch_count));
+  for (std::size_t li = 0; li < pre->lamps.size(); ++li)
+    for (int m = 0; m < chart_patch_count; ++m)
+      for (int c = 0; c < 3; ++c) {
+        double sum = 0, count = 0;
+        for (const auto& blk : partial) {
+          sum += blk[li][static_cast<std::size_t>(m * 3 + c)][0];
+          count += blk[li][static_cast<std::size_t>(m * 3 + c)][1];
+        }
+        pre->truth_e[li][static_cast<std::size_t>(m)][static_cast<std::size_t>(c)] = count > 0 ? sum / count : 0.0;
+      }
+  return pre;
+}
+
+void CameraModel::Impl::place_defects_and_dust() {
+  std::mt19937_64 rng(detail::splitmix64(seed ^ 0x4445'4645'4354ull));
+  const int W = config.width, H = config.height;
+  const double pixels = double(W) * double(H);
+  const auto count = [&](double fraction) {
+    return fraction > 0 ? std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(fraction * pixels))) : 0;
+  };
+  std::uniform_int_distribution<int> ux(0, W - 1), uy(0, H - 1);
+  for (std::size_t i = 0, n = count(config.hot_pixel_fraction); i < n; ++i)
+    defects.push_back({ux(rng), uy(rng), PixelDefect::Kind::hot});
+  for (std::size_t i = 0, n = count(config.dead_pixel_fraction); i < n; ++i)
+    defects.push_back({ux(rng), uy(rng), PixelDefect::Kind::dead});
+
+  // Dust shadows on patches away from the border, like the outliers of fig. 31(c).
+  std::uniform_int_distribution<int> col(1, chart_columns - 2), row(1, chart_rows - 2);
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  const double scale = std::max(1.0, W / 3504.0 * 8.0);
+  for (int i = 0; i < config.dust_specks; ++i) {
+    const int patch = col(rng) * chart_rows + row(rng);
+    const auto& r = regions[static_cast<std::size_t>(patch)];
+    DustSpeck d;
+    d.patch = patch;
+    d.radius = std::max(1.5, scale * (0.3 + 0.5 * u01(rng)));
+    d.x = r.x + d.radius + u01(rng) * std::max(0.0, r.width - 2 * d.radius);
+    d.y = r.y + d.radius + u01(rng) * std::max(0.0, r.height - 2 * d.radius);
+    d.transmission = 0.55 + 0.3 * u01(rng);
+    dust.push_back(d);
+  }
+
+  column_offset.resize(static_cast<std::size_t>(W));
+  std::normal_distribution<double> n01(0.0, 1.0);
+  for (auto& o : column_offset) o = static_cast<float>(config.column_offset_sigma_dn * n01(rng));
+}
+
+CameraModel::CameraModel(std::shared_ptr<const Scene> scene, CameraConfig config) : impl_(std::make_unique<Impl>()) {
+  if (!scene) throw Error(ErrorClass::bad_parameter, "CameraModel needs a Scene");
+  if (config.width < 64 || config.height < 64 || config.width % 2 || config.height % 2)
+    throw Error(ErrorClass::bad_parameter, "camera frame must be at least 64×64 with even width and height, got " +
+                                               std::to_string(config.width) + "×" + std::to_string(config.height));
+  if (!(config.chart_height_fraction > 0.1 && config.chart_height_fraction <= 1.0))
+    throw Error(ErrorClass::bad_parameter, "chart_height_fraction must be within (0.1, 1]");
+  auto& m = *impl_;
+  m.scene = std::move(scene);
+  m.config = std::move(config);
+  m.seed = m.config.seed ? *m.config.seed : m.scene->stream_seed("camera");
+  m.sens = detail::load_sensitivities(m.config, *m.scene);
+  m.px_per_mm = m.config.chart_height_fraction * m.config.height / chart_height_mm;
+  if (chart_width_mm * m.px_per_mm > m.config.width)
+    m.px_per_mm = m.config.width / chart_width_mm;  // portrait-ish frames: fit the width instead
+  m.origin_x = (m.config.width - chart_width_mm * m.px_per_mm) / 2.0;
+  m.origin_y = (m.config.height - chart_height_mm * m.px_per_mm) / 2.0;
+
+  for (const auto& p : m.scene->chart().patches) m.material_reflectance.push_back(p.reflectance);
+  m.material_reflectance.push_back(Spectrum{380.0, 350.0, {surround_reflectance, surround_reflectance}});
+  m.material_reflectance.push_back(Spectrum{380.0, 350.0, {Scene::floor_reflectance(), Scene::floor_reflectance()}});
+  for (Lamp l : all_lamps) {
+    auto& resp = m.response[lamp_index(l)];
+    resp.resize(material_count);
+    for (int mat = 0; mat < material_count; ++mat) {
+      const Spectrum rad = m.scene->lamp_radiance_per_cd(l, m.material_reflectance[static_cast<std::size_t>(mat)]);
+      for (std::size_t c = 0; c < 3; ++c) {
+        double sum = 0;
+        for (std::size_t i = 0; i < rad.values.size(); ++i) sum += rad.values[i] * m.sens.rgb[c].at(rad.wavelength(i));
+        resp[static_cast<std::size_t>(mat)][c] = 683.0 * sum * rad.step_nm;
+      }
+    }
+  }
+  for (const auto& p : m.scene->chart().patches) {
+    // Pixels whose centres lie inside the patch square.
+    const int x0 = static_cast<int>(std::ceil(m.origin_x + p.x_mm * m.px_per_mm - 0.5));
+    const int x1 = static_cast<int>(std::ceil(m.origin_x + (p.x_mm + p.size_mm) * m.px_per_mm - 0.5));
+    const int y0 = static_cast<int>(std::ceil(m.origin_y + p.y_mm * m.px_per_mm - 0.5));
+    const int y1 = static_cast<int>(std::ceil(m.origin_y + (p.y_mm + p.size_mm) * m.px_per_mm - 0.5));
+    m.regions.push_back({x0, y0, x1 - x0, y1 - y0});
+  }
+  m.place_defects_and_dust();
+}
+
+CameraModel::~CameraModel() = default;
+
+int CameraModel::width() const { return impl_->config.width; }
+int CameraModel::height() const { return impl_->config.height; }
+std::uint64_t CameraModel::seed() const { return impl_->seed; }
+const CameraConfig& CameraModel::config() const { return impl_->config; }
+
+RawFrame CameraModel::render(const CameraSettings& settings, std::uint64_t frame_index) const {
+  RawFrame f;
+  render_into(f, settings, frame_index);
+  return f;
+}
+
+void CameraModel::render_into(RawFrame& out, const CameraSettings& settings, std::uint64_t frame_index) const {
+  const auto pre = impl_->precomputed(settings);
+  const int W = impl_->config.width, H = impl_->config.height;
+  out.width = W;
+  out.height = H;
+  out.cfa = "RGGB";
+  out.black_level = 256;
+  out.white_level = 4095;
+  out.frame_index = frame_index;
+  out.settings = settings;
+  out.pixels.resize(static_cast<std::size_t>(W) * static_cast<std::size_t>(H));
+
+  std::array<float, 5> warm{};
+  for (std::size_t li = 0; li < pre->lamps.size(); ++li)
+    warm[li] = static_cast<float>(impl_->scene->warmup_factor(pre->lamps[li]));
+  const float g = static_cast<float>(pre->gain), g2 = g * g;
+  const float white = static_cast<float>(out.white_level);
+  const float* table = detail::normal_table().data();
+  const std::uint64_t frame_key = detail::splitmix64(impl_->seed ^ detail::splitmix64(frame_index + 0x46524D45ull));
+  const std::size_t lamps = pre->lamps.size();
+  std::uint16_t* dst = out.pixels.data();
+
+  for_row_blocks(H, impl_->config.threads, [&](int block, int y0, int y1) {
+    detail::Xoshiro256Plus rng(frame_key ^ (static_cast<std::uint64_t>(block) * 0xD1B54A32D192ED03ull));
+    const std::size_t begin = static_cast<std::size_t>(y0) * W, end = static_cast<std::size_t>(y1) * W;
+    std::uint64_t bits = 0;
+    int left = 0;
+    for (std::size_t p = begin; p < end; ++p) {
+      float s = 0.0f;
+      for (std::size_t li = 0; li < lamps; ++li) s += warm[li] * pre->signal_e[li][p];
+      if (left == 0) bits = rng(), left = 4;
+      const float z = table[bits & 0xFFFF];
+      bits >>= 16;
+      --left;
+      float v = pre->base_dn[p] + g * s + std::sqrt(pre->var0[p] + g2 * s) * z + 0.5f;
+      v = std::clamp(v, 0.0f, white);
+      dst[p] = static_cast<std::uint16_t>(v);
+    }
+  });
+}
+
+PatchRegion CameraModel::patch_region(int patch_index) const {
+  if (patch_index < 0 || patch_index >= chart_patch_count)
+    throw Error(ErrorClass::bad_parameter, "patch index " + std::to_string(patch_index) + " is outside 0..139");
+  return impl_->regions[static_cast<std::size_t>(patch_index)];
+}
+
+std::array<double, 3> CameraModel::ground_truth(int patch_index, const CameraSettings& settings) const {
+  if (patch_index < 0 || patch_index >= chart_patch_count)
+    throw Error(ErrorClass::bad_parameter, "patch index " + std::to_string(patch_index) + " is outside 0..139");
+  return ground_truth(settings)[static_cast<std::size_t>(patch_index)];
+}
+
+std::vector<std::array<double, 3>> CameraModel::ground_truth(const CameraSettings& settings) const {
+  const auto pre = impl_->precomputed(settings);
+  std::vector<std::array<double, 3>> out(chart_patch_count);
+  for (int m = 0; m < chart_patch_count; ++m)
+    for (std::size_t c = 0; c < 3; ++c) {
+      double e = pre->dark_e;
+      for (std::size_t li = 0; li < pre->lamps.size(); ++li)
+        e += impl_->scene->warmup_factor(pre->lamps[li]) * pre->truth_e[li][static_cast<std::size_t>(m)][c];
+      out[static_cast<std::size_t>(m)][c] = std::min(256.0 + pre->gain * e, 4095.0);
+    }
+  return out;
+}
+
+const std::vector<PixelDefect>& CameraModel::defects() const { return impl_->defects; }
+const std::vector<DustSpeck>& CameraModel::dust() const { return impl_->dust; }
+const std::array<Spectrum, 3>& CameraModel::sensitivities() const { return impl_->sens.rgb; }
+const std::string& CameraModel::sensitivity_source() const { return impl_->sens.source; }
+
+std::array<double, 9> CameraModel::xyz_to_camera_d65() const {
+  // Least squares over the chart: camera RGB ≈ M · XYZ, both scaled so that a perfect white has G = Y = 1.
+  const auto& resp = impl_->response[lamp_index(Lamp::d65)];
+  const Spectrum white_refl{380.0, 350.0, {1.0, 1.0}};
+  auto xyz_of = [&](const Spectrum& refl) {
+    const Spectrum rad = impl_->scene->lamp_radiance_per_cd(Lamp::d65, refl);
+    analysis::SpectralSet set;
+    set.names = {"s"};
+    set.values.resize(1, static_cast<Eigen::Index>(rad.values.size()));
+    for (std::size_t i = 0; i < rad.values.size(); ++i) {
+      set.wavelengths.push_back(rad.wavelength(i));
+      set.values(0, static_cast<Eigen::Index>(i)) = rad.values[i];
+    }
+    const auto xyz = analysis::emission_to_xyz(set, analysis::Observer::cie1931_2deg, 683.0)[0];
+    return Eigen::Vector3d(xyz.X, xyz.Y, xyz.Z);
+  };
+  const Eigen::Vector3d white_xyz = xyz_of(white_refl);
+  double white_g = 0;
+  {
+    const Spectrum rad = impl_->scene->lamp_radiance_per_cd(Lamp::d65, white_refl);
+    for (std::size_t i = 0; i < rad.values.size(); ++i) white_g += rad.values[i] * impl_->sens.rgb[1].at(rad.wavelength(i));
+    white_g *= 683.0 * rad.step_nm;
+  }
+  Eigen::MatrixXd X(chart_patch_count, 3), C(chart_patch_count, 3);
+  for (int m = 0; m < chart_patch_count; ++m) {
+    X.row(m) = xyz_of(impl_->material_reflectance[static_cast<std::size_t>(m)]).transpose() / white_xyz.y();
+    for (int c = 0; c < 3; ++c) C(m, c) = resp[static_cast<std::size_t>(m)][static_cast<std::size_t>(c)] / white_g;
+  }
+  const Eigen::Matrix3d Mt = X.colPivHouseholderQr().solve(C);  // C ≈ X · Mᵀ
+  std::array<double, 9> out{};
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) out[static_cast<std::size_t>(r * 3 + c)] = Mt(c, r);
+  return out;
+}
+
+std::array<double, 3> CameraModel::as_shot_neutral() const {
+  const auto lamps = impl_->scene->lamps_on();
+  const double dimmer = impl_->scene->dimmer();
+  const auto [fx, fy] = impl_->scene->chart_to_floor_mm(chart_width_mm / 2, chart_height_mm / 2);
+  const Spectrum white{380.0, 350.0, {1.0, 1.0}};
+  std::array<double, 3> rgb{};
+  for (Lamp l : lamps) {
+    const double k = impl_->scene->lamp_floor_luminance(l, dimmer, fx, fy) * impl_->scene->warmup_factor(l);
+    const Spectrum rad = impl_->scene->lamp_radiance_per_cd(l, white);
+    for (std::size_t c = 0; c < 3; ++c) {
+      double sum = 0;
+      for (std::size_t i = 0; i < rad.values.size(); ++i) sum += rad.values[i] * impl_->sens.rgb[c].at(rad.wavelength(i));
+      rgb[c] += k * sum;
+    }
+  }
+  if (!(rgb[1] > 0)) return {1.0, 1.0, 1.0};  // dark cabinet: no neutral to report
+  return {rgb[0] / rgb[1], 1.0, rgb[2] / rgb[1]};
+}
+
+double CameraModel::temporal_sigma_dn(double signal_dn, const CameraSettings& settings) const {
+  const double g = impl_->gain_dn_per_e(settings);
+  const double e = std::max(0.0, signal_dn / g);
+  return std::sqrt(g * g * e + g * g * impl_->config.read_noise_e * impl_->config.read_noise_e +
+                   impl_->config.adc_noise_dn * impl_->config.adc_noise_dn);
+}
+
+}  // namespace colorlab::sim::camera

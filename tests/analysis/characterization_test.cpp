@@ -1,0 +1,258 @@
+// Chapter 7 characterization: term sets as §7.3 lists them, exact least squares and cross-validation, comparison with
+// ArgyllCMS colprof/profcheck on the same inputs, the SG→CC24 generalisation bar of colprof -ax, and the black box.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <random>
+#include <regex>
+
+#include "colorlab/analysis/blackbox.hpp"
+#include "colorlab/analysis/chart_io.hpp"
+#include "colorlab/analysis/color_difference.hpp"
+#include "colorlab/analysis/colorimetry.hpp"
+#include "colorlab/analysis/regression.hpp"
+#include "colorlab/analysis/standard_data.hpp"
+#include "colorlab/core/error.hpp"
+#include "test_support.hpp"
+
+namespace ca = colorlab::analysis;
+
+namespace {
+
+TEST(TermSets, DissertationSetsAreExactlyAsListed) {
+  const std::size_t sizes[] = {3, 5, 6, 8, 9, 11, 13, 20, 16, 29, 19};
+  for (int n = 1; n <= 11; ++n) EXPECT_EQ(ca::dissertation_set(n).size(), sizes[n - 1]) << "set " << n;
+  EXPECT_EQ(ca::dissertation_set(3).describe(), "r, g, b, rg, rb, gb");  // no constant
+  EXPECT_EQ(ca::dissertation_set(7).terms.back().label(), "1");
+  EXPECT_EQ(ca::dissertation_set(2).describe(), "r, g, b, rgb, 1");
+  const auto s10 = ca::dissertation_set(10);
+  EXPECT_EQ(s10.terms[14].label(), "r^3");  // the OCR's "r^3 g^3" is two terms
+  EXPECT_EQ(s10.terms[15].label(), "g^3");
+  EXPECT_EQ(s10.terms[20].label(), "r^3g^3b^3");
+  EXPECT_EQ(s10.terms[27].label(), "r^4g^4b^4");
+  EXPECT_EQ(ca::dissertation_set(8).describe(),
+            "r, g, b, rg, rb, gb, r^2, g^2, b^2, r^2g^2, r^2b^2, g^2b^2, r^2g^2b^2, r^3, g^3, b^3, r^3g^3, r^3b^3, g^3b^3, 1");
+  for (int n : ca::kHongCheungSizes) EXPECT_EQ(ca::hong_cheung_set(n).size(), static_cast<std::size_t>(n));
+  const std::size_t rp[] = {3, 6, 13, 22};
+  for (int d = 1; d <= 4; ++d) EXPECT_EQ(ca::root_polynomial_set(d).size(), rp[d - 1]);
+  EXPECT_EQ(ca::root_polynomial_set(2).terms[3].label(), "(rg)^1/2");
+  EXPECT_THROW(ca::term_set_by_name("poly:12"), colorlab::Error);
+  EXPECT_THROW(ca::term_set_by_name("hong:4"), colorlab::Error);
+  EXPECT_THROW(ca::term_set_by_name("spline:3"), colorlab::Error);
+  EXPECT_EQ(ca::all_term_sets().size(), 26u);
+}
+
+// Root-polynomial terms are degree-1 homogeneous: scaling RGB by k scales every term by k (exposure invariance).
+TEST(TermSets, RootPolynomialsScaleWithExposure) {
+  Eigen::MatrixXd rgb(1, 3);
+  rgb << 0.2, 0.5, 0.7;
+  for (int d = 1; d <= 4; ++d) {
+    auto s = ca::root_polynomial_set(d);
+    Eigen::MatrixXd a = ca::expand_terms(s, rgb), b = ca::expand_terms(s, 2 * rgb);
+    EXPECT_NEAR((b - 2 * a).cwiseAbs().maxCoeff(), 0, 1e-12);
+  }
+}
+
+ca::ChartData synthetic_chart(int n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0.02, 1.0);
+  ca::ChartData c;
+  c.rgb.resize(n, 3);
+  for (int i = 0; i < n; ++i) {
+    c.ids.push_back("P" + std::to_string(i + 1));
+    c.rgb.row(i) << u(rng), u(rng), u(rng);
+  }
+  return c;
+}
+
+TEST(Regression, RecoversAGeneratingPolynomialAndLooMatchesExplicitRefits) {
+  ca::ChartData c = synthetic_chart(60, 7);
+  const auto set = ca::dissertation_set(6);
+  Eigen::MatrixXd truth = Eigen::MatrixXd::Random(static_cast<Eigen::Index>(set.size()), 3) * 20;
+  c.xyz = ca::expand_terms(set, c.rgb) * truth;
+  c.xyz.array() += 40;  // keep XYZ positive; the constant term absorbs it
+  c.lab = ca::xyz_rows_to_lab(c.xyz, c.white);
+  ca::FitOptions o;
+  o.input_scale = 1.0;
+  auto model = ca::fit(set, c, o);
+  Eigen::MatrixXd shifted = truth;
+  shifted.row(static_cast<Eigen::Index>(set.size()) - 1).array() += 40;
+  EXPECT_NEAR((model.coefficients() - shifted).cwiseAbs().maxCoeff(), 0, 1e-8);
+
+  // Noisy version: LOO by the leverage identity equals 60 explicit refits.
+  std::mt19937 rng(3);
+  std::normal_distribution<double> nd(0, 0.5);
+  for (Eigen::Index i = 0; i < c.xyz.rows(); ++i)
+    for (int k = 0; k < 3; ++k) c.xyz(i, k) += nd(rng);
+  c.lab = ca::xyz_rows_to_lab(c.xyz, c.white);
+  for (double ridge : {0.0, 1e-3}) {
+    o.ridge = ridge;
+    auto loo = ca::cross_validate(set, c, o, ca::CvSpec::loo());
+    for (std::size_t i = 0; i < c.size(); ++i) {
+      std::vector<std::size_t> rest;
+      for (std::size_t j = 0; j < c.size(); ++j)
+        if (j != i) rest.push_back(j);
+      auto m = ca::fit(set, c.subset(rest), o);
+      Eigen::MatrixXd lab = m.apply(c.rgb.row(static_cast<Eigen::Index>(i)));
+      ca::Lab ref{c.lab(static_cast<Eigen::Index>(i), 0), c.lab(static_cast<Eigen::Index>(i), 1), c.lab(static_cast<Eigen::Index>(i), 2)};
+      EXPECT_NEAR(loo.de76[i], ca::delta_e76({lab(0, 0), lab(0, 1), lab(0, 2)}, ref), 1e-7) << "patch " << i << " ridge " << ridge;
+    }
+  }
+  auto k5 = ca::cross_validate(set, c, o, ca::CvSpec::k_fold(5));
+  EXPECT_EQ(k5.de76.size(), c.size());
+  EXPECT_TRUE(std::isfinite(k5.s76.mean));
+}
+
+struct ArgyllResult {
+  double avg = NAN, peak = NAN;
+};
+
+// Builds an Argyll profile from the chart and checks it against the same chart, as the notes' recipe does.
+ArgyllResult argyll_profile_check(const ca::ChartData& chart, const std::string& algo, const std::filesystem::path& dir,
+                                  bool de2000, const ca::ChartData* test = nullptr) {
+  ca::write_argyll_ti3(dir / "train.ti3", chart);
+  const std::string base = (dir / ("p_" + algo)).string();
+  std::string cmd = "cd '" + dir.string() + "' && colprof -qm -a" + algo + " -ua -O '" + base + ".icc' train";
+  if (ca::testing::run(cmd) != 0) return {};
+  std::string check_ti3 = (dir / "train.ti3").string();
+  if (test) {
+    ca::write_argyll_ti3(dir / "test.ti3", *test);
+    check_ti3 = (dir / "test.ti3").string();
+  }
+  const std::string out = (dir / "profcheck.txt").string();
+  cmd = std::string("profcheck ") + (de2000 ? "-k " : "") + "'" + check_ti3 + "' '" + base + ".icc' > '" + out + "' 2>&1";
+  if (std::system(cmd.c_str()) != 0) return {};
+  std::ifstream f(out);
+  std::string text((std::istreambuf_iterator<char>(f)), {});
+  std::smatch m;
+  ArgyllResult r;
+  if (std::regex_search(text, m, std::regex(R"(peak err = ([0-9.]+), avg err = ([0-9.]+))"))) {
+    r.peak = std::stod(m[1]);
+    r.avg = std::stod(m[2]);
+  }
+  return r;
+}
+
+TEST(ArgyllComparison, MatrixFitMatchesColprofMatrixOnTheSameChart) {
+  COLORLAB_REQUIRE_SHARED(cc24, "testvec_cc24_canon20d_d50_argyll.csv");
+  COLORLAB_REQUIRE_TOOL("colprof");
+  COLORLAB_REQUIRE_TOOL("profcheck");
+  ca::ChartData c = ca::read_chart(cc24);
+  auto dir = ca::testing::temp_dir("colprof");
+  ArgyllResult am = argyll_profile_check(c, "m", dir, false);
+  ASSERT_TRUE(std::isfinite(am.avg)) << "colprof/profcheck failed in " << dir;
+  // colorlab's 3×3 matrix on linear RGB → XYZ (what a matrix profile is, without Argyll's curve freedom).
+  ca::FitOptions o;
+  o.input_scale = 1.0;
+  auto ccm = ca::fit("ccm", c, o);
+  auto ours = ca::evaluate(ccm.apply(c.rgb), c.lab);
+  std::cout << "CC24 self-fit dE76 mean/max: colprof -am " << am.avg << "/" << am.peak << ", colorlab ccm "
+            << ours.s76.mean << "/" << ours.s76.max << "\n";
+  // Same model class, same data: the least-squares matrix may differ from Argyll's (it fits in XYZ, Argyll
+  // optimises in L*a*b* with curves), but not by more than a fraction of a ΔE.
+  EXPECT_NEAR(ours.s76.mean, am.avg, 0.6);
+  // And the stored -am predictions from the notes' run agree with this run of colprof.
+  EXPECT_NEAR(am.avg, 1.91, 0.15);
+}
+
+TEST(ArgyllComparison, LutFitVersusColprofLutOnTheSameChart) {
+  COLORLAB_REQUIRE_SHARED(sg, "testvec_sg140_canon20d_d50_argyll.csv");
+  COLORLAB_REQUIRE_TOOL("colprof");
+  COLORLAB_REQUIRE_TOOL("profcheck");
+  ca::ChartData c = ca::read_chart(sg);
+  auto dir = ca::testing::temp_dir("colprof-lut");
+  ArgyllResult ax = argyll_profile_check(c, "x", dir, true);
+  ASSERT_TRUE(std::isfinite(ax.avg)) << "colprof/profcheck failed in " << dir;
+  ca::FitOptions o;
+  o.input_scale = 1.0;
+  auto sel = ca::select_model(ca::all_term_sets(), {ca::FitTarget::xyz_then_lab}, c, o, ca::CvSpec::loo());
+  const auto& ch = sel.candidates[sel.chosen];
+  std::cout << "SG self-check dE00 mean/max: colprof -ax " << ax.avg << "/" << ax.peak << "; colorlab " << ch.method
+            << " training " << ch.training.s00.mean << "/" << ch.training.s00.max << ", LOO " << ch.cv.s00.mean << "/"
+            << ch.cv.s00.max << "\n";
+  // A cLUT with ~33³ nodes fits its 140 training patches almost exactly; what matters is the held-out error, which
+  // must stay within a small multiple of Argyll's training residual.
+  EXPECT_LT(ch.cv.s00.mean, std::max(1.0, 4 * ax.avg));
+}
+
+TEST(Generalisation, BestCrossValidatedModelTrainedOnSgBeatsColprofAxOnCc24) {
+  COLORLAB_REQUIRE_SHARED(sg, "testvec_sg140_canon20d_d50_argyll.csv");
+  COLORLAB_REQUIRE_SHARED(cc24, "testvec_cc24_canon20d_d50_argyll.csv");
+  ca::ChartData train = ca::read_chart(sg), test = ca::read_chart(cc24);
+  ca::FitOptions o;
+  o.input_scale = 1.0;  // both charts are white-balanced to perfect white = 1
+  auto sel = ca::select_model(ca::all_term_sets(), {ca::FitTarget::xyz_then_lab, ca::FitTarget::lab_direct}, train, o,
+                              ca::CvSpec::loo());
+  const auto& ch = sel.candidates[sel.chosen];
+  ca::FitOptions fo = o;
+  fo.target = ch.target;
+  auto model = ca::fit(ca::term_set_by_name(ch.method), train, fo);
+  auto e = ca::evaluate(model.apply(test.rgb), test.lab);
+  std::cout << "chosen " << ch.method << " (" << ca::to_string(ch.target) << ", " << ch.terms << " terms; best "
+            << sel.candidates[sel.best].method << " LOO " << sel.candidates[sel.best].cv.s00.mean << ") on CC24: dE00 mean "
+            << e.s00.mean << " max " << e.s00.max << " (colprof -ax: 0.67 / 1.49)\n";
+  // Independent bar: Argyll's own SG-trained cLUT profile evaluated on CC24 (stored predictions, colorimetry-notes §6).
+  EXPECT_LE(e.s00.mean, 0.67);
+  EXPECT_LE(e.s00.max, 1.49);
+}
+
+// §7.4 on synthetic data: Canon 20D sensitivities × D65 × SG spectra, 0.5 % noise.
+TEST(BlackBox, RecoversCanon20dCurvesFromNoisyRaw) {
+  COLORLAB_REQUIRE_SHARED(ssf_file, "camera_ssf_canon_eos_20d_camspec_10nm_400_720.csv");
+  COLORLAB_REQUIRE_SHARED(sg_file, "colorcheckersg_xrite_before_nov2014_dcamprof_10nm_380_730.csv");
+  ca::SpectralSet ssf = ca::read_spectra(ssf_file);
+  ca::SpectralSet refl = ca::resample(ca::read_spectra(sg_file), ssf.wavelengths, ca::Interpolation::linear);
+  ca::SpectralSet lamp = ca::resample(ca::load_illuminant("D65"), ssf.wavelengths, ca::Interpolation::linear);
+  Eigen::MatrixXd spectra = refl.values.array().rowwise() * lamp.values.row(0).array();  // 140 × 33 radiance
+  Eigen::MatrixXd clean = spectra * ssf.values.transpose();                              // 140 × 3
+  const double gain = 4095 * 0.9 / clean.maxCoeff();                                     // brightest patch at 90 %
+  clean *= gain;
+  const Eigen::MatrixXd true_curves = ssf.values * gain;
+  std::mt19937 rng(20);
+  std::normal_distribution<double> nd(0, 1);
+  Eigen::MatrixXd raw = clean;
+  for (Eigen::Index i = 0; i < raw.rows(); ++i)
+    for (int c = 0; c < 3; ++c) raw(i, c) *= 1 + 0.005 * nd(rng);
+  auto model = ca::fit_blackbox(spectra, raw);
+  auto table = ca::blackbox_residuals(model, spectra, raw, 4095);
+  for (int c = 0; c < 3; ++c) {
+    double peak = true_curves.row(c).maxCoeff();
+    double curve_err = (model.sensitivities.row(c) - true_curves.row(c)).cwiseAbs().maxCoeff() / peak;
+    std::cout << "channel " << "RGB"[c] << ": lambda " << model.lambda[static_cast<std::size_t>(c)] << ", RAW |err| mean "
+              << table.percent[static_cast<std::size_t>(c)].mean << " % FS, max " << table.percent[static_cast<std::size_t>(c)].max
+              << " %; curve max err " << 100 * curve_err << " % of peak\n";
+    EXPECT_LE(table.percent[static_cast<std::size_t>(c)].mean, 0.5);
+    EXPECT_LE(curve_err, 0.10);
+  }
+  // Without the penalty the NNLS fit is as good on RAW but the curves wander (the notes' 96 % of peak).
+  ca::BlackBoxOptions plain;
+  plain.smoothness = false;
+  auto rough = ca::fit_blackbox(spectra, raw, plain);
+  double worst = 0;
+  for (int c = 0; c < 3; ++c)
+    worst = std::max(worst, (rough.sensitivities.row(c) - true_curves.row(c)).cwiseAbs().maxCoeff() / true_curves.row(c).maxCoeff());
+  std::cout << "without smoothness: curve max err " << 100 * worst << " % of peak\n";
+  EXPECT_GT(worst, 0.10);
+}
+
+TEST(Nnls, SatisfiesKuhnTuckerConditions) {
+  std::mt19937 rng(5);
+  std::normal_distribution<double> nd(0, 1);
+  Eigen::MatrixXd A(30, 8);
+  Eigen::VectorXd b(30);
+  for (Eigen::Index i = 0; i < 30; ++i) {
+    b(i) = nd(rng);
+    for (int j = 0; j < 8; ++j) A(i, j) = nd(rng);
+  }
+  Eigen::VectorXd x = ca::nnls(A, b);
+  Eigen::VectorXd w = A.transpose() * (b - A * x);
+  for (int j = 0; j < 8; ++j) {
+    EXPECT_GE(x(j), 0);
+    if (x(j) > 0) EXPECT_NEAR(w(j), 0, 1e-9);  // free variables: zero gradient
+    else EXPECT_LE(w(j), 1e-9);                // bound variables: gradient points into the bound
+  }
+}
+
+}  // namespace
