@@ -51,7 +51,11 @@ ReflectanceIntegrator::ReflectanceIntegrator(const SpectralSet& illuminant, cons
   const Eigen::MatrixXd cmf = observer.values * resampling_matrix(observer.wavelengths, fine, opt.observer).transpose();
   std::vector<double> clamped = fine;
   for (double& w : clamped) w = std::clamp(w, reflectance_grid.front(), reflectance_grid.back());
-  const Eigen::MatrixXd Rm = resampling_matrix(reflectance_grid, clamped, opt.reflectance);  // fine × bands
+  // Sprague where the grid allows it, the natural spline on short or irregular grids.
+  const Interpolation refl_method = opt.reflectance == Interpolation::sprague && !sprague_applicable(reflectance_grid)
+                                        ? Interpolation::cubic_spline
+                                        : opt.reflectance;
+  const Eigen::MatrixXd Rm = resampling_matrix(reflectance_grid, clamped, refl_method);  // fine × bands
   // CIE 15 sums S·x̄·R·Δλ over the grid (rectangle rule); the normalisation k cancels Δλ anyway.
   const Eigen::RowVectorXd w = Eigen::RowVectorXd::Constant(static_cast<Eigen::Index>(fine.size()), opt.step_nm).cwiseProduct(S);
   Eigen::MatrixXd lamp_cmf = cmf.array().rowwise() * w.array();  // 3 × fine

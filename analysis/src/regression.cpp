@@ -53,6 +53,18 @@ Solution solve(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y, double ridge,
 
 Eigen::MatrixXd target_of(const ChartData& d, FitTarget t) { return t == FitTarget::lab_direct ? d.lab : d.xyz; }
 
+// Row weights (square roots of the least-squares weights) for the target.
+Eigen::VectorXd row_weights(const ChartData& d, FitTarget t) {
+  Eigen::VectorXd w = Eigen::VectorXd::Ones(static_cast<Eigen::Index>(d.size()));
+  if (t != FitTarget::xyz_lightness_weighted) return w;
+  for (Eigen::Index i = 0; i < w.size(); ++i) {
+    // Below L* ≈ 8 the CIE curve is linear, so the slope stops growing there.
+    const double y = std::max(d.xyz(i, 1) / d.white.Y, 0.008856);
+    w(i) = std::pow(y, -2.0 / 3.0);
+  }
+  return w;
+}
+
 double scale_for(const ChartData& d, const FitOptions& o) {
   if (o.input_scale > 0) return o.input_scale;
   double mx = d.rgb.maxCoeff();
@@ -108,7 +120,14 @@ ChartData ChartData::subset(const std::vector<std::size_t>& rows) const {
   return s;
 }
 
-const char* to_string(FitTarget t) { return t == FitTarget::lab_direct ? "lab" : "xyz"; }
+const char* to_string(FitTarget t) {
+  switch (t) {
+    case FitTarget::lab_direct: return "lab";
+    case FitTarget::xyz_then_lab: return "xyz";
+    case FitTarget::xyz_lightness_weighted: return "xyzw";
+  }
+  return "?";
+}
 
 Eigen::MatrixXd xyz_rows_to_lab(const Eigen::MatrixXd& xyz, const Xyz& white) {
   Eigen::MatrixXd lab(xyz.rows(), 3);
@@ -136,8 +155,9 @@ Eigen::MatrixXd PolynomialModel::apply(const Eigen::MatrixXd& rgb) const {
 PolynomialModel fit(const TermSet& terms, const ChartData& train, const FitOptions& o) {
   train.check();
   const double scale = scale_for(train, o);
-  Eigen::MatrixXd X = expand_terms(terms, train.rgb / scale);
-  auto s = solve(X, target_of(train, o.target), o.ridge, terms.name, false);
+  const Eigen::VectorXd w = row_weights(train, o.target);
+  Eigen::MatrixXd X = w.asDiagonal() * expand_terms(terms, train.rgb / scale);
+  auto s = solve(X, w.asDiagonal() * target_of(train, o.target), o.ridge, terms.name, false);
   return PolynomialModel(terms, o.target, s.coefficients, scale, train.white);
 }
 
@@ -194,10 +214,13 @@ ErrorStats cross_validate(const TermSet& terms, const ChartData& data, const Fit
   if (cv.kind == CvSpec::Kind::none) {
     pred = fit(terms, data, o).predict_target(data.rgb);
   } else if (cv.kind == CvSpec::Kind::leave_one_out) {
-    Eigen::MatrixXd X = expand_terms(terms, data.rgb / scale);
+    const Eigen::VectorXd w = row_weights(data, o.target);
+    Eigen::MatrixXd X = w.asDiagonal() * expand_terms(terms, data.rgb / scale);
     try {
-      auto s = solve(X, Y, o.ridge, terms.name, true);
-      Eigen::MatrixXd resid = Y - X * s.coefficients;
+      const Eigen::MatrixXd Yw = w.asDiagonal() * Y;
+      auto s = solve(X, Yw, o.ridge, terms.name, true);
+      // Weighted residuals over (1 − h_ii) are the weighted held-out residuals; unweight them.
+      Eigen::MatrixXd resid = (Yw - X * s.coefficients).array().colwise() / w.array();
       // PRESS identity: the held-out residual is e_i / (1 − h_ii), exact for least squares and ridge alike.
       for (Eigen::Index i = 0; i < n; ++i) {
         double denom = 1 - s.leverage(i);

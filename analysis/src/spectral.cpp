@@ -54,6 +54,14 @@ std::vector<double> uniform_grid(double start, double end, double step) {
   return g;
 }
 
+bool sprague_applicable(const std::vector<double>& x) {
+  if (x.size() < 6) return false;
+  const double h = x[1] - x[0];
+  for (std::size_t i = 1; i < x.size(); ++i)
+    if (std::abs((x[i] - x[i - 1]) - h) > 1e-6 * h) return false;
+  return h > 0;
+}
+
 namespace {
 
 // Natural cubic spline through the unit vector e_j gives column j of the resampling matrix; solving the

@@ -57,16 +57,21 @@ void BM_camera_pipeline(benchmark::State& state) {
 void BM_camera_sequential(benchmark::State& state) {
   const auto capture = milliseconds(state.range(0));
   const auto decode = milliseconds(state.range(1));
-  double wall = 0;
+  double wall = 0, captured = 0, decoded = 0;
   for (auto _ : state) {
+    captured = decoded = 0;
     const auto t0 = steady_clock::now();
     for (std::size_t i = 0; i < kFrames; ++i) {
+      const auto a = steady_clock::now();
       std::this_thread::sleep_for(capture);
+      const auto b = steady_clock::now();
       spin_for(decode);
+      captured += duration<double, std::milli>(b - a).count();
+      decoded += duration<double, std::milli>(steady_clock::now() - b).count();
     }
     wall = duration<double, std::milli>(steady_clock::now() - t0).count();
   }
-  report(state, static_cast<double>(capture.count()), static_cast<double>(decode.count()), wall / kFrames);
+  report(state, captured / kFrames, decoded / kFrames, wall / kFrames);
 }
 
 void stage_times(benchmark::internal::Benchmark* b) {

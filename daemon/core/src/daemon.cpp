@@ -1,5 +1,9 @@
 #include "colorlab/daemon/daemon.hpp"
 
+#include <unistd.h>
+
+#include <fstream>
+
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/detached.hpp>
 #include <boost/asio/io_context.hpp>
@@ -65,7 +69,30 @@ Daemon::Daemon(DaemonConfig config) : impl_(std::make_unique<Impl>()) {
   d.server->start();
 }
 
-Daemon::~Daemon() = default;
+Daemon::~Daemon() {
+  std::error_code ec;
+  std::filesystem::remove(endpoint_file_path(impl_->config), ec);
+}
+
+std::filesystem::path endpoint_file_path(const DaemonConfig& config) { return config.state_dir / "colorlabd.endpoint"; }
+
+// Where this daemon listens, for clients and tests that asked for port 0. Written atomically.
+void Daemon::write_endpoint_file() {
+  auto& d = *impl_;
+  nlohmann::json j{{"pid", ::getpid()},
+                   {"url", "http://" + d.config.listen_host + ":" + std::to_string(d.server->bound_port())},
+                   {"port", d.server->bound_port()},
+                   {"unix_socket", d.config.socket_path().string()}};
+  auto path = endpoint_file_path(d.config);
+  auto tmp = path;
+  tmp += ".tmp";
+  {
+    std::ofstream out(tmp);
+    out << j.dump() << "\n";
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+}
 
 int Daemon::run() {
   auto& d = *impl_;
@@ -95,6 +122,7 @@ int Daemon::run() {
 
   std::string where = d.config.listen_host + ":" + std::to_string(d.server->bound_port()) + " and " +
                       d.config.socket_path().string();
+  write_endpoint_file();
   d.notifier.ready("serving on " + where);
   d.notifier.start_watchdog();
   log::info("colorlabd", "serving the v1 API on " + where + (d.sim ? " (simulated lab)" : ""));

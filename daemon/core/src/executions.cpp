@@ -88,6 +88,7 @@ store::ExecutionRecord Executions::start(const std::string& campaign_name, const
         } catch (const Error& e) {
           status = ExecutionStatus::finished_error;
           problem = protocol::problem_from_error(e).to_json();
+          if (!e.info().device_code.empty()) problem["device_code"] = e.info().device_code;
           if (!e.info().transcript.empty()) problem["transcript"] = e.info().transcript;
           log::warning("executions", record.id + " failed: " + e.what());
         } catch (const std::exception& e) {

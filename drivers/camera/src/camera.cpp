@@ -1,6 +1,8 @@
 #include "colorlab/drivers/camera/camera.hpp"
 
+#include <algorithm>
 #include <exception>
+#include <thread>
 #include <utility>
 
 #include "colorlab/core/log.hpp"
@@ -93,6 +95,25 @@ std::string Camera::name() const {
   return n;
 }
 
+void Camera::note(std::string line) {
+  const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - created_);
+  std::lock_guard lock(mutex_);
+  transcript_.push_back("+" + std::to_string(ms.count()) + "ms " + std::move(line));
+  constexpr std::size_t kCapacity = 32;  // enough for a series' last frames and the failure
+  while (transcript_.size() > kCapacity) transcript_.pop_front();
+}
+
+std::vector<std::string> Camera::transcript() const {
+  std::lock_guard lock(mutex_);
+  return {transcript_.begin(), transcript_.end()};
+}
+
+Error Camera::with_transcript(const Error& e) const {
+  ErrorInfo info = e.info();
+  if (info.transcript.empty()) info.transcript = transcript();
+  return Error(std::move(info));
+}
+
 void Camera::require_connected() const {
   const auto s = state_.load();
   if (s == CameraState::disconnected || s == CameraState::initialising) {
@@ -120,13 +141,71 @@ std::future<void> Camera::connect() {
         identity_ = std::move(c.identity);
         limits_ = std::move(c.limits);
         settings_ = std::move(c.settings);
+        configured_ = {};
       }
       state_.store(CameraState::ready);
+      note("connected " + name());
       log::info("camera", "connected " + name());
     } catch (...) {
       state_.store(CameraState::disconnected);
-      throw to_error(std::current_exception(), "connect " + name());
+      Error e = to_error(std::current_exception(), "connect " + name());
+      note(std::string("connect failed: ") + e.what());
+      throw with_transcript(e);
     }
+  });
+}
+
+std::future<void> Camera::reconnect(int attempts, std::chrono::milliseconds first_backoff) {
+  return worker_->submit([this, attempts, first_backoff] {
+    const std::string expected_serial = identity().serial;
+    auto backoff = first_backoff;
+    std::optional<Error> last;
+    for (int attempt = 1; attempt <= std::max(1, attempts); ++attempt) {
+      if (state_.load() != CameraState::disconnected) do_disconnect();
+      state_.store(CameraState::disconnected);
+      if (attempt > 1) {
+        std::this_thread::sleep_for(backoff);
+        backoff *= 2;
+      }
+      note("reconnect attempt " + std::to_string(attempt));
+      state_.store(CameraState::initialising);
+      try {
+        Connected c = do_connect();
+        if (!expected_serial.empty() && c.identity.serial != expected_serial) {
+          do_disconnect();
+          state_.store(CameraState::disconnected);
+          throw with_transcript(Error(ErrorInfo{
+              .cls = ErrorClass::needs_operator,
+              .message = "reconnected to camera #" + c.identity.serial + ", expected #" + expected_serial,
+              .hint = "a different camera body is attached; put the original back or start a new calibration",
+          }));
+        }
+        const CameraSettings again = [&] {
+          std::lock_guard lock(mutex_);
+          identity_ = std::move(c.identity);
+          limits_ = std::move(c.limits);
+          settings_ = std::move(c.settings);
+          return configured_;
+        }();
+        do_configure(again);
+        {
+          std::lock_guard lock(mutex_);
+          settings_.merge(again);
+        }
+        state_.store(CameraState::ready);
+        note("reconnected " + name());
+        return;
+      } catch (const Error& e) {
+        if (e.cls() == ErrorClass::needs_operator) throw;
+        state_.store(CameraState::disconnected);
+        last = e;
+        note(std::string("reconnect failed: ") + e.what());
+      } catch (...) {
+        state_.store(CameraState::disconnected);
+        last = to_error(std::current_exception(), "reconnect " + name());
+      }
+    }
+    throw with_transcript(*last);
   });
 }
 
@@ -138,23 +217,63 @@ std::future<void> Camera::disconnect() {
 }
 
 std::future<void> Camera::configure(CameraSettings wanted) {
+  // Refused at once rather than queued: settings that silently apply after the running series
+  // would make the next series differ from what the caller believes it asked for.
+  if (series_pending_.load()) {
+    std::promise<void> refused;
+    refused.set_exception(std::make_exception_ptr(
+        Error(ErrorInfo{.cls = ErrorClass::conflict,
+                        .message = name() + " is busy with a capture series; settings unchanged",
+                        .hint = "configure between series, not during one",
+                        .retryable = true})));
+    return refused.get_future();
+  }
   return worker_->submit([this, wanted = std::move(wanted)] {
     require_connected();
-    if (series_pending_.load()) {
-      throw Error(ErrorClass::conflict, name() + " is busy with a capture series; settings unchanged",
-                  "configure between series, not during one");
-    }
     validate(wanted, limits(), name());
     try {
       do_configure(wanted);
     } catch (...) {
       Error e = to_error(std::current_exception(), "configure " + name());
+      note(std::string("configure failed: ") + e.what());
       after_failure(e);
-      throw e;
+      throw with_transcript(e);
     }
     std::lock_guard lock(mutex_);
     settings_.merge(wanted);
+    configured_.merge(wanted);
   });
+}
+
+namespace {
+
+// Runs a future-returning operation's outcome into a callback without blocking anyone: the
+// future is already satisfied when the worker task that produced it finishes.
+void forward(std::future<void> f, WorkerThread& worker, OperationDone done) {
+  auto shared = std::make_shared<std::future<void>>(std::move(f));
+  auto deliver = [shared, done = std::move(done)] {
+    try {
+      shared->get();
+      done(std::nullopt);
+    } catch (const Error& e) {
+      done(e);
+    } catch (...) {
+      done(to_error(std::current_exception(), "camera operation"));
+    }
+  };
+  if (shared->wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
+    deliver();  // refused at once
+  } else {
+    worker.post(std::move(deliver));  // queued behind the operation itself
+  }
+}
+
+}  // namespace
+
+void Camera::connect(OperationDone done) { forward(connect(), *worker_, std::move(done)); }
+
+void Camera::configure(CameraSettings settings, OperationDone done) {
+  forward(configure(std::move(settings)), *worker_, std::move(done));
 }
 
 std::future<CaptureReport> Camera::capture(std::size_t n, FrameSink sink, CaptureOptions options) {
@@ -225,18 +344,26 @@ CaptureReport Camera::run_series(std::size_t n, const FrameSink& sink, std::size
     return report;
   }
   state_.store(CameraState::busy);
+  note("series of " + std::to_string(n) + " frames");
   try {
     do_begin_series(n);
   } catch (...) {
     report.error = to_error(std::current_exception(), "start series on " + name());
+    note(std::string("series start failed: ") + report.error->what());
     after_failure(*report.error);
+    report.error = with_transcript(*report.error);
     return report;
   }
 
   if (!pipeline_ || depth != 2) pipeline_ = std::make_unique<FramePipeline<CapturedFrame>>(depth);
   std::vector<std::filesystem::path> saved;  // touched only by the consumer until run() returns
   const PipelineRun run = pipeline_->run(
-      n, [this](std::size_t i) { return do_capture_frame(i); },
+      n,
+      [this](std::size_t i) {
+        CapturedFrame f = do_capture_frame(i);
+        note("frame " + std::to_string(i) + " captured " + f.file_name);
+        return f;
+      },
       [&](CapturedFrame&& f, std::size_t i) {
         auto files = std::move(f.saved_files);
         deliver(std::move(f), i, sink);
@@ -252,6 +379,8 @@ CaptureReport Camera::run_series(std::size_t n, const FrameSink& sink, std::size
   report.wall_time = run.wall_time;
   if (run.error) {
     report.error = to_error(run.error, run.error_in_consumer ? "decode/deliver on " + name() : "capture on " + name());
+    note(std::string(run.error_in_consumer ? "delivery failed: " : "capture failed: ") + report.error->what());
+    report.error = with_transcript(*report.error);
     if (run.error_in_consumer) {
       state_.store(CameraState::ready);
     } else {

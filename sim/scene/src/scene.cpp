@@ -52,9 +52,13 @@ Spectrum transmission_filter_spectrum() {
   return s;
 }
 
+Spectrum flat(double r) { return Spectrum{380.0, 10.0, std::vector<double>(36, r)}; }
+
 }  // namespace
 
 struct Scene::Impl {
+  Spectrum chart_surround = flat(0.05);
+  Spectrum table_plate = flat(0.80);
   SceneConfig config;
   std::shared_ptr<const SimClock> clock;
   Chart chart;
@@ -272,6 +276,18 @@ std::pair<double, double> Scene::patch_floor_position_mm(int patch_index) const 
   }
   const auto& p = impl_->chart.patches[static_cast<std::size_t>(patch_index)];
   return chart_to_floor_mm(p.x_mm + p.size_mm / 2, p.y_mm + p.size_mm / 2);
+}
+
+Scene::TableSample Scene::table_sample(double x_mm, double y_mm) const {
+  if (!(x_mm >= 0 && x_mm <= table_width_mm && y_mm >= 0 && y_mm <= table_height_mm)) {
+    throw Error(ErrorClass::bad_parameter, "table position (" + std::to_string(x_mm) + ", " + std::to_string(y_mm) +
+                                               ") mm is outside the 310 × 230 mm SpectroScan T table");
+  }
+  const double cx = x_mm - impl_->config.chart_on_table_x_mm, cy = y_mm - impl_->config.chart_on_table_y_mm;
+  if (cx < 0 || cy < 0 || cx >= chart_width_mm || cy >= chart_height_mm) return {std::nullopt, &impl_->table_plate};
+  const auto patch = impl_->chart.patch_at(cx, cy);
+  if (!patch) return {std::nullopt, &impl_->chart_surround};
+  return {patch, &impl_->chart.patches[static_cast<std::size_t>(*patch)].reflectance};
 }
 
 const Spectrum& Scene::white_tile() const { return impl_->white_tile; }

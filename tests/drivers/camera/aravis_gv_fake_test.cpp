@@ -7,6 +7,8 @@
 
 #include "colorlab/drivers/camera/aravis_camera.hpp"
 #include "colorlab/sim/aravis/gv_fake_camera.hpp"
+#include "colorlab/sim/aravis/scene_fill.hpp"
+#include "sim_fixture.hpp"
 
 namespace cam = colorlab::drivers::camera;
 namespace gv = colorlab::sim::aravis;
@@ -206,4 +208,86 @@ TEST(camera_aravis, open_without_camera_is_a_typed_error) {
   ASSERT_TRUE(report.error.has_value());
   EXPECT_EQ(report.error->cls(), ErrorClass::no_comms);
   EXPECT_EQ(report.delivered, 0U);
+}
+
+TEST(camera_aravis, scene_frames_average_to_the_scene_ground_truth) {
+  auto model = cam::test::small_model(640, 428);
+  auto fake = start_fake(gv::scene_camera_options(model, 4.0));
+  // ROI: the bounding box of four neighbouring patches, on even coordinates (RGGB phase kept).
+  const int patches[] = {44, 45, 54, 55};
+  int x0 = 1 << 30, y0 = 1 << 30, x1 = 0, y1 = 0;
+  for (int p : patches) {
+    const auto r = model->patch_region(p);
+    x0 = std::min(x0, r.x);
+    y0 = std::min(y0, r.y);
+    x1 = std::max(x1, r.x + r.width);
+    y1 = std::max(y1, r.y + r.height);
+  }
+  x0 &= ~1;
+  y0 &= ~1;
+  const int w = (x1 - x0 + 1) & ~1, h = (y1 - y0 + 1) & ~1;
+  auto o = small_roi();
+  o.region = cam::Region{x0, y0, w, h};
+  cam::AravisCamera camera(o);
+  camera.connect().get();
+  cam::CameraSettings s;
+  s.pixel_format = cam::PixelFormat::bayer_rg12;
+  s.exposure_us = 1e6 / 30;
+  s.gain = 0;
+  camera.configure(s).get();
+
+  std::vector<double> sum(static_cast<std::size_t>(w * h), 0.0);
+  const std::size_t n = 4;
+  auto report = camera
+                    .capture(n,
+                             [&](const cam::RawImage& img) {
+                               ASSERT_EQ(img.width, static_cast<std::size_t>(w));
+                               for (std::size_t y = 0; y < img.height; ++y) {
+                                 for (std::size_t x = 0; x < img.width; ++x) sum[y * img.width + x] += img.at(x, y);
+                               }
+                             })
+                    .get();
+  ASSERT_TRUE(report.complete()) << (report.error ? report.error->what() : "");
+  const auto truth = model->ground_truth(gv::model_settings_for(1e6 / 30, 0, 4.0));
+  for (int p : patches) {
+    const auto r = model->patch_region(p);
+    for (int ch = 0; ch < 3; ++ch) {
+      std::vector<double> v;  // inner half of the patch, median: clear of edges and dust
+      for (int y = r.y + r.height / 4; y < r.y + 3 * r.height / 4; ++y) {
+        for (int x = r.x + r.width / 4; x < r.x + 3 * r.width / 4; ++x) {
+          if (colorlab::sim::camera::rggb_channel(x, y) == ch) {
+            v.push_back(sum[static_cast<std::size_t>((y - y0) * w + (x - x0))] / n);
+          }
+        }
+      }
+      ASSERT_FALSE(v.empty());
+      std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+      const double expected = truth[static_cast<std::size_t>(p)][static_cast<std::size_t>(ch)];
+      EXPECT_NEAR(v[v.size() / 2], expected, std::max(4.0, 0.02 * (expected - 256))) << "patch " << p << " ch " << ch;
+    }
+  }
+}
+
+TEST(camera_aravis, reconnect_verifies_the_camera_is_the_same_body) {
+  auto fake = start_fake();
+  cam::AravisCamera camera(small_roi());
+  camera.connect().get();
+  fake.reset();
+  gv::GvFakeOptions other;
+  other.serial = "CLGV0002";
+  fake = start_fake(other);
+  try {
+    camera.reconnect(2, std::chrono::milliseconds(10)).get();
+    FAIL() << "a different serial must not be accepted silently";
+  } catch (const colorlab::Error& e) {
+    EXPECT_EQ(e.cls(), ErrorClass::needs_operator) << e.what();
+    EXPECT_NE(std::string(e.what()).find("CLGV0002"), std::string::npos);
+  }
+  EXPECT_EQ(camera.state(), cam::CameraState::disconnected);
+  fake.reset();
+  fake = start_fake();  // the original body is back
+  camera.reconnect(2, std::chrono::milliseconds(10)).get();
+  EXPECT_EQ(camera.state(), cam::CameraState::ready);
+  auto report = camera.capture(1, [](const cam::RawImage&) {}).get();
+  EXPECT_TRUE(report.complete()) << report.delivered << "/" << report.requested << " " << (report.error ? report.error->what() : "no error");
 }

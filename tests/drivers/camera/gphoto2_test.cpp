@@ -9,6 +9,9 @@
 #include <random>
 
 #include "colorlab/drivers/camera/gphoto2_camera.hpp"
+#include "colorlab/drivers/camera/raw_decoder.hpp"
+#include "colorlab/sim/camera/dng.hpp"
+#include "sim_fixture.hpp"
 
 namespace cam = colorlab::drivers::camera;
 namespace fs = std::filesystem;
@@ -169,4 +172,18 @@ TEST(camera_gphoto2, missing_port_is_a_typed_error) {
     EXPECT_FALSE(e.hint().empty());
   }
   EXPECT_EQ(camera.state(), cam::CameraState::disconnected);
+}
+
+TEST(camera_gphoto2, dng_downloaded_from_card_decodes_exactly) {
+  CardDir card;
+  auto model = cam::test::small_model();
+  const auto frame = model->render({}, 9);
+  colorlab::sim::camera::write_dng(card.root / "DCIM/100CANON/IMG_0009.DNG", frame, {});
+  cam::Gphoto2Camera camera(card.options());
+  camera.connect().get();
+  const auto bytes = camera.download({"/DCIM/100CANON", "IMG_0009.DNG"}).get();
+  cam::RawDecoder decoder;
+  const auto img = decoder.decode_buffer(bytes, "IMG_0009.DNG");
+  ASSERT_EQ(img.width, static_cast<std::size_t>(frame.width));
+  EXPECT_TRUE(std::equal(frame.pixels.begin(), frame.pixels.end(), img.contiguous().begin()));
 }

@@ -175,8 +175,16 @@ TEST(camera_simulated, disconnect_mid_series_needs_a_reconnect) {
   ASSERT_TRUE(refused.error);
   EXPECT_EQ(refused.error->cls(), ErrorClass::no_comms);
 
-  rig.camera->connect().get();
+  // The error carries the transcript of what led to it.
+  const auto& lines = report.error->info().transcript;
+  ASSERT_FALSE(lines.empty());
+  EXPECT_NE(lines.back().find("capture failed"), std::string::npos) << lines.back();
+  EXPECT_TRUE(std::any_of(lines.begin(), lines.end(),
+                          [](const std::string& l) { return l.find("frame 2 captured") != std::string::npos; }));
+
+  rig.camera->reconnect(3, std::chrono::milliseconds(1)).get();
   EXPECT_EQ(rig.camera->state(), cam::CameraState::ready);
+  EXPECT_EQ(rig.camera->identity().serial, "SIM20D0001");
   EXPECT_TRUE(capture_n(*rig.camera, 2).complete());
 }
 
@@ -195,7 +203,12 @@ TEST(camera_simulated, a_second_series_while_one_runs_is_refused_not_queued) {
   EXPECT_EQ(second.delivered, 0U);
   cam::CameraSettings s;
   s.iso = 200;
-  EXPECT_THROW(rig.camera->configure(s).get(), colorlab::Error);  // queued behind, still refused: series pending
+  try {
+    rig.camera->configure(s).get();
+    FAIL() << "configure during a series must be refused";
+  } catch (const colorlab::Error& e) {
+    EXPECT_EQ(e.cls(), ErrorClass::conflict);
+  }
   EXPECT_TRUE(first.get().complete());
 }
 

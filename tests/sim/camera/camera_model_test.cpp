@@ -32,7 +32,7 @@ double patch_channel_mean(const RawFrame& f, const CameraModel& cam, int patch, 
   return sum / n;
 }
 
-TEST(CameraModel, SameSeedAndFrameGiveTheSameBytesWhateverTheThreadCount) {
+TEST(SimCameraModel, SameSeedAndFrameGiveTheSameBytesWhateverTheThreadCount) {
   auto scene = test::d65_scene();
   CameraConfig one = test::small_camera();
   one.threads = 1;
@@ -49,7 +49,7 @@ TEST(CameraModel, SameSeedAndFrameGiveTheSameBytesWhateverTheThreadCount) {
   EXPECT_NE(c.render(s, 7).pixels, fa.pixels);
 }
 
-TEST(CameraModel, FrameLayoutIsA12BitRggbMosaic) {
+TEST(SimCameraModel, FrameLayoutIsA12BitRggbMosaic) {
   const CameraModel cam(test::d65_scene(), test::small_camera());
   const RawFrame f = cam.render({}, 0);
   EXPECT_EQ(f.width, 700);
@@ -66,7 +66,7 @@ TEST(CameraModel, FrameLayoutIsA12BitRggbMosaic) {
   EXPECT_GT(patch_channel_mean(f, cam, red, 0), patch_channel_mean(f, cam, red, 2) + 100);
 }
 
-TEST(CameraModel, RenderedMeansMatchTheGroundTruth) {
+TEST(SimCameraModel, RenderedMeansMatchTheGroundTruth) {
   const CameraModel cam(test::d65_scene(), test::small_camera());
   const CameraSettings s;
   const auto truth = cam.ground_truth(s);
@@ -98,7 +98,7 @@ TEST(CameraModel, RenderedMeansMatchTheGroundTruth) {
   EXPECT_LT(truth[a1][1], 4000);
 }
 
-TEST(CameraModel, ExposureScalesWithShutterApertureAndIso) {
+TEST(SimCameraModel, ExposureScalesWithShutterApertureAndIso) {
   const CameraModel cam(test::d65_scene(), test::small_camera());
   const int patch = 44;  // an inner patch
   const double base = cam.ground_truth(patch, {4.0, 1 / 30.0, 100})[1] - 256;
@@ -112,7 +112,7 @@ TEST(CameraModel, ExposureScalesWithShutterApertureAndIso) {
   EXPECT_THROW(cam.patch_region(140), Error);
 }
 
-TEST(CameraModel, DimmerAndExposureCompensationAreNotQuiteEquivalent) {
+TEST(SimCameraModel, DimmerAndExposureCompensationAreNotQuiteEquivalent) {
   // Table 7: halving the light and doubling the exposure should give the same image "theoretically".
   auto scene = test::d65_scene();
   const CameraModel cam(scene, test::small_camera());
@@ -125,7 +125,7 @@ TEST(CameraModel, DimmerAndExposureCompensationAreNotQuiteEquivalent) {
   EXPECT_NEAR(cam.ground_truth(44, {4.0, 1 / 30.0, 100})[1], 256, 0.1);  // only dark current left
 }
 
-TEST(CameraModel, HotAndDeadPixelsAreFixedPerCamera) {
+TEST(SimCameraModel, HotAndDeadPixelsAreFixedPerCamera) {
   const CameraModel cam(test::d65_scene(), test::small_camera());
   const CameraModel same(test::d65_scene(), test::small_camera());
   ASSERT_FALSE(cam.defects().empty());
@@ -146,7 +146,7 @@ TEST(CameraModel, HotAndDeadPixelsAreFixedPerCamera) {
   for (std::size_t i = 0; i < cam.defects().size(); ++i) EXPECT_EQ(same.defects()[i].x, cam.defects()[i].x);
 }
 
-TEST(CameraModel, DustSpecksDarkenPatchPixelsLikeFig31c) {
+TEST(SimCameraModel, DustSpecksDarkenPatchPixelsLikeFig31c) {
   const CameraModel cam(test::d65_scene(), test::small_camera());
   ASSERT_EQ(cam.dust().size(), 6u);
   const RawFrame f = cam.render({}, 0);
@@ -165,7 +165,7 @@ TEST(CameraModel, DustSpecksDarkenPatchPixelsLikeFig31c) {
   }
 }
 
-TEST(CameraModel, VignettingDarkensCornersMoreWideOpen) {
+TEST(SimCameraModel, VignettingDarkensCornersMoreWideOpen) {
   const CameraModel cam(test::d65_scene(), test::small_camera());
   // A1 (corner of the chart) relative to F5 (centre) at f/2.8 and f/11, exposure-compensated: the lamp field
   // is the same, only the lens differs.
@@ -178,7 +178,7 @@ TEST(CameraModel, VignettingDarkensCornersMoreWideOpen) {
   EXPECT_LT(ratio(2.8), ratio(11.0) * 0.985);
 }
 
-TEST(CameraModel, LongExposuresClipAt12Bits) {
+TEST(SimCameraModel, LongExposuresClipAt12Bits) {
   const CameraModel cam(test::d65_scene(), test::small_camera());
   const RawFrame f = cam.render({4.0, 1.0, 100}, 0);
   const auto clipped = std::count(f.pixels.begin(), f.pixels.end(), std::uint16_t{4095});
@@ -186,7 +186,7 @@ TEST(CameraModel, LongExposuresClipAt12Bits) {
   EXPECT_EQ(*std::max_element(f.pixels.begin(), f.pixels.end()), 4095);
 }
 
-TEST(CameraModel, SensitivitiesComeFromTheCanon20dFileOrTheParametricDefault) {
+TEST(SimCameraModel, SensitivitiesComeFromTheCanon20dFileOrTheParametricDefault) {
   auto scene = test::d65_scene();
   CameraConfig param = test::small_camera();
   param.force_parametric_sensitivities = true;
@@ -208,7 +208,7 @@ TEST(CameraModel, SensitivitiesComeFromTheCanon20dFileOrTheParametricDefault) {
   EXPECT_LT(peak(c.sensitivities()[1]), 560);
 }
 
-TEST(CameraModel, ColorMatrixMapsD65WhiteToTheCameraNeutral) {
+TEST(SimCameraModel, ColorMatrixMapsD65WhiteToTheCameraNeutral) {
   const CameraModel cam(test::d65_scene(), test::small_camera());
   const auto m = cam.xyz_to_camera_d65();
   const double white[3] = {0.95047, 1.0, 1.08883};  // D65, Y = 1

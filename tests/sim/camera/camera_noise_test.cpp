@@ -29,7 +29,7 @@ double patch_green_std(const std::vector<double>& img, int width, const CameraMo
   return std::sqrt(std::max(0.0, s2 / n - mean * mean));
 }
 
-TEST(FrameAveraging, NoiseFallsAsInverseRootNDownToTheFixedPatternFloor) {
+TEST(SimFrameAveraging, NoiseFallsAsInverseRootNDownToTheFixedPatternFloor) {
   const CameraModel cam(test::d65_scene(), test::small_camera());
   const CameraSettings s;
   const std::vector<int> counts{1, 2, 4, 8, 16, 25};

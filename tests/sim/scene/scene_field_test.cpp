@@ -23,9 +23,9 @@ Grid lamp_grid(const Scene& s, Lamp l, double dimmer) {
   return test::sample_grid([&](double x, double y) { return s.lamp_floor_luminance(l, dimmer, x, y); });
 }
 
-class FieldTest : public ::testing::TestWithParam<std::uint64_t> {};
+class SimFieldTest : public ::testing::TestWithParam<std::uint64_t> {};
 
-TEST_P(FieldTest, D65FullRangeAndBrightestSpotMatchSection62) {
+TEST_P(SimFieldTest, D65FullRangeAndBrightestSpotMatchSection62) {
   const Scene scene(synthetic_config(GetParam()), std::make_shared<SimClock>());
   const Grid g = lamp_grid(scene, Lamp::d65, 100);
   std::printf("seed %llu: D65 100%% min %.1f max %.1f\n", (unsigned long long)GetParam(), test::grid_min(g),
@@ -42,7 +42,7 @@ TEST_P(FieldTest, D65FullRangeAndBrightestSpotMatchSection62) {
   EXPECT_LE(bc, 12);
 }
 
-TEST_P(FieldTest, BestChartSizedWindowStdIsAboutSix) {
+TEST_P(SimFieldTest, BestChartSizedWindowStdIsAboutSix) {
   const Scene scene(synthetic_config(GetParam()), std::make_shared<SimClock>());
   const double best = test::best_window_std(lamp_grid(scene, Lamp::d65, 100));
   std::printf("best 4x5 window std at 100%%: %.2f (dissertation table 3: 6.28)\n", best);
@@ -50,7 +50,7 @@ TEST_P(FieldTest, BestChartSizedWindowStdIsAboutSix) {
   EXPECT_LT(best, 8.5);
 }
 
-TEST_P(FieldTest, DimmerScaledDifferencesAreOfTheDissertationsOrder) {
+TEST_P(SimFieldTest, DimmerScaledDifferencesAreOfTheDissertationsOrder) {
   const Scene scene(synthetic_config(GetParam()), std::make_shared<SimClock>());
   const Grid full = lamp_grid(scene, Lamp::d65, 100);
   for (double d : {50.0, 25.0, 15.0}) {
@@ -61,7 +61,7 @@ TEST_P(FieldTest, DimmerScaledDifferencesAreOfTheDissertationsOrder) {
   }
 }
 
-TEST_P(FieldTest, Tl84AndCwfAreLessUniformThanD65) {
+TEST_P(SimFieldTest, Tl84AndCwfAreLessUniformThanD65) {
   const Scene scene(synthetic_config(GetParam()), std::make_shared<SimClock>());
   const auto relative_spread = [&](Lamp l) {
     const Grid g = lamp_grid(scene, l, 100);
@@ -75,9 +75,9 @@ TEST_P(FieldTest, Tl84AndCwfAreLessUniformThanD65) {
   EXPECT_GT(test::best_window_std(lamp_grid(scene, Lamp::cwf, 100)), best_d65);
 }
 
-INSTANTIATE_TEST_SUITE_P(Seeds, FieldTest, ::testing::Values(1u, 7u, 12345u));
+INSTANTIATE_TEST_SUITE_P(SimSeeds, SimFieldTest, ::testing::Values(1u, 7u, 12345u));
 
-TEST(Dimmer, ResponseIsMonotonicAndNotProportional) {
+TEST(SimDimmer, ResponseIsMonotonicAndNotProportional) {
   EXPECT_DOUBLE_EQ(Scene::dimmer_output(100), 1.0);
   EXPECT_DOUBLE_EQ(Scene::dimmer_output(0), 0.0);
   double prev = 0;
@@ -91,7 +91,7 @@ TEST(Dimmer, ResponseIsMonotonicAndNotProportional) {
   EXPECT_LT(Scene::dimmer_output(15) / 0.15, 0.9);
 }
 
-TEST(Dimmer, FloorLuminanceFollowsTheModelledResponse) {
+TEST(SimDimmer, FloorLuminanceFollowsTheModelledResponse) {
   SceneConfig cfg = synthetic_config();
   cfg.lamps_on_at_start = {Lamp::d65};
   Scene scene(cfg, std::make_shared<SimClock>());
@@ -106,7 +106,7 @@ TEST(Dimmer, FloorLuminanceFollowsTheModelledResponse) {
   EXPECT_THROW(scene.set_dimmer(-1), Error);
 }
 
-TEST(WarmUp, SwitchedOnLampDriftsUpToItsSteadyOutput) {
+TEST(SimWarmUp, SwitchedOnLampDriftsUpToItsSteadyOutput) {
   SceneConfig cfg = synthetic_config();
   cfg.warmup_tau_s = 2000.0;  // long, so the measurement below is insensitive to scheduler jitter
   auto clock = std::make_shared<SimClock>(1.0);
@@ -125,7 +125,7 @@ TEST(WarmUp, SwitchedOnLampDriftsUpToItsSteadyOutput) {
   EXPECT_DOUBLE_EQ(warm_scene.floor_luminance(0, 10), steady);
 }
 
-TEST(WarmUp, DriftFollowsSimulatedTime) {
+TEST(SimWarmUp, DriftFollowsSimulatedTime) {
   SceneConfig cfg = synthetic_config();
   cfg.warmup_tau_s = 60.0;
   auto clock = std::make_shared<SimClock>(10000.0);  // 60 simulated s = 6 ms real
@@ -135,7 +135,7 @@ TEST(WarmUp, DriftFollowsSimulatedTime) {
   EXPECT_NEAR(scene.warmup_factor(Lamp::cwf), 1.0, 1e-3);
 }
 
-TEST(Field, SeedsGiveDifferentButDeterministicCabinets) {
+TEST(SimField, SeedsGiveDifferentButDeterministicCabinets) {
   const Scene a(synthetic_config(3), std::make_shared<SimClock>());
   const Scene b(synthetic_config(3), std::make_shared<SimClock>());
   const Scene c(synthetic_config(4), std::make_shared<SimClock>());
@@ -144,14 +144,14 @@ TEST(Field, SeedsGiveDifferentButDeterministicCabinets) {
   EXPECT_NE(ga, gc);
 }
 
-TEST(Field, OffGridSpotsAreRejected) {
+TEST(SimField, OffGridSpotsAreRejected) {
   const Scene s(synthetic_config(), std::make_shared<SimClock>());
   EXPECT_THROW(s.floor_luminance(8, 0), Error);
   EXPECT_THROW(s.floor_luminance(0, 20), Error);
   EXPECT_THROW(s.floor_luminance(-1, 0), Error);
 }
 
-TEST(Field, LuminanceNoiseIsThatOfAnLs110) {
+TEST(SimField, LuminanceNoiseIsThatOfAnLs110) {
   const Scene s(synthetic_config(), std::make_shared<SimClock>());
   EXPECT_NEAR(s.luminance_noise_sigma(300.0), 0.5 * (0.6 + 0.1), 1e-12);
   EXPECT_GT(s.luminance_noise_sigma(300.0), s.luminance_noise_sigma(30.0));

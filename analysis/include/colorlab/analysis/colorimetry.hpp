@@ -25,7 +25,7 @@ inline constexpr Xyz kIccD50White{96.42, 100.0, 82.49};  // what ICC (and Argyll
 struct IntegrationOptions {
   // Lamps with line spectra (F2, F11) need a fine grid: subsampling them to 10 nm moves the white point.
   double step_nm = 1.0;
-  Interpolation reflectance = Interpolation::sprague;  // CIE 167:2005; needs a uniform grid
+  Interpolation reflectance = Interpolation::sprague;  // CIE 167:2005; spline where the grid is not uniform
   Interpolation illuminant = Interpolation::linear;
   Interpolation observer = Interpolation::cubic_spline;
   // CIE 15:2004 §7.2.2.1: outside the measured range a reflectance equals its nearest measured value, so the

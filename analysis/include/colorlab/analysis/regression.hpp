@@ -32,6 +32,9 @@ struct ChartData {
 enum class FitTarget {
   lab_direct,    // regress L*a*b* itself (the dissertation)
   xyz_then_lab,  // regress XYZ, convert with the white
+  // Regress XYZ with each patch weighted by (Y/Yn)^(-2/3), the slope of L* = 116·(Y/Yn)^(1/3) − 16: least squares
+  // in XYZ then approximates least squares in L*a*b*, so dark patches are not neglected.
+  xyz_lightness_weighted,
 };
 const char* to_string(FitTarget t);
 

@@ -34,6 +34,8 @@ enum class Interpolation {
 };
 
 std::vector<double> uniform_grid(double start_nm, double end_nm, double step_nm);
+// Sprague needs a uniform grid of at least 6 samples.
+bool sprague_applicable(const std::vector<double>& grid);
 
 // Matrix R (to.size() × from.size()) with resampled = R · values, so that a resampling is computed once and
 // applied to many spectra. Target points must lie inside [from.front(), from.back()].

@@ -8,6 +8,9 @@
 
 namespace colorlab::daemon {
 
+// <state_dir>/colorlabd.endpoint: {"pid","url","port","unix_socket"} of the running daemon.
+std::filesystem::path endpoint_file_path(const DaemonConfig& config);
+
 class Daemon {
  public:
   explicit Daemon(DaemonConfig config);
@@ -16,6 +19,7 @@ class Daemon {
   int run();
 
  private:
+  void write_endpoint_file();
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

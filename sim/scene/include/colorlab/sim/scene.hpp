@@ -42,6 +42,10 @@ inline constexpr int chart_rows = 10;
 inline constexpr double chart_width_mm = 279.4;
 inline constexpr double chart_height_mm = 215.9;
 
+// SpectroScan T table: 310 × 230 mm, origin at its top-left corner, x right, y towards the operator.
+inline constexpr double table_width_mm = 310.0;
+inline constexpr double table_height_mm = 230.0;
+
 struct SceneConfig {
   std::uint64_t seed = 1;
   // Chart spectra: CSV (wavelength_nm,A1..N10) or CGATS with SPEC_nnn fields and SAMPLE_ID. When unset, the
@@ -51,6 +55,9 @@ struct SceneConfig {
   // Chart centre on the cabinet floor (default: the middle of the front region, as §6.2 concludes).
   double chart_center_x_mm = 600.0;
   double chart_center_y_mm = 140.0;
+  // Where the chart's top-left corner lies on the SpectroScan T table (mm); the chart is centred by default.
+  double chart_on_table_x_mm = (table_width_mm - chart_width_mm) / 2.0;
+  double chart_on_table_y_mm = (table_height_mm - chart_height_mm) / 2.0;
   // Warm-up: a lamp switched on starts at warmup_start_fraction of its output (fluorescent tubes) and
   // approaches 1 with time constant warmup_tau_s simulated seconds (tungsten A is ten times faster).
   double warmup_start_fraction = 0.85;
@@ -133,6 +140,13 @@ class Scene {
   std::pair<double, double> patch_floor_position_mm(int patch_index) const;
   // Floor point (mm) of a chart point (mm from the chart's top-left corner; chart top edge is at the back).
   std::pair<double, double> chart_to_floor_mm(double chart_x_mm, double chart_y_mm) const;
+  // What the Spectrolino's aperture sees at table point (x, y) mm: a chart patch, the chart's dark surround,
+  // or the table's off-white paper-hold plate. Throws Error(bad_parameter) off the table.
+  struct TableSample {
+    std::optional<int> patch;  // chart patch index when on a patch
+    const Spectrum* reflectance = nullptr;  // owned by the scene
+  };
+  TableSample table_sample(double x_mm, double y_mm) const;
   // Spectrolino white calibration tile (its certified reflectance, 380–730/10 nm).
   const Spectrum& white_tile() const;
   // A neutral-density-plus-colour filter for transmission mode (380–730/10 nm).

@@ -21,6 +21,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <deque>
 #include <filesystem>
 #include <functional>
 #include <future>
@@ -82,6 +83,8 @@ struct CaptureReport {
 // only during the call. Throwing stops the series (the report carries the error).
 using FrameSink = std::function<void(const RawImage&)>;
 using CaptureDone = std::function<void(CaptureReport)>;
+// Completion of connect/configure: nullopt on success.
+using OperationDone = std::function<void(std::optional<Error>)>;
 
 class Camera {
  public:
@@ -92,8 +95,19 @@ class Camera {
   // Opens the device and reads identity and limits. The future throws colorlab::Error.
   std::future<void> connect();
   std::future<void> disconnect();
+  // The reconnect state machine: close, back off (doubling from `first_backoff`), reopen, and
+  // re-verify identity: a different serial than before is Error(needs_operator), because
+  // calibration and defect maps belong to one camera body. Settings configured earlier are
+  // applied again (a rebooted camera forgets them). Gives up after `attempts` tries with the
+  // last error. connect(), by contrast, starts from whatever the device reports.
+  std::future<void> reconnect(int attempts = 5,
+                              std::chrono::milliseconds first_backoff = std::chrono::milliseconds(200));
   // Validates against limits() first: Error(unsupported) / Error(bad_parameter) with a hint.
   std::future<void> configure(CameraSettings settings);
+  // Callback forms for event loops (asio_camera.hpp wraps them for co_await); `done` runs on
+  // the camera's worker thread, or on the caller's when refused at once.
+  void connect(OperationDone done);
+  void configure(CameraSettings settings, OperationDone done);
 
   // Never throws: every failure is in the report. Error(conflict) at once if a series runs.
   std::future<CaptureReport> capture(std::size_t n_frames, FrameSink sink, CaptureOptions options = {});
@@ -129,18 +143,25 @@ class Camera {
   WorkerThread& worker() { return *worker_; }
   void require_connected() const;  // throws Error(no_comms)
   void set_state(CameraState s) { state_.store(s); }
+  // Adds a line to the bounded event transcript attached to every error this camera reports.
+  void note(std::string line);
+  std::vector<std::string> transcript() const;
 
  private:
   CaptureReport run_series(std::size_t n, const FrameSink& sink, std::size_t depth);
   void deliver(CapturedFrame&& frame, std::size_t index, const FrameSink& sink);
   void after_failure(const Error& e);
+  Error with_transcript(const Error& e) const;
 
   mutable std::mutex mutex_;
   CameraIdentity identity_;
   CameraLimits limits_;
   CameraSettings settings_;
+  CameraSettings configured_;  // what callers asked for since connect(); reapplied by reconnect()
   std::atomic<CameraState> state_{CameraState::disconnected};
   std::atomic<bool> series_pending_{false};
+  std::deque<std::string> transcript_;  // guarded by mutex_
+  std::chrono::steady_clock::time_point created_ = std::chrono::steady_clock::now();
   std::unique_ptr<FramePipeline<CapturedFrame>> pipeline_;
   std::unique_ptr<WorkerThread> worker_;  // declared last: joined first
 };

@@ -1,0 +1,86 @@
+// `colorlab analyze ...` end to end on files: parses real command lines and checks the printed numbers against the
+// library (and, for de2000, against Sharma's published values).
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "colorlab/analysis/chart_io.hpp"
+#include "colorlab/cli/analyze_command.hpp"
+#include "colorlab/core/error.hpp"
+#include "test_support.hpp"
+
+namespace ca = colorlab::analysis;
+
+namespace {
+
+std::string run_cli(std::vector<std::string> args) {
+  CLI::App app{"colorlab"};
+  colorlab::cli::add_analyze_command(app);
+  args.insert(args.begin(), "colorlab");
+  std::vector<const char*> argv;
+  for (auto& a : args) argv.push_back(a.c_str());
+  ::testing::internal::CaptureStdout();
+  try {
+    app.parse(static_cast<int>(argv.size()), argv.data());
+  } catch (...) {
+    ::testing::internal::GetCapturedStdout();
+    throw;
+  }
+  return ::testing::internal::GetCapturedStdout();
+}
+
+TEST(AnalyzeCli, XyzAndLabOfSpectra) {
+  auto dir = ca::testing::temp_dir("cli");
+  std::ofstream(dir / "s.csv") << "wavelength_nm,white,grey\n380,1,0.2\n500,1,0.2\n600,1,0.2\n730,1,0.2\n";
+  std::string out = run_cli({"analyze", "lab", (dir / "s.csv").string(), "--illuminant", "D65"});
+  EXPECT_NE(out.find("white,100,0,0"), std::string::npos) << out;
+  out = run_cli({"analyze", "xyz", (dir / "s.csv").string(), "--illuminant", "F11", "--observer", "10", "--json"});
+  EXPECT_NE(out.find("\"xyz\""), std::string::npos) << out;
+  EXPECT_NE(out.find("\"Y\": 20.0"), std::string::npos) << out;
+  EXPECT_THROW(run_cli({"analyze", "xyz", (dir / "s.csv").string(), "--observer", "4"}), CLI::ValidationError);
+}
+
+TEST(AnalyzeCli, De2000OnSharmaPairs) {
+  COLORLAB_REQUIRE_SHARED(pairs, "ciede2000_sharma2005_34pairs.csv");
+  std::string out = run_cli({"analyze", "de2000", pairs.string()});
+  EXPECT_NE(out.find("\n1,2.04246,"), std::string::npos) << out;  // pair 1: Sharma 2.0425
+  EXPECT_NE(out.find("dE00,"), std::string::npos);
+}
+
+TEST(AnalyzeCli, FitWithCrossValidationAndTestChart) {
+  COLORLAB_REQUIRE_SHARED(sg, "testvec_sg140_canon20d_d50_argyll.csv");
+  COLORLAB_REQUIRE_SHARED(cc, "testvec_cc24_canon20d_d50_argyll.csv");
+  std::string out = run_cli({"analyze", "fit", "--method", "rootpoly:2", "--train", sg.string(), "--test", cc.string(), "--cv", "k5"});
+  EXPECT_NE(out.find("rootpoly:2,6,xyz"), std::string::npos) << out;
+  EXPECT_NE(out.find("# test_summary"), std::string::npos) << out;
+  out = run_cli({"analyze", "fit", "--train", sg.string(), "--json"});
+  EXPECT_NE(out.find("\"model\""), std::string::npos);
+  EXPECT_THROW(run_cli({"analyze", "fit", "--method", "poly:12", "--train", sg.string()}), colorlab::Error);
+}
+
+TEST(AnalyzeCli, UniformityAndAveraging) {
+  auto dir = ca::testing::temp_dir("cli2");
+  {
+    std::ofstream g(dir / "grid.csv");
+    for (int r = 0; r < 8; ++r) {
+      for (int c = 0; c < 10; ++c) g << (c ? "," : "") << 200 + r * 3 + c * 5;
+      g << "\n";
+    }
+  }
+  std::string out = run_cli({"analyze", "uniformity", (dir / "grid.csv").string()});
+  EXPECT_NE(out.find("# placement"), std::string::npos) << out;
+  EXPECT_NE(out.find("200,266,66"), std::string::npos) << out;  // min, max, range
+  // Two 16-bit 4×2 PGM frames.
+  for (int f = 0; f < 2; ++f) {
+    std::ofstream p(dir / ("f" + std::to_string(f) + ".pgm"), std::ios::binary);
+    p << "P5\n4 2\n65535\n";
+    for (int i = 0; i < 8; ++i) {
+      int v = 1000 + 10 * f;
+      p.put(static_cast<char>(v >> 8)).put(static_cast<char>(v & 255));
+    }
+  }
+  out = run_cli({"analyze", "averaging", (dir / "f0.pgm").string(), (dir / "f1.pgm").string()});
+  EXPECT_NE(out.find("stdev over 2 frames,7.07107,7.07107"), std::string::npos) << out;
+}
+
+}  // namespace

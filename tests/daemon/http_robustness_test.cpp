@@ -1,0 +1,177 @@
+// colorlabd as a real process, fed malformed HTTP, malformed JSON, unknown routes, oversized
+// bodies and headers: every one gets a 4xx application/problem+json and the daemon keeps serving.
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <fstream>
+#include <thread>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "colorlab/client/api_client.hpp"
+#include "colorlab/testing/process.hpp"
+#include "colorlab/testing/temp_dir.hpp"
+
+using colorlab::testing::Process;
+using colorlab::testing::TempDir;
+using nlohmann::json;
+
+namespace {
+
+struct RawReply {
+  int status = 0;
+  std::string headers;
+  std::string body;
+};
+
+RawReply send_raw(unsigned short port, const std::string& bytes) {
+  int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(port);
+  ::inet_pton(AF_INET, "127.0.0.1", &addr.sin_addr);
+  EXPECT_EQ(::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+  timeval tv{10, 0};
+  ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+  ::send(fd, bytes.data(), bytes.size(), MSG_NOSIGNAL);
+  std::string in;
+  char buf[4096];
+  ssize_t n;
+  while ((n = ::recv(fd, buf, sizeof buf, 0)) > 0) in.append(buf, static_cast<size_t>(n));
+  ::close(fd);
+  RawReply r;
+  auto sp = in.find(' ');
+  if (sp != std::string::npos) r.status = std::atoi(in.c_str() + sp + 1);
+  auto end = in.find("\r\n\r\n");
+  if (end != std::string::npos) {
+    r.headers = in.substr(0, end);
+    r.body = in.substr(end + 4);
+  }
+  return r;
+}
+
+class DaemonHttp : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::ofstream(dir / "colorlabd.toml") << "state_dir = \"state\"\n";
+    daemon = std::make_unique<Process>(
+        std::vector<std::string>{colorlab::testing::bin_path("colorlabd"), "--config", (dir / "colorlabd.toml").string(),
+                                 "--listen", "127.0.0.1:0"},
+        dir / "colorlabd.log");
+    auto endpoint_file = dir / "state" / "colorlabd.endpoint";
+    for (int i = 0; i < 200 && !std::filesystem::exists(endpoint_file); ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(25));
+    }
+    ASSERT_TRUE(std::filesystem::exists(endpoint_file)) << "colorlabd did not start";
+    json endpoint = json::parse(std::ifstream(endpoint_file));
+    port = endpoint["port"];
+    socket_path = endpoint["unix_socket"];
+  }
+
+  void expect_problem(const RawReply& r, int status, const std::string& code) {
+    EXPECT_EQ(r.status, status) << r.headers << "\n" << r.body;
+    EXPECT_NE(r.headers.find("application/problem+json"), std::string::npos) << r.headers;
+    auto j = json::parse(r.body, nullptr, false);
+    ASSERT_FALSE(j.is_discarded()) << r.body;
+    EXPECT_EQ(j["status"], status);
+    EXPECT_EQ(j["code"], code) << r.body;
+    EXPECT_TRUE(j.contains("type") && j.contains("title") && j.contains("detail") && j.contains("category"));
+  }
+
+  void expect_still_serving() {
+    auto r = send_raw(port, "GET /v1 HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n");
+    ASSERT_EQ(r.status, 200) << r.body;
+    EXPECT_EQ(json::parse(r.body)["api_version"], "1");
+  }
+
+  TempDir dir;
+  std::unique_ptr<Process> daemon;
+  unsigned short port = 0;
+  std::string socket_path;
+};
+
+}  // namespace
+
+TEST_F(DaemonHttp, GarbageInsteadOfHttpIsA400) {
+  expect_problem(send_raw(port, "HELLO THERE\r\n\r\n"), 400, "bad-http");
+  expect_problem(send_raw(port, "GET /v1 HTTP/1.1\r\nHost x\r\n\r\n"), 400, "bad-http");
+  expect_still_serving();
+}
+
+TEST_F(DaemonHttp, MalformedJsonIsA400) {
+  std::string body = "{\"campaign\": \"luminance-spot\", ";
+  expect_problem(send_raw(port, "POST /v1/executions HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\n"
+                                "Connection: close\r\nContent-Length: " +
+                                    std::to_string(body.size()) + "\r\n\r\n" + body),
+                 400, "bad-json");
+  expect_still_serving();
+}
+
+TEST_F(DaemonHttp, WrongShapesAndMediaTypesAreRefused) {
+  auto post = [&](const std::string& ct, const std::string& body) {
+    return send_raw(port, "POST /v1/executions HTTP/1.1\r\nHost: x\r\nContent-Type: " + ct +
+                              "\r\nConnection: close\r\nContent-Length: " + std::to_string(body.size()) + "\r\n\r\n" + body);
+  };
+  expect_problem(post("text/plain", "{}"), 415, "unsupported-media-type");
+  expect_problem(post("application/json", "[1,2]"), 400, "bad-request");
+  expect_problem(post("application/json", R"({"campaign": "no-such-campaign"})"), 404, "not_found");
+  expect_problem(post("application/json", R"({"campaign": "luminance-spot", "params": {"readings": -1}})"), 400,
+                 "bad_parameter");
+  expect_problem(post("application/json", R"({"campaign": "luminance-spot", "params": {"colour": 1}})"), 400,
+                 "bad_parameter");
+  expect_still_serving();
+}
+
+TEST_F(DaemonHttp, UnknownRoutesAndMethodsAre404And405) {
+  expect_problem(send_raw(port, "GET /v2/runs HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n"), 404, "not-found");
+  expect_problem(send_raw(port, "GET /v1/runs/no-such-run HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n"), 404,
+                 "not_found");
+  expect_problem(send_raw(port, "GET /v1/runs?limit=100000 HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n"), 400,
+                 "bad_parameter");
+  auto r = send_raw(port, "DELETE /v1/runs HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n");
+  expect_problem(r, 405, "method-not-allowed");
+  EXPECT_NE(r.headers.find("Allow: GET"), std::string::npos) << r.headers;
+  expect_still_serving();
+}
+
+TEST_F(DaemonHttp, OversizedBodyAndHeadersAreRefusedBeforeReading) {
+  expect_problem(send_raw(port, "POST /v1/executions HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\n"
+                                "Content-Length: 50000000\r\n\r\n{"),
+                 413, "body-too-large");
+  expect_problem(send_raw(port, "GET /v1 HTTP/1.1\r\nHost: x\r\nX-Big: " + std::string(40000, 'a') + "\r\n\r\n"), 431,
+                 "header-too-large");
+  expect_still_serving();
+}
+
+TEST_F(DaemonHttp, KeepAliveServesSeveralRequestsOnOneConnection) {
+  auto r = send_raw(port,
+                    "GET /v1 HTTP/1.1\r\nHost: x\r\n\r\n"
+                    "GET /v1/nope HTTP/1.1\r\nHost: x\r\n\r\n"
+                    "GET /v1/instruments HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n");
+  EXPECT_EQ(r.status, 200);
+  std::string all = r.headers + r.body;
+  EXPECT_NE(all.find("HTTP/1.1 404"), std::string::npos);
+  EXPECT_NE(all.find("\"items\":[]"), std::string::npos) << all;
+}
+
+TEST_F(DaemonHttp, CampaignWithoutItsInstrumentFailsWithAHint) {
+  colorlab::client::Endpoint ep;
+  ep.unix_socket = socket_path;  // the Unix socket serves the same API
+  colorlab::client::ApiClient api(ep);
+  auto e = api.post("/v1/executions", {{"campaign", "luminance-spot"}});
+  json status;
+  for (int i = 0; i < 200; ++i) {
+    status = api.get("/v1/executions/" + e["id"].get<std::string>());
+    if (status["status"] != "waiting" && status["status"] != "running") break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  EXPECT_EQ(status["status"], "finished_error");
+  EXPECT_EQ(status["error"]["code"], "not_found");
+  EXPECT_FALSE(status["error"]["hint"].get<std::string>().empty());
+  auto run = api.get("/v1/runs/" + e["run_id"].get<std::string>());
+  EXPECT_EQ(run["status"], "finished_error");
+  expect_still_serving();
+}

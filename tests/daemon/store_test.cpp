@@ -1,0 +1,169 @@
+// The store's promises: forward-only migrations, refusal of newer or foreign files, durable
+// measurements, interrupted runs finalised at open, idempotent execution creation, keyset paging.
+#include <gtest/gtest.h>
+#include <sqlite3.h>
+
+#include "colorlab/core/error.hpp"
+#include "colorlab/store/schema.hpp"
+#include "colorlab/store/store.hpp"
+#include "colorlab/testing/temp_dir.hpp"
+
+using colorlab::Error;
+using colorlab::ErrorClass;
+using colorlab::protocol::ExecutionStatus;
+using colorlab::store::NewRun;
+using colorlab::store::Store;
+using colorlab::testing::TempDir;
+
+namespace {
+
+NewRun luminance_run() {
+  NewRun r;
+  r.campaign = "luminance-spot";
+  r.params = {{"readings", 2}};
+  r.simulated = true;
+  r.instruments = nlohmann::json::array({{{"id", "ls110"}}});
+  return r;
+}
+
+void set_user_version(const std::filesystem::path& db, int v) {
+  sqlite3* h = nullptr;
+  ASSERT_EQ(sqlite3_open(db.c_str(), &h), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(h, ("PRAGMA user_version = " + std::to_string(v)).c_str(), nullptr, nullptr, nullptr), SQLITE_OK);
+  sqlite3_close(h);
+}
+
+}  // namespace
+
+TEST(Store, CreatesSchemaAtCurrentVersion) {
+  TempDir dir;
+  Store store(dir / "state/colorlab.db");
+  colorlab::store::Database db((dir / "state/colorlab.db").string(), true);
+  EXPECT_EQ(colorlab::store::schema_version(db), colorlab::store::kSchemaVersion);
+}
+
+TEST(Store, RefusesDatabaseFromNewerColorlab) {
+  TempDir dir;
+  { Store store(dir / "colorlab.db"); }
+  set_user_version(dir / "colorlab.db", colorlab::store::kSchemaVersion + 1);
+  try {
+    Store again(dir / "colorlab.db");
+    FAIL() << "a newer database must be refused";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.cls(), ErrorClass::io_error);
+    EXPECT_NE(std::string(e.what()).find("newer"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Store, RefusesForeignDatabase) {
+  TempDir dir;
+  sqlite3* h = nullptr;
+  ASSERT_EQ(sqlite3_open((dir / "other.db").c_str(), &h), SQLITE_OK);
+  sqlite3_exec(h, "PRAGMA application_id = 1234; CREATE TABLE t(x);", nullptr, nullptr, nullptr);
+  sqlite3_close(h);
+  EXPECT_THROW(Store(dir / "other.db"), Error);
+}
+
+TEST(Store, RejectsGarbageFileWithTypedError) {
+  TempDir dir;
+  {
+    FILE* f = std::fopen((dir / "colorlab.db").c_str(), "w");
+    std::fputs("this is not a database, just some text that is long enough to be read as a header page....", f);
+    std::fclose(f);
+  }
+  try {
+    Store s(dir / "colorlab.db");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.cls(), ErrorClass::io_error) << e.what();
+  }
+}
+
+TEST(Store, MeasurementsSurviveReopenAndUnfinishedRunsBecomeInterrupted) {
+  TempDir dir;
+  std::string run_id, exec_id;
+  {
+    Store store(dir / "colorlab.db");
+    auto created = store.create_execution(luminance_run());
+    ASSERT_TRUE(created.created);
+    run_id = created.execution.run_id;
+    exec_id = created.execution.id;
+    store.mark_run_started(run_id);
+    store.update_execution(exec_id, ExecutionStatus::running, 0.5, "reading/1");
+    store.add_measurement(run_id, "reading/0", "ls110", true, "luminance", 245.5, "cd/m2", {{"raw", "OK00,   245.50"}});
+    // The process "dies" here: no finish_run.
+  }
+  Store reopened(dir / "colorlab.db");
+  EXPECT_EQ(reopened.interrupted_at_open(), 1);
+  auto run = reopened.run(run_id);
+  ASSERT_TRUE(run);
+  EXPECT_EQ(run->status, "interrupted");
+  EXPECT_TRUE(run->finished_at.has_value());
+  EXPECT_EQ(reopened.execution(exec_id)->status, ExecutionStatus::interrupted);
+  auto ms = reopened.measurements(run_id);
+  ASSERT_EQ(ms.size(), 1u);
+  EXPECT_DOUBLE_EQ(*ms[0].value, 245.5);
+  EXPECT_TRUE(ms[0].simulated);
+  EXPECT_EQ(ms[0].data["raw"], "OK00,   245.50");
+}
+
+TEST(Store, RepeatedStepIsAConflictNotADuplicate) {
+  TempDir dir;
+  Store store(dir / "colorlab.db");
+  auto e = store.create_execution(luminance_run()).execution;
+  store.add_measurement(e.run_id, "reading/0", "ls110", false, "luminance", 1.0, "cd/m2", nullptr);
+  EXPECT_TRUE(store.has_measurement(e.run_id, "reading/0"));
+  try {
+    store.add_measurement(e.run_id, "reading/0", "ls110", false, "luminance", 2.0, "cd/m2", nullptr);
+    FAIL();
+  } catch (const Error& err) {
+    EXPECT_EQ(err.cls(), ErrorClass::conflict);
+  }
+  ASSERT_EQ(store.measurements(e.run_id).size(), 1u);
+  EXPECT_DOUBLE_EQ(*store.measurements(e.run_id)[0].value, 1.0);
+}
+
+TEST(Store, IdempotencyKeyReturnsTheSameExecution) {
+  TempDir dir;
+  Store store(dir / "colorlab.db");
+  auto run = luminance_run();
+  run.idempotency_key = "night-2026-11-22";
+  auto first = store.create_execution(run);
+  auto second = store.create_execution(run);
+  EXPECT_TRUE(first.created);
+  EXPECT_FALSE(second.created);
+  EXPECT_EQ(first.execution.id, second.execution.id);
+  EXPECT_EQ(store.runs(10, std::nullopt).runs.size(), 1u);
+}
+
+TEST(Store, CursorPagingVisitsEveryRunOnceNewestFirst) {
+  TempDir dir;
+  Store store(dir / "colorlab.db");
+  std::vector<std::string> created;
+  for (int i = 0; i < 7; ++i) created.push_back(store.create_execution(luminance_run()).execution.run_id);
+  std::vector<std::string> seen;
+  std::optional<std::string> cursor;
+  int pages = 0;
+  do {
+    auto page = store.runs(3, cursor);
+    for (const auto& r : page.runs) seen.push_back(r.id);
+    cursor = page.next_cursor;
+    ++pages;
+  } while (cursor);
+  EXPECT_EQ(pages, 3);
+  std::reverse(created.begin(), created.end());
+  EXPECT_EQ(seen, created);
+}
+
+TEST(Store, ForeignCursorIsABadParameter) {
+  TempDir dir;
+  Store store(dir / "colorlab.db");
+  for (const char* bad : {"abc", "-3", "12x", ""}) {
+    try {
+      store.runs(3, std::string(bad));
+      FAIL() << bad;
+    } catch (const Error& e) {
+      EXPECT_EQ(e.cls(), ErrorClass::bad_parameter) << bad;
+    }
+  }
+}
