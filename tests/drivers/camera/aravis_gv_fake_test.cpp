@@ -272,6 +272,9 @@ TEST(camera_aravis, reconnect_verifies_the_camera_is_the_same_body) {
   auto fake = start_fake();
   cam::AravisCamera camera(small_roi());
   camera.connect().get();
+  cam::CameraSettings s;
+  s.pixel_format = cam::PixelFormat::bayer_rg12;  // must survive the reconnect (the new fake starts in Mono8)
+  camera.configure(s).get();
   fake.reset();
   gv::GvFakeOptions other;
   other.serial = "CLGV0002";

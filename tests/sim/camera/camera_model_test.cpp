@@ -221,3 +221,33 @@ TEST(SimCameraModel, ColorMatrixMapsD65WhiteToTheCameraNeutral) {
 
 }  // namespace
 }  // namespace colorlab::sim::camera
+
+namespace colorlab::sim::camera {
+namespace {
+
+TEST(SimCameraModel, FramesDuringWarmUpAreDarker) {
+  SceneConfig cfg;
+  cfg.force_synthetic_chart = true;
+  cfg.warmup_tau_s = 1e6;  // effectively frozen at its start value for the duration of the test
+  auto scene = std::make_shared<Scene>(cfg, std::make_shared<SimClock>());
+  const CameraModel cam(scene, test::small_camera());
+  scene->set_lamp(Lamp::d65, true);
+  const double cold = cam.ground_truth(44, {})[1] - 256;
+  const RawFrame f = cam.render({}, 0);
+  SceneConfig warm_cfg = cfg;
+  warm_cfg.lamps_on_at_start = {Lamp::d65};
+  const CameraModel warm_cam(std::make_shared<Scene>(warm_cfg, std::make_shared<SimClock>()), test::small_camera());
+  const double warm = warm_cam.ground_truth(44, {})[1] - 256;
+  EXPECT_NEAR(cold / warm, cfg.warmup_start_fraction, 0.002);
+  // The rendered frame follows the same (cold) truth.
+  const auto r = cam.patch_region(44);
+  double sum = 0;
+  int n = 0;
+  for (int y = r.y; y < r.y + r.height; ++y)
+    for (int x = r.x; x < r.x + r.width; ++x)
+      if (rggb_channel(x, y) == 1) sum += f.at(x, y) - 256, ++n;
+  EXPECT_NEAR(sum / n, cold, 0.03 * cold);
+}
+
+}  // namespace
+}  // namespace colorlab::sim::camera
