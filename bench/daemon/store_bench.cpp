@@ -1,0 +1,104 @@
+// What durability costs and what keyset paging saves, measured side by side:
+// - one committed measurement with synchronous=FULL (colorlab's choice) vs NORMAL vs a batched
+//   transaction (QCoDeS's fix for slow inserts, PR #1187);
+// - a page of runs deep in a 20 000-run catalogue: keyset (colorlab) vs OFFSET (QCoDeS #1915).
+#include <benchmark/benchmark.h>
+#include <sqlite3.h>
+
+#include "colorlab/store/store.hpp"
+#include "colorlab/testing/temp_dir.hpp"
+
+namespace {
+
+void BM_CommitMeasurement_Full(benchmark::State& state) {
+  colorlab::testing::TempDir dir;
+  colorlab::store::Store store(dir / "colorlab.db");
+  colorlab::store::NewRun run{"luminance-spot", nlohmann::json::object(), true, nlohmann::json::array(), std::nullopt};
+  auto e = store.create_execution(run).execution;
+  long i = 0;
+  for (auto _ : state) {
+    store.add_measurement(e.run_id, "reading/" + std::to_string(i++), "ls110", true, "luminance", 245.3, "cd/m2",
+                          {{"raw", "OK00,   245.30"}});
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_CommitMeasurement_Full)->Unit(benchmark::kMicrosecond);
+
+// The same rows through raw SQLite: NORMAL (no fsync per commit) and one transaction for all.
+void raw_inserts(benchmark::State& state, const char* sync, bool batched) {
+  colorlab::testing::TempDir dir;
+  sqlite3* db = nullptr;
+  sqlite3_open((dir / "raw.db").c_str(), &db);
+  sqlite3_exec(db, "PRAGMA journal_mode=WAL", nullptr, nullptr, nullptr);
+  sqlite3_exec(db, (std::string("PRAGMA synchronous=") + sync).c_str(), nullptr, nullptr, nullptr);
+  sqlite3_exec(db, "CREATE TABLE m(run TEXT, seq INT, step TEXT, value REAL, data TEXT, PRIMARY KEY(run, step)) WITHOUT ROWID",
+               nullptr, nullptr, nullptr);
+  sqlite3_stmt* st = nullptr;
+  sqlite3_prepare_v2(db, "INSERT INTO m VALUES ('r', ?1, ?2, 245.3, '{\"raw\":\"OK00,   245.30\"}')", -1, &st, nullptr);
+  long i = 0;
+  if (batched) sqlite3_exec(db, "BEGIN", nullptr, nullptr, nullptr);
+  for (auto _ : state) {
+    std::string step = "reading/" + std::to_string(i);
+    sqlite3_bind_int64(st, 1, i++);
+    sqlite3_bind_text(st, 2, step.c_str(), -1, SQLITE_TRANSIENT);
+    sqlite3_step(st);
+    sqlite3_reset(st);
+  }
+  if (batched) sqlite3_exec(db, "COMMIT", nullptr, nullptr, nullptr);
+  sqlite3_finalize(st);
+  sqlite3_close(db);
+  state.SetItemsProcessed(state.iterations());
+}
+void BM_RawInsert_Normal(benchmark::State& s) { raw_inserts(s, "NORMAL", false); }
+void BM_RawInsert_OneTransaction(benchmark::State& s) { raw_inserts(s, "FULL", true); }
+BENCHMARK(BM_RawInsert_Normal)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_RawInsert_OneTransaction)->Unit(benchmark::kMicrosecond);
+
+struct Catalogue {
+  colorlab::testing::TempDir dir;
+  std::unique_ptr<colorlab::store::Store> store;
+  Catalogue() {
+    store = std::make_unique<colorlab::store::Store>(dir / "colorlab.db");
+    sqlite3* db = nullptr;
+    sqlite3_open((dir / "colorlab.db").c_str(), &db);
+    sqlite3_exec(db, "BEGIN", nullptr, nullptr, nullptr);
+    for (int i = 0; i < 20000; ++i) {
+      std::string sql = "INSERT INTO runs (id, campaign, params, status, simulated, instruments, created_at) VALUES ('run-" +
+                        std::to_string(i) + "', 'luminance-spot', '{}', 'finished_ok', 1, '[]', '2026-11-22T00:00:00.000Z')";
+      sqlite3_exec(db, sql.c_str(), nullptr, nullptr, nullptr);
+    }
+    sqlite3_exec(db, "COMMIT", nullptr, nullptr, nullptr);
+    sqlite3_close(db);
+  }
+};
+
+Catalogue& catalogue() {
+  static Catalogue c;
+  return c;
+}
+
+void BM_RunsPage_Keyset_Deep(benchmark::State& state) {
+  auto& c = catalogue();
+  for (auto _ : state) benchmark::DoNotOptimize(c.store->runs(50, std::string("1000")));
+}
+BENCHMARK(BM_RunsPage_Keyset_Deep)->Unit(benchmark::kMicrosecond);
+
+void BM_RunsPage_Offset_Deep(benchmark::State& state) {
+  auto& c = catalogue();
+  sqlite3* db = nullptr;
+  sqlite3_open_v2((c.dir / "colorlab.db").c_str(), &db, SQLITE_OPEN_READONLY, nullptr);
+  sqlite3_stmt* st = nullptr;
+  sqlite3_prepare_v2(db, "SELECT seq, id, campaign, params, status FROM runs ORDER BY seq DESC LIMIT 50 OFFSET 18950", -1,
+                     &st, nullptr);
+  for (auto _ : state) {
+    while (sqlite3_step(st) == SQLITE_ROW) benchmark::DoNotOptimize(sqlite3_column_int64(st, 0));
+    sqlite3_reset(st);
+  }
+  sqlite3_finalize(st);
+  sqlite3_close(db);
+}
+BENCHMARK(BM_RunsPage_Offset_Deep)->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
