@@ -41,13 +41,16 @@ PatchValue robust_of(std::vector<double>& px, std::size_t total, double k, const
   PatchValue pv;
   pv.total = total;
   pv.good = px.size();
-  double mean = 0, m2 = 0;
-  for (std::size_t i = 0; i < px.size(); ++i) {
-    double d = px[i] - mean;
-    mean += d / static_cast<double>(i + 1);
-    m2 += d * (px[i] - mean);
+  const double n = static_cast<double>(px.size());
+  // Shifted sums (by the first pixel) keep the one-pass variance exact for offset data such as 16-bit counts.
+  const double shift = px.front();
+  double s1 = 0, s2 = 0;
+  for (double v : px) {
+    const double d = v - shift;
+    s1 += d;
+    s2 += d * d;
   }
-  pv.stdev = px.size() > 1 ? std::sqrt(m2 / static_cast<double>(px.size() - 1)) : 0.0;
+  pv.stdev = px.size() > 1 ? std::sqrt(std::max(0.0, (s2 - s1 * s1 / n) / (n - 1))) : 0.0;
   pv.median = median_of(px);
   double sum = 0;
   for (double v : px)
@@ -78,7 +81,8 @@ PatchValue robust_patch_value(const ImageView& img, const Rect& r, const RobustO
   check_region(img, r);
   check_mask(img, defects);
   const double k = opt.effective_k();
-  std::vector<double> px;
+  thread_local std::vector<double> px;  // reused: 140 patches must not mean 140 allocations
+  px.clear();
   px.reserve(r.width * r.height);
   for (std::size_t y = r.y; y < r.y + r.height; ++y)
     for (std::size_t x = r.x; x < r.x + r.width; ++x) {

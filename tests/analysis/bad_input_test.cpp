@@ -37,7 +37,7 @@ ca::SpectralSet flat_reflectance(double v) {
   return s;
 }
 
-TEST(BadInput, NanAndNegativeSpectraNameSampleAndWavelength) {
+TEST(AnalysisBadInput, NanAndNegativeSpectraNameSampleAndWavelength) {
   auto lamp = ca::load_illuminant("D65");
   auto s = flat_reflectance(0.5);
   s.values(1, 7) = NAN;
@@ -49,7 +49,7 @@ TEST(BadInput, NanAndNegativeSpectraNameSampleAndWavelength) {
   expect_error([&] { ca::illuminant_white(bad_lamp, ca::Observer::cie1931_2deg); }, ErrorClass::bad_data, "emission spectrum");
 }
 
-TEST(BadInput, MismatchedGridsAndPatchCounts) {
+TEST(AnalysisBadInput, MismatchedGridsAndPatchCounts) {
   auto lamp = ca::load_illuminant("D65");
   ca::ReflectanceIntegrator integ(lamp, ca::load_observer(ca::Observer::cie1931_2deg), ca::uniform_grid(400, 700, 10));
   expect_error([&] { integ.xyz(flat_reflectance(0.5)); }, ErrorClass::bad_data, "wavelength grid differs");
@@ -69,7 +69,7 @@ TEST(BadInput, MismatchedGridsAndPatchCounts) {
                "5 spectra but 4 RAW");
 }
 
-TEST(BadInput, EmptyRegionsAndOutOfImageRegions) {
+TEST(AnalysisBadInput, EmptyRegionsAndOutOfImageRegions) {
   std::vector<float> px(100, 1.0f);
   ca::ImageView v{px.data(), 10, 10, 10};
   expect_error([&] { ca::robust_patch_value(v, {2, 2, 0, 5}); }, ErrorClass::bad_data, "is empty");
@@ -78,7 +78,7 @@ TEST(BadInput, EmptyRegionsAndOutOfImageRegions) {
   expect_error([&] { ca::robust_patch_value(v, {0, 0, 3, 3}, {}, &all); }, ErrorClass::bad_data, "no usable");
 }
 
-TEST(BadInput, RankDeficientDesigns) {
+TEST(AnalysisBadInput, RankDeficientDesigns) {
   ca::ChartData c;
   c.ids = {"a", "b", "c", "d"};
   c.rgb = Eigen::MatrixXd::Random(4, 3).cwiseAbs();
@@ -89,7 +89,7 @@ TEST(BadInput, RankDeficientDesigns) {
   expect_error([&] { ca::fit("poly:3", c); }, ErrorClass::bad_data, "rank");
 }
 
-TEST(BadInput, UnreadableAndMalformedFiles) {
+TEST(AnalysisBadInput, UnreadableAndMalformedFiles) {
   expect_error([] { ca::read_spectra("/nonexistent/dir/x.sp"); }, ErrorClass::io_error, "/nonexistent/dir/x.sp");
   expect_error([] { ca::read_chart("/nonexistent/chart.csv"); }, ErrorClass::io_error, "chart.csv");
   auto dir = ca::testing::temp_dir("bad");

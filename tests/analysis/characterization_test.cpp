@@ -21,7 +21,7 @@ namespace ca = colorlab::analysis;
 
 namespace {
 
-TEST(TermSets, DissertationSetsAreExactlyAsListed) {
+TEST(AnalysisTermSets, DissertationSetsAreExactlyAsListed) {
   const std::size_t sizes[] = {3, 5, 6, 8, 9, 11, 13, 20, 16, 29, 19};
   for (int n = 1; n <= 11; ++n) EXPECT_EQ(ca::dissertation_set(n).size(), sizes[n - 1]) << "set " << n;
   EXPECT_EQ(ca::dissertation_set(3).describe(), "r, g, b, rg, rb, gb");  // no constant
@@ -45,7 +45,7 @@ TEST(TermSets, DissertationSetsAreExactlyAsListed) {
 }
 
 // Root-polynomial terms are degree-1 homogeneous: scaling RGB by k scales every term by k (exposure invariance).
-TEST(TermSets, RootPolynomialsScaleWithExposure) {
+TEST(AnalysisTermSets, RootPolynomialsScaleWithExposure) {
   Eigen::MatrixXd rgb(1, 3);
   rgb << 0.2, 0.5, 0.7;
   for (int d = 1; d <= 4; ++d) {
@@ -67,7 +67,7 @@ ca::ChartData synthetic_chart(int n, unsigned seed) {
   return c;
 }
 
-TEST(Regression, RecoversAGeneratingPolynomialAndLooMatchesExplicitRefits) {
+TEST(AnalysisRegression, RecoversAGeneratingPolynomialAndLooMatchesExplicitRefits) {
   ca::ChartData c = synthetic_chart(60, 7);
   const auto set = ca::dissertation_set(6);
   Eigen::MatrixXd truth = Eigen::MatrixXd::Random(static_cast<Eigen::Index>(set.size()), 3) * 20;
@@ -135,7 +135,7 @@ ArgyllResult argyll_profile_check(const ca::ChartData& chart, const std::string&
   return r;
 }
 
-TEST(ArgyllComparison, MatrixFitMatchesColprofMatrixOnTheSameChart) {
+TEST(AnalysisArgyllComparison, MatrixFitMatchesColprofMatrixOnTheSameChart) {
   COLORLAB_REQUIRE_SHARED(cc24, "testvec_cc24_canon20d_d50_argyll.csv");
   COLORLAB_REQUIRE_TOOL("colprof");
   COLORLAB_REQUIRE_TOOL("profcheck");
@@ -157,7 +157,7 @@ TEST(ArgyllComparison, MatrixFitMatchesColprofMatrixOnTheSameChart) {
   EXPECT_NEAR(am.avg, 1.91, 0.15);
 }
 
-TEST(ArgyllComparison, LutFitVersusColprofLutOnTheSameChart) {
+TEST(AnalysisArgyllComparison, LutFitVersusColprofLutOnTheSameChart) {
   COLORLAB_REQUIRE_SHARED(cc24, "testvec_cc24_canon20d_d50_argyll.csv");
   COLORLAB_REQUIRE_TOOL("colprof");
   COLORLAB_REQUIRE_TOOL("profcheck");
@@ -177,7 +177,7 @@ TEST(ArgyllComparison, LutFitVersusColprofLutOnTheSameChart) {
   EXPECT_GE(r.cv.s00.mean, r.training.s00.mean);
 }
 
-TEST(Generalisation, BestCrossValidatedModelTrainedOnSgBeatsColprofAxOnCc24) {
+TEST(AnalysisGeneralisation, BestCrossValidatedModelTrainedOnSgBeatsColprofAxOnCc24) {
   COLORLAB_REQUIRE_SHARED(sg, "testvec_sg140_canon20d_d50_argyll.csv");
   COLORLAB_REQUIRE_SHARED(cc24, "testvec_cc24_canon20d_d50_argyll.csv");
   ca::ChartData train = ca::read_chart(sg), test = ca::read_chart(cc24);
@@ -202,7 +202,7 @@ TEST(Generalisation, BestCrossValidatedModelTrainedOnSgBeatsColprofAxOnCc24) {
 }
 
 // §7.4 on synthetic data: Canon 20D sensitivities × D65 × SG spectra, 0.5 % noise.
-TEST(BlackBox, RecoversCanon20dCurvesFromNoisyRaw) {
+TEST(AnalysisBlackBox, RecoversCanon20dCurvesFromNoisyRaw) {
   COLORLAB_REQUIRE_SHARED(ssf_file, "camera_ssf_canon_eos_20d_camspec_10nm_400_720.csv");
   COLORLAB_REQUIRE_SHARED(sg_file, "colorcheckersg_xrite_before_nov2014_dcamprof_10nm_380_730.csv");
   ca::SpectralSet ssf = ca::read_spectra(ssf_file);
@@ -243,7 +243,7 @@ TEST(BlackBox, RecoversCanon20dCurvesFromNoisyRaw) {
   EXPECT_GT(worst, 0.6);
 }
 
-TEST(Nnls, SatisfiesKuhnTuckerConditions) {
+TEST(AnalysisNnls, SatisfiesKuhnTuckerConditions) {
   std::mt19937 rng(5);
   std::normal_distribution<double> nd(0, 1);
   Eigen::MatrixXd A(30, 8);

@@ -29,25 +29,26 @@ std::string run_cli(std::vector<std::string> args) {
   return ::testing::internal::GetCapturedStdout();
 }
 
-TEST(AnalyzeCli, XyzAndLabOfSpectra) {
+TEST(AnalysisCli, XyzAndLabOfSpectra) {
   auto dir = ca::testing::temp_dir("cli");
   std::ofstream(dir / "s.csv") << "wavelength_nm,white,grey\n380,1,0.2\n500,1,0.2\n600,1,0.2\n730,1,0.2\n";
   std::string out = run_cli({"analyze", "lab", (dir / "s.csv").string(), "--illuminant", "D65"});
   EXPECT_NE(out.find("white,100,0,0"), std::string::npos) << out;
+  EXPECT_NE(out.find("grey,51.8372,0,0"), std::string::npos) << out;  // 116·0.2^(1/3) − 16
   out = run_cli({"analyze", "xyz", (dir / "s.csv").string(), "--illuminant", "F11", "--observer", "10", "--json"});
   EXPECT_NE(out.find("\"xyz\""), std::string::npos) << out;
-  EXPECT_NE(out.find("\"Y\": 20.0"), std::string::npos) << out;
+  EXPECT_NE(out.find("\"id\": \"grey\""), std::string::npos) << out;
   EXPECT_THROW(run_cli({"analyze", "xyz", (dir / "s.csv").string(), "--observer", "4"}), CLI::ValidationError);
 }
 
-TEST(AnalyzeCli, De2000OnSharmaPairs) {
+TEST(AnalysisCli, De2000OnSharmaPairs) {
   COLORLAB_REQUIRE_SHARED(pairs, "ciede2000_sharma2005_34pairs.csv");
   std::string out = run_cli({"analyze", "de2000", pairs.string()});
   EXPECT_NE(out.find("\n1,2.04246,"), std::string::npos) << out;  // pair 1: Sharma 2.0425
   EXPECT_NE(out.find("dE00,"), std::string::npos);
 }
 
-TEST(AnalyzeCli, FitWithCrossValidationAndTestChart) {
+TEST(AnalysisCli, FitWithCrossValidationAndTestChart) {
   COLORLAB_REQUIRE_SHARED(sg, "testvec_sg140_canon20d_d50_argyll.csv");
   COLORLAB_REQUIRE_SHARED(cc, "testvec_cc24_canon20d_d50_argyll.csv");
   std::string out = run_cli({"analyze", "fit", "--method", "rootpoly:2", "--train", sg.string(), "--test", cc.string(), "--cv", "k5"});
@@ -58,7 +59,7 @@ TEST(AnalyzeCli, FitWithCrossValidationAndTestChart) {
   EXPECT_THROW(run_cli({"analyze", "fit", "--method", "poly:12", "--train", sg.string()}), colorlab::Error);
 }
 
-TEST(AnalyzeCli, UniformityAndAveraging) {
+TEST(AnalysisCli, UniformityAndAveraging) {
   auto dir = ca::testing::temp_dir("cli2");
   {
     std::ofstream g(dir / "grid.csv");

@@ -14,7 +14,7 @@ namespace ca = colorlab::analysis;
 
 namespace {
 
-TEST(Ciede2000, SharmaWuDalal34PairsTo1e4) {
+TEST(AnalysisCiede2000, SharmaWuDalal34PairsTo1e4) {
   COLORLAB_REQUIRE_SHARED(file, "ciede2000_sharma2005_34pairs.csv");
   ca::CsvTable t = ca::read_csv(file);
   ASSERT_EQ(t.rows.size(), 34u);
@@ -34,7 +34,7 @@ ca::IntegrationOptions plain_sum(double step) {
 }
 
 // CIE 1931 2° whites from plain sums (colorimetry-notes §2).
-TEST(Whites, PlainTenNanometreSumsMatchPublishedWhites) {
+TEST(AnalysisWhites, PlainTenNanometreSumsMatchPublishedWhites) {
   const auto obs = ca::load_observer(ca::Observer::cie1931_2deg);
   const auto grid = ca::uniform_grid(380, 730, 10);
   struct W {
@@ -53,7 +53,7 @@ TEST(Whites, PlainTenNanometreSumsMatchPublishedWhites) {
   EXPECT_NEAR(d50.white().Z, 82.512, 0.015);
 }
 
-TEST(Whites, FluorescentLampsNeedTheFineGrid) {
+TEST(AnalysisWhites, FluorescentLampsNeedTheFineGrid) {
   const auto f2 = ca::load_illuminant("F2");
   ca::XyY fine = ca::xyz_to_xyy(ca::illuminant_white(f2, ca::Observer::cie1931_2deg));
   EXPECT_NEAR(fine.x, 0.3721, 1e-4);
@@ -74,7 +74,7 @@ TEST(Whites, FluorescentLampsNeedTheFineGrid) {
   EXPECT_NEAR(bad.y, 0.3927, 5e-4);
 }
 
-TEST(Lab, SmallValueBranchAndRoundTrip) {
+TEST(AnalysisLab, SmallValueBranchAndRoundTrip) {
   const ca::Xyz white{95.0456, 100.0, 108.9058};
   // Below (6/29)³ L* is linear: 903.2963 · Y/Yn.
   ca::Lab dark = ca::xyz_to_lab({0.095, 0.1, 0.1089}, white);
@@ -88,7 +88,7 @@ TEST(Lab, SmallValueBranchAndRoundTrip) {
 }
 
 // colour-science's documented example (XYZ 0.20654008, 0.12197225, 0.05136952 under D65 xy 0.3127, 0.3290).
-TEST(LabLuv, PublishedExample) {
+TEST(AnalysisLabLuv, PublishedExample) {
   const ca::Xyz white = ca::xyy_to_xyz({0.3127, 0.3290, 100});
   const ca::Xyz c{20.654008, 12.197225, 5.136952};
   ca::Lab lab = ca::xyz_to_lab(c, white);
@@ -103,7 +103,7 @@ TEST(LabLuv, PublishedExample) {
 }
 
 // Bradford D65 → D50 as tabulated by Lindbloom (www.brucelindbloom.com).
-TEST(Bradford, D65ToD50Matrix) {
+TEST(AnalysisBradford, D65ToD50Matrix) {
   const ca::Xyz d65{95.047, 100, 108.883}, d50{96.422, 100, 82.521};
   const double M[3][3] = {{1.0478112, 0.0228866, -0.0501270}, {0.0295424, 0.9904844, -0.0170491}, {-0.0092345, 0.0150436, 0.7521316}};
   for (int j = 0; j < 3; ++j) {
@@ -119,7 +119,7 @@ TEST(Bradford, D65ToD50Matrix) {
 }
 
 // ICC sRGB profile colorants (D50-adapted): red = 0.4361, 0.2225, 0.0139; Adobe RGB red = 0.6098, 0.3111, 0.0195.
-TEST(RgbSpaces, ColorantsAndWhiteThroughLcms) {
+TEST(AnalysisRgbSpaces, ColorantsAndWhiteThroughLcms) {
   auto s = ca::rgb_to_xyz_d50(ca::RgbSpace::srgb, {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}});
   EXPECT_NEAR(s[0].X, 43.607, 0.05);
   EXPECT_NEAR(s[0].Y, 22.250, 0.05);
@@ -144,7 +144,7 @@ TEST(RgbSpaces, ColorantsAndWhiteThroughLcms) {
   EXPECT_NEAR(g[0].Y, 100 * std::pow(0.5, 563.0 / 256.0), 0.02);
 }
 
-TEST(Emission, IlluminantWhiteEqualsReflectorWhite) {
+TEST(AnalysisEmission, IlluminantWhiteEqualsReflectorWhite) {
   const auto d65 = ca::load_illuminant("D65");
   ca::Xyz e = ca::illuminant_white(d65, ca::Observer::cie1931_2deg);
   ca::ReflectanceIntegrator integ(d65, ca::load_observer(ca::Observer::cie1931_2deg), ca::uniform_grid(300, 830, 5));

@@ -12,7 +12,7 @@ namespace ca = colorlab::analysis;
 
 namespace {
 
-TEST(FrameAccumulator, StreamingMeanAndStdEqualTwoPassOverAllFrames) {
+TEST(AnalysisFrameAccumulator, StreamingMeanAndStdEqualTwoPassOverAllFrames) {
   const std::size_t w = 13, h = 11, n = 7;
   std::mt19937 rng(1);
   std::uniform_int_distribution<int> u(0, 65535);
@@ -48,7 +48,7 @@ struct Img {
   ca::ImageView view() const { return {px.data(), w, h, w}; }
 };
 
-TEST(RobustPatch, MedianThenMeanWithinKIgnoresOutliers) {
+TEST(AnalysisRobustPatch, MedianThenMeanWithinKIgnoresOutliers) {
   Img img{20, 20, std::vector<float>(400)};
   std::mt19937 rng(2);
   std::uniform_real_distribution<float> u(-2, 2);
@@ -74,7 +74,7 @@ TEST(RobustPatch, MedianThenMeanWithinKIgnoresOutliers) {
   EXPECT_DOUBLE_EQ((ca::RobustOptions{8, 2.5}.effective_k()), 2.5);
 }
 
-TEST(RobustPatch, DefectMapFromDarkAndFlatIsExcluded) {
+TEST(AnalysisRobustPatch, DefectMapFromDarkAndFlatIsExcluded) {
   const std::size_t w = 32, h = 32;
   Img dark{w, h, std::vector<float>(w * h)}, flat{w, h, std::vector<float>(w * h)}, scene{w, h, std::vector<float>(w * h)};
   std::mt19937 rng(3);
@@ -112,7 +112,7 @@ TEST(RobustPatch, DefectMapFromDarkAndFlatIsExcluded) {
   EXPECT_NEAR(with.median, med, 1e-5);
 }
 
-TEST(RobustPatch, BayerChannelsSeparated) {
+TEST(AnalysisRobustPatch, BayerChannelsSeparated) {
   const std::size_t w = 16, h = 16;
   Img raw{w, h, std::vector<float>(w * h)};
   for (std::size_t y = 0; y < h; ++y)
@@ -127,7 +127,7 @@ TEST(RobustPatch, BayerChannelsSeparated) {
   EXPECT_FLOAT_EQ(bggr[2].value, 1000);
 }
 
-TEST(NoiseVsAveraging, Table2LayoutFallsAsOneOverRootN) {
+TEST(AnalysisNoiseVsAveraging, Table2LayoutFallsAsOneOverRootN) {
   const std::size_t w = 60, h = 40, frames = 25;
   const float sigma = 2.0f;
   std::mt19937 rng(4);

@@ -53,7 +53,7 @@ BEGIN_DATA
 END_DATA
 )";
 
-TEST(Cgats, ParsesArgyllTi3WithQuotesCommentsAndTwoTables) {
+TEST(AnalysisCgats, ParsesArgyllTi3WithQuotesCommentsAndTwoTables) {
   auto tables = ca::parse_cgats(kTi3, "mem.ti3");
   ASSERT_EQ(tables.size(), 2u);
   const auto& t = tables[0];
@@ -70,7 +70,7 @@ TEST(Cgats, ParsesArgyllTi3WithQuotesCommentsAndTwoTables) {
   EXPECT_DOUBLE_EQ(s.values(1, 2), 0.60);  // percent → fraction by SPECTRAL_NORM
 }
 
-TEST(Cgats, FormatThenParseRoundTrips) {
+TEST(AnalysisCgats, FormatThenParseRoundTrips) {
   auto t = ca::parse_cgats(kTi3, "mem.ti3").front();
   auto again = ca::parse_cgats(ca::format_cgats(t), "again").front();
   EXPECT_EQ(again.fields, t.fields);
@@ -78,7 +78,7 @@ TEST(Cgats, FormatThenParseRoundTrips) {
   EXPECT_EQ(again.keyword("SPECTRAL_NORM").value(), "100.0");
 }
 
-TEST(Cgats, MalformedFilesGiveTypedErrorsWithLocation) {
+TEST(AnalysisCgats, MalformedFilesGiveTypedErrorsWithLocation) {
   auto expect_bad = [](const std::string& text, const std::string& needle) {
     try {
       ca::parse_cgats(text, "bad.ti3");
@@ -97,7 +97,7 @@ TEST(Cgats, MalformedFilesGiveTypedErrorsWithLocation) {
   EXPECT_THROW(ca::spectra_from_cgats(t.front()), colorlab::Error);
 }
 
-TEST(Csv, ReadsHeaderQuotesAndTrailingCommas) {
+TEST(AnalysisCsv, ReadsHeaderQuotesAndTrailingCommas) {
   auto t = ca::parse_csv("wavelength_nm,a,\"b,c\",\n400,0.1,0.2,\n410,0.3,0.4,\n", "m.csv");
   ASSERT_EQ(t.header.size(), 3u);
   EXPECT_EQ(t.header[2], "b,c");
@@ -108,7 +108,7 @@ TEST(Csv, ReadsHeaderQuotesAndTrailingCommas) {
   EXPECT_THROW(ca::read_csv("/nonexistent/file.csv"), colorlab::Error);
 }
 
-TEST(StandardData, ColordObserversAndIlluminants) {
+TEST(AnalysisStandardData, ColordObserversAndIlluminants) {
   auto obs = ca::load_observer(ca::Observer::cie1931_2deg);
   ASSERT_EQ(obs.size(), 3u);
   EXPECT_DOUBLE_EQ(obs.wavelengths.front(), 360);
@@ -131,7 +131,7 @@ TEST(StandardData, ColordObserversAndIlluminants) {
 
 double f(double x) { return std::exp(-std::pow((x - 550) / 60, 2)); }
 
-TEST(Resampling, InterpolatorsReproduceNodesPolynomialsAndSmoothCurves) {
+TEST(AnalysisResampling, InterpolatorsReproduceNodesPolynomialsAndSmoothCurves) {
   auto from = ca::uniform_grid(380, 730, 10);
   auto to = ca::uniform_grid(380, 730, 1);
   Eigen::VectorXd quad(static_cast<Eigen::Index>(from.size())), lin(quad.size()), g(quad.size());
@@ -150,7 +150,9 @@ TEST(Resampling, InterpolatorsReproduceNodesPolynomialsAndSmoothCurves) {
     double x = (to[k] - 500) / 100;
     auto kk = static_cast<Eigen::Index>(k);
     // Sprague is exact for low-order polynomials away from the CIE's extrapolated end points.
-    if (to[k] >= from[2] && to[k] <= from[from.size() - 3]) EXPECT_NEAR(sq(kk), 1 + x + 0.5 * x * x, 1e-9) << to[k];
+    if (to[k] >= from[2] && to[k] <= from[from.size() - 3]) {
+      EXPECT_NEAR(sq(kk), 1 + x + 0.5 * x * x, 1e-9) << to[k];
+    }
     EXPECT_NEAR(cl(kk), 2 - x, 1e-9) << to[k];                 // natural spline is exact for lines
     es = std::max(es, std::abs(sg(kk) - f(to[k])));
     ec = std::max(ec, std::abs(cg(kk) - f(to[k])));
@@ -163,7 +165,7 @@ TEST(Resampling, InterpolatorsReproduceNodesPolynomialsAndSmoothCurves) {
   EXPECT_THROW(ca::resampling_matrix({400, 410, 430, 440, 450, 460}, {405}, ca::Interpolation::sprague), colorlab::Error);
 }
 
-TEST(ChartIo, SgPatchNumberingIsTheDissertations) {
+TEST(AnalysisChartIo, SgPatchNumberingIsTheDissertations) {
   EXPECT_EQ(ca::sg_patch_id(1), "A1");
   EXPECT_EQ(ca::sg_patch_id(14), "N1");
   EXPECT_EQ(ca::sg_patch_id(15), "A2");
@@ -173,7 +175,7 @@ TEST(ChartIo, SgPatchNumberingIsTheDissertations) {
   EXPECT_THROW(ca::sg_patch_number("O1"), colorlab::Error);
 }
 
-TEST(ChartIo, ReadsTestVectorsAndWritesTi3ThatReadsBack) {
+TEST(AnalysisChartIo, ReadsTestVectorsAndWritesTi3ThatReadsBack) {
   COLORLAB_REQUIRE_SHARED(file, "testvec_cc24_canon20d_d50_argyll.csv");
   ca::ChartData c = ca::read_chart(file);
   ASSERT_EQ(c.size(), 24u);

@@ -36,9 +36,9 @@ std::string argyll_illuminant(const std::string& name) {
   return (colorlab::paths::colord_dir() / ("illuminant/CIE-" + name + ".sp")).string();
 }
 
-class Spec2Cie : public ::testing::TestWithParam<Case> {};
+class AnalysisSpec2Cie : public ::testing::TestWithParam<Case> {};
 
-TEST_P(Spec2Cie, XyzAndLabAgreeWithArgyll) {
+TEST_P(AnalysisSpec2Cie, XyzAndLabAgreeWithArgyll) {
   const Case c = GetParam();
   COLORLAB_REQUIRE_SHARED(chart_file, c.chart);
   COLORLAB_REQUIRE_TOOL("spec2cie");
@@ -79,7 +79,7 @@ TEST_P(Spec2Cie, XyzAndLabAgreeWithArgyll) {
 }
 
 INSTANTIATE_TEST_SUITE_P(
-    Charts, Spec2Cie,
+    Charts, AnalysisSpec2Cie,
     ::testing::Values(Case{"colorcheckersg_xrite_before_nov2014_dcamprof_10nm_380_730.csv", "D50", 2},
                       Case{"colorcheckersg_xrite_before_nov2014_dcamprof_10nm_380_730.csv", "D65", 2},
                       Case{"colorcheckersg_xrite_before_nov2014_dcamprof_10nm_380_730.csv", "A", 2},
@@ -94,7 +94,7 @@ INSTANTIATE_TEST_SUITE_P(
                       Case{"colorchecker24_ohta_10nm_380_730.csv", "A", 10},
                       Case{"colorchecker24_xrite_before_nov2014_dcamprof_5nm_380_730.csv", "F11", 2}));
 
-TEST(XRitePublished, PreNov2014SgSpectraReproducePublishedLab) {
+TEST(AnalysisXRitePublished, PreNov2014SgSpectraReproducePublishedLab) {
   COLORLAB_REQUIRE_SHARED(spectra_file, "colorcheckersg_xrite_before_nov2014_dcamprof_10nm_380_730.csv");
   COLORLAB_REQUIRE_SHARED(lab_file, "colorcheckersg_xrite_lab_d50.csv");
   ca::SpectralSet refl = ca::read_spectra(spectra_file);

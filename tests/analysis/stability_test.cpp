@@ -33,7 +33,7 @@ double test_error(const std::string& method, const ca::ChartData& train, const c
   }
 }
 
-class Stability : public ::testing::Test {
+class AnalysisStability : public ::testing::Test {
  protected:
   void SetUp() override {
     auto sg = ca::testing::shared("testvec_sg140_canon20d_d50_argyll.csv");
@@ -45,7 +45,7 @@ class Stability : public ::testing::Test {
   ca::ChartData sg_, cc24_;
 };
 
-TEST_F(Stability, ExtrapolationToTheMostSaturatedPatches) {
+TEST_F(AnalysisStability, ExtrapolationToTheMostSaturatedPatches) {
   std::vector<std::size_t> order(sg_.size());
   std::iota(order.begin(), order.end(), 0);
   auto chroma = [&](std::size_t i) { return std::hypot(sg_.lab(static_cast<Eigen::Index>(i), 1), sg_.lab(static_cast<Eigen::Index>(i), 2)); };
@@ -62,7 +62,7 @@ TEST_F(Stability, ExtrapolationToTheMostSaturatedPatches) {
   }
 }
 
-TEST_F(Stability, HighOrderPolynomialsOscillateAndSelectionAvoidsThem) {
+TEST_F(AnalysisStability, HighOrderPolynomialsOscillateAndSelectionAvoidsThem) {
   // 24 training patches, 20-term polynomial: near-perfect on its own patches, poor on the 140 it never saw.
   const auto o = unit_scale();
   double self = ca::evaluate(ca::fit("poly:8", cc24_, o).apply(cc24_.rgb), cc24_.lab).s00.mean;
@@ -93,7 +93,7 @@ TEST_F(Stability, HighOrderPolynomialsOscillateAndSelectionAvoidsThem) {
   EXPECT_LT(test_error(ch.method, cc24_, sg_), other);
 }
 
-TEST_F(Stability, RawNoiseFromPointOneToTwoPercent) {
+TEST_F(AnalysisStability, RawNoiseFromPointOneToTwoPercent) {
   const auto o = unit_scale();
   std::mt19937 rng(11);
   std::normal_distribution<double> nd(0, 1);
@@ -116,7 +116,7 @@ TEST_F(Stability, RawNoiseFromPointOneToTwoPercent) {
   }
 }
 
-TEST_F(Stability, ExposurePlusMinusOneStop) {
+TEST_F(AnalysisStability, ExposurePlusMinusOneStop) {
   const auto o = unit_scale();
   for (const char* m : kMethods) {
     auto model = ca::fit(m, sg_, o);
@@ -135,11 +135,13 @@ TEST_F(Stability, ExposurePlusMinusOneStop) {
       EXPECT_NEAR(errs[2], errs[1], 1e-9) << m;
     }
     // Higher powers of an over-exposed input explode: poly:10's r⁴g⁴b⁴ terms grow 4096-fold at +1 stop.
-    if (std::string(m) == "poly:10") EXPECT_GT(errs[2], 5 * errs[1]) << m;
+    if (std::string(m) == "poly:10") {
+      EXPECT_GT(errs[2], 5 * errs[1]) << m;
+    }
   }
 }
 
-TEST_F(Stability, FromOneHundredFortyToTwentyFourTrainingPatches) {
+TEST_F(AnalysisStability, FromOneHundredFortyToTwentyFourTrainingPatches) {
   const auto o = unit_scale();
   std::vector<std::size_t> idx(sg_.size());
   std::iota(idx.begin(), idx.end(), 0);
@@ -153,11 +155,13 @@ TEST_F(Stability, FromOneHundredFortyToTwentyFourTrainingPatches) {
     auto sel = ca::select_model(ca::all_term_sets(), {ca::FitTarget::xyz_then_lab}, train, o, ca::CvSpec::loo());
     std::cout << " | selected " << sel.candidates[sel.chosen].method << "\n";
     if (n == 140) chosen_terms_full = sel.candidates[sel.chosen].terms;
-    if (n == 24) EXPECT_LE(sel.candidates[sel.chosen].terms, chosen_terms_full);
+    if (n == 24) {
+      EXPECT_LE(sel.candidates[sel.chosen].terms, chosen_terms_full);
+    }
   }
 }
 
-TEST_F(Stability, IllConditionedDesignsStaySolvable) {
+TEST_F(AnalysisStability, IllConditionedDesignsStaySolvable) {
   // 12-bit counts instead of 0..1: poly:11 has r⁵ up to 1.2e18 beside a constant 1.
   ca::ChartData counts = sg_;
   counts.rgb *= 4095;

@@ -19,7 +19,7 @@ Eigen::MatrixXd cabinet(double scale) {
   return g;
 }
 
-TEST(Uniformity, MirrorWindowsAndBestPlacement) {
+TEST(AnalysisUniformity, MirrorWindowsAndBestPlacement) {
   Eigen::MatrixXd left = cabinet(1.0);
   auto res = ca::analyse_uniformity(left);
   ASSERT_EQ(res.full.rows(), 8);
@@ -43,7 +43,7 @@ TEST(Uniformity, MirrorWindowsAndBestPlacement) {
   EXPECT_LE(res.best.col, 7);  // the first of the two mirror-image minima
 }
 
-TEST(Uniformity, DimmerProportionalityAndLampComparison) {
+TEST(AnalysisUniformity, DimmerProportionalityAndLampComparison) {
   auto full = ca::analyse_uniformity(cabinet(1.0));
   auto half = ca::analyse_uniformity(cabinet(0.5));
   auto check = ca::dimmer_proportionality(full.difference, half.difference, 0.5);
@@ -63,7 +63,7 @@ TEST(Uniformity, DimmerProportionalityAndLampComparison) {
   EXPECT_THROW(ca::analyse_uniformity(Eigen::MatrixXd::Ones(2, 2)), colorlab::Error);
 }
 
-TEST(Statistics, OneSummaryForEverything) {
+TEST(AnalysisStatistics, OneSummaryForEverything) {
   auto s = ca::summarize(std::vector<double>{4, 1, 3, 2});
   EXPECT_EQ(s.count, 4u);
   EXPECT_DOUBLE_EQ(s.min, 1);

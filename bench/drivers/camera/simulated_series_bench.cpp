@@ -113,3 +113,26 @@ void BM_camera_simulated_sequential(benchmark::State& state) {
 
 BENCHMARK(BM_camera_simulated_pipeline)->Arg(0)->Arg(100)->Arg(300)->Iterations(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_camera_simulated_sequential)->Arg(0)->Arg(100)->Arg(300)->Iterations(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+namespace {
+
+// The decode stage alone on one full-size DNG: LibRaw from a file (page cache) and from memory
+// (the tethered path: bytes straight from the USB download).
+void BM_camera_decode_dng(benchmark::State& state) {
+  const auto dir = bench_dir();
+  const auto path = dir / "IMG_DECODE.DNG";
+  simcam::write_dng(path, full_size_model()->render({}, 0), {});
+  std::ifstream in(path, std::ios::binary);
+  const std::vector<std::uint8_t> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  cam::RawDecoder decoder;
+  for (auto _ : state) {
+    const auto img = state.range(0) == 0 ? decoder.decode_file(path) : decoder.decode_buffer(bytes, "IMG_DECODE.DNG");
+    benchmark::DoNotOptimize(img.pixels);
+  }
+  state.SetLabel(state.range(0) == 0 ? "file" : "memory");
+  fs::remove_all(dir);
+}
+
+}  // namespace
+
+BENCHMARK(BM_camera_decode_dng)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Repetitions(3)->ReportAggregatesOnly(true);

@@ -24,7 +24,7 @@ using detail::Table;
 
 namespace {
 
-using Row = std::vector<std::variant<std::string, double>>;
+using Row = std::vector<detail::Cell>;
 
 Row summary_row(const std::string& name, const ca::Summary& s) { return {name, s.min, s.max, s.median, s.mean, s.stdev}; }
 const std::vector<std::string> kSummaryColumns{"quantity", "min", "max", "median", "mean", "stdev"};

@@ -13,9 +13,10 @@ void print_tables(std::ostream& os, const std::vector<Table>& tables, bool json)
       for (const auto& r : t.rows) {
         nlohmann::json o = nlohmann::json::object();
         for (std::size_t i = 0; i < r.size() && i < t.columns.size(); ++i) {
-          if (const auto* s = std::get_if<std::string>(&r[i])) o[t.columns[i]] = *s;
-          else {
-            double v = std::get<double>(r[i]);
+          if (r[i].is_text) {
+            o[t.columns[i]] = r[i].text;
+          } else {
+            const double v = r[i].number;
             o[t.columns[i]] = std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
           }
         }
@@ -36,11 +37,12 @@ void print_tables(std::ostream& os, const std::vector<Table>& tables, bool json)
     for (const auto& r : t.rows) {
       for (std::size_t i = 0; i < r.size(); ++i) {
         if (i) os << ",";
-        if (const auto* s = std::get_if<std::string>(&r[i])) {
-          bool quote = s->find_first_of(",\"") != std::string::npos;
-          os << (quote ? "\"" : "") << *s << (quote ? "\"" : "");
+        if (r[i].is_text) {
+          bool quote = r[i].text.find_first_of(",\"") != std::string::npos;
+          os << (quote ? "\"" : "") << r[i].text << (quote ? "\"" : "");
         } else {
-          os << std::setprecision(6) << std::get<double>(r[i]);
+          const double v = r[i].number;
+          os << std::setprecision(6) << (std::abs(v) < 1e-9 ? 0.0 : v);  // no "-2.8e-13" for an exact zero
         }
       }
       os << "\n";

@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <map>
+#include <mutex>
 
 #include "colorlab/core/log.hpp"
 
@@ -35,6 +36,40 @@ auto on_gphoto2_thread(F&& f) -> std::invoke_result_t<F> {
   WorkerThread& t = gphoto2_thread();
   if (t.on_this_thread()) return f();
   return t.submit(std::forward<F>(f)).get();
+}
+
+// A libgphoto2 call can block forever on a wedged USB link. Callers then stop waiting after the
+// deadline and get Error(hardware_fail); the stuck call keeps the gphoto2 thread until it
+// returns, and every later call fails fast until then. Lambdas passed here capture by value
+// (shared Session, options), so a call that returns late touches nothing that has gone.
+std::mutex g_stuck_mutex;
+std::shared_future<void> g_stuck;  // ready once the overrunning call has returned
+
+template <class F>
+auto on_gphoto2_thread_within(std::chrono::milliseconds limit, const std::string& what, F f)
+    -> std::invoke_result_t<F> {
+  WorkerThread& t = gphoto2_thread();
+  if (t.on_this_thread()) return f();
+  {
+    std::lock_guard lock(g_stuck_mutex);
+    if (g_stuck.valid() && g_stuck.wait_for(std::chrono::seconds(0)) != std::future_status::ready) {
+      throw Error(ErrorInfo{.cls = ErrorClass::hardware_fail,
+                            .message = "libgphoto2 is still stuck in an earlier call; cannot " + what,
+                            .hint = "unplug or power-cycle the camera; restart the daemon if this persists",
+                            .retryable = true});
+    }
+  }
+  auto result = t.submit(std::move(f));
+  if (result.wait_for(limit) == std::future_status::timeout) {
+    std::lock_guard lock(g_stuck_mutex);
+    g_stuck = t.submit([] {}).share();  // runs right after the stuck call returns
+    throw Error(ErrorInfo{.cls = ErrorClass::hardware_fail,
+                          .message = "libgphoto2 " + what + " did not return within " +
+                                     std::to_string(limit.count() / 1000) + " s",
+                          .hint = "the USB link or the camera firmware is stuck: power-cycle the camera, then reconnect",
+                          .retryable = true});
+  }
+  return result.get();
 }
 
 void check(int rc, std::string_view operation) {
@@ -356,13 +391,13 @@ std::optional<std::string> image_format_label(const std::vector<std::string>& la
 }  // namespace
 
 Camera::Connected Gphoto2Camera::do_connect() {
-  return on_gphoto2_thread([this] {
-    auto s = std::make_unique<Session>();
+  auto [connected, session] = on_gphoto2_thread_within(options_.call_timeout, "connect", [options = options_] {
+    auto s = std::make_shared<Session>();
     s->ctx = gp_context_new();
     check(gp_camera_new(&s->cam), "gp_camera_new");
 
-    std::string model = options_.model;
-    std::string port = options_.port;
+    std::string model = options.model;
+    std::string port = options.port;
     if (model.empty() || port.empty()) {
       ListGuard found;
       check(gp_camera_autodetect(found.list, s->ctx), "gp_camera_autodetect");
@@ -443,22 +478,21 @@ Camera::Connected Gphoto2Camera::do_connect() {
     }
     c.limits = limits_from_choices(s->choices);
     c.settings = current;
-    session_ = std::move(s);
-    return c;
+    return std::make_pair(std::move(c), std::move(s));
   });
+  session_ = std::move(session);
+  return connected;
 }
 
 void Gphoto2Camera::do_disconnect() noexcept {
-  try {
-    on_gphoto2_thread([this] { session_.reset(); });
-  } catch (...) {
-    log::warning("camera", "gphoto2 disconnect failed; session dropped");
-  }
+  if (!session_) return;
+  // Closed on the gphoto2 thread, without waiting: behind a stuck call this must not block.
+  gphoto2_thread().post([s = std::move(session_)]() mutable { s.reset(); });
 }
 
 void Gphoto2Camera::do_configure(const CameraSettings& wanted) {
-  on_gphoto2_thread([&] {
-    Session& s = *session_;
+  on_gphoto2_thread_within(options_.call_timeout, "configure", [session = session_, wanted] {
+    Session& s = *session;
     WidgetGuard window;
     check(gp_camera_get_config(s.cam, &window.w, s.ctx), "read configuration");
     auto set = [&](const char* name, const std::string& label) {
@@ -498,9 +532,9 @@ void Gphoto2Camera::do_configure(const CameraSettings& wanted) {
 std::future<std::vector<CardFile>> Gphoto2Camera::list_files(std::string folder) {
   return worker().submit([this, folder] {
     require_connected();
-    return on_gphoto2_thread([&] {
+    return on_gphoto2_thread_within(options_.call_timeout, "list files", [session = session_, folder] {
       std::vector<CardFile> out;
-      session_->list_recursive(folder, out);
+      session->list_recursive(folder, out);
       return out;
     });
   });
@@ -509,15 +543,16 @@ std::future<std::vector<CardFile>> Gphoto2Camera::list_files(std::string folder)
 std::future<std::vector<std::uint8_t>> Gphoto2Camera::download(CardFile file) {
   return worker().submit([this, file] {
     require_connected();
-    return on_gphoto2_thread([&] { return session_->download(file); });
+    return on_gphoto2_thread_within(options_.call_timeout, "download " + file.name,
+                                    [session = session_, file] { return session->download(file); });
   });
 }
 
 std::future<void> Gphoto2Camera::remove(CardFile file) {
   return worker().submit([this, file] {
     require_connected();
-    on_gphoto2_thread([&] {
-      check(gp_camera_file_delete(session_->cam, file.folder.c_str(), file.name.c_str(), session_->ctx),
+    on_gphoto2_thread_within(options_.call_timeout, "delete " + file.name, [session = session_, file] {
+      check(gp_camera_file_delete(session->cam, file.folder.c_str(), file.name.c_str(), session->ctx),
             "delete " + file.folder + "/" + file.name);
     });
   });
@@ -525,8 +560,9 @@ std::future<void> Gphoto2Camera::remove(CardFile file) {
 
 CapturedFrame Gphoto2Camera::do_capture_frame(std::size_t index) {
   const auto format = settings().image_format.value_or(ImageFormat::raw);
-  return on_gphoto2_thread([&] {
-    Session& s = *session_;
+  return on_gphoto2_thread_within(options_.call_timeout, "capture frame " + std::to_string(index),
+                                  [session = session_, options = options_, format, index] {
+    Session& s = *session;
     CameraFilePath shot{};
     check(gp_camera_capture(s.cam, GP_CAPTURE_IMAGE, &shot, s.ctx), "capture frame " + std::to_string(index));
     CapturedFrame frame;
@@ -535,7 +571,7 @@ CapturedFrame Gphoto2Camera::do_capture_frame(std::size_t index) {
 
     // capture() names one file; with RAW+JPEG the partner arrives as a FILE_ADDED event.
     const auto deadline = std::chrono::steady_clock::now() +
-                          std::chrono::milliseconds(format == ImageFormat::raw_and_jpeg ? options_.pair_wait_ms : 0);
+                          std::chrono::milliseconds(format == ImageFormat::raw_and_jpeg ? options.pair_wait_ms : 0);
     while (format == ImageFormat::raw_and_jpeg && files.size() < 2 && std::chrono::steady_clock::now() < deadline) {
       CameraEventType type{};
       void* data = nullptr;
@@ -552,11 +588,26 @@ CapturedFrame Gphoto2Camera::do_capture_frame(std::size_t index) {
       if (type == GP_EVENT_TIMEOUT) break;
     }
 
+    if (format == ImageFormat::raw_and_jpeg && files.size() < 2) {
+      // No FILE_ADDED for the partner (camlibs without events): look for the same basename.
+      ListGuard listing;
+      if (gp_camera_folder_list_files(s.cam, shot.folder, listing.list, s.ctx) >= GP_OK) {
+        for (int i = 0; i < gp_list_count(listing.list); ++i) {
+          const char* other = nullptr;
+          gp_list_get_name(listing.list, i, &other);
+          if (other && std::string(other) != shot.name &&
+              basename_without_extension(other) == basename_without_extension(shot.name)) {
+            files.push_back({shot.folder, other});
+          }
+        }
+      }
+    }
+
     for (const auto& f : files) {
       auto bytes = s.download(f);
-      if (!options_.keep_dir.empty()) {
-        std::filesystem::create_directories(options_.keep_dir);
-        const auto path = options_.keep_dir / f.name;
+      if (!options.keep_dir.empty()) {
+        std::filesystem::create_directories(options.keep_dir);
+        const auto path = options.keep_dir / f.name;
         std::ofstream out(path, std::ios::binary);
         out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
         if (!out) throw Error(ErrorClass::io_error, "cannot save " + path.string(), "check disk space and permissions");
@@ -566,7 +617,7 @@ CapturedFrame Gphoto2Camera::do_capture_frame(std::size_t index) {
         frame.file_bytes = std::move(bytes);
         frame.file_name = f.name;
       }
-      if (options_.delete_on_card) {
+      if (options.delete_on_card) {
         check(gp_camera_file_delete(s.cam, f.folder.c_str(), f.name.c_str(), s.ctx), "delete " + f.name + " on card");
       }
     }

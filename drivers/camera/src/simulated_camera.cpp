@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "colorlab/sim/camera/dng.hpp"
+#include "colorlab/sim/camera/processed.hpp"
 
 namespace colorlab::drivers::camera {
 
@@ -24,7 +25,7 @@ CameraLimits eos20d_limits() {
   l.iso = {100, 200, 400, 800, 1600};
   for (const char* s : kShutterLabels) l.shutter_s.push_back(*parse_shutter_label(s));
   l.aperture_f = {2.8, 3.2, 3.5, 4, 4.5, 5, 5.6, 6.3, 7.1, 8, 9, 10, 11, 13, 14, 16, 18, 20, 22};
-  l.image_formats = {ImageFormat::raw};
+  l.image_formats = {ImageFormat::raw, ImageFormat::raw_and_jpeg};
   return l;
 }
 
@@ -84,7 +85,7 @@ Camera::Connected SimulatedCamera::do_connect() {
   c.settings.iso = e.iso;
   c.settings.shutter_s = e.shutter_s;
   c.settings.aperture_f = e.f_number;
-  c.settings.image_format = ImageFormat::raw;
+  c.settings.image_format = format_;
   return c;
 }
 
@@ -99,6 +100,7 @@ void SimulatedCamera::do_configure(const CameraSettings& s) {
   if (s.iso) exposure_.iso = *s.iso;
   if (s.shutter_s) exposure_.shutter_s = *s.shutter_s;
   if (s.aperture_f) exposure_.f_number = *s.aperture_f;
+  if (s.image_format) format_ = *s.image_format;
 }
 
 CapturedFrame SimulatedCamera::do_capture_frame(std::size_t index) {
@@ -135,6 +137,10 @@ CapturedFrame SimulatedCamera::do_capture_frame(std::size_t index) {
   }
 
   const auto exposure = model_settings();
+  const ImageFormat format = [&] {
+    std::lock_guard lock(fault_mutex_);
+    return format_;
+  }();
   const std::uint64_t shot = shots_.fetch_add(1);
   sim::camera::RawFrame raw = options_.model->render(exposure, shot);
   if (options_.extra_capture_time.count() > 0) std::this_thread::sleep_for(options_.extra_capture_time);
@@ -150,9 +156,29 @@ CapturedFrame SimulatedCamera::do_capture_frame(std::size_t index) {
   CapturedFrame frame;
   frame.timestamp = std::chrono::system_clock::now();
   frame.file_name = name_buf;
+  if (format == ImageFormat::raw_and_jpeg || options_.write_tiff16) {
+    const auto developed = sim::camera::develop(raw, *options_.model);
+    auto sidecar = path;
+    if (format == ImageFormat::raw_and_jpeg) {
+      try {
+        sidecar.replace_extension(".JPG");
+        sim::camera::write_jpeg(sidecar, developed);
+      } catch (const Error& e) {
+        if (e.cls() != ErrorClass::unsupported) throw;
+        sidecar.replace_extension(".TIF");  // built without libjpeg
+        sim::camera::write_tiff(sidecar, developed, 8);
+      }
+      frame.saved_files.push_back(sidecar);
+    }
+    if (options_.write_tiff16) {
+      sidecar.replace_extension(".TIFF");
+      sim::camera::write_tiff(sidecar, developed, 16);
+      frame.saved_files.push_back(sidecar);
+    }
+  }
   frame.file_bytes = read_file(path);
   if (options_.keep_files) {
-    frame.saved_files.push_back(path);
+    frame.saved_files.insert(frame.saved_files.begin(), path);
   } else {
     std::error_code ec;
     std::filesystem::remove(path, ec);

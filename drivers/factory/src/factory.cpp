@@ -1,11 +1,17 @@
 #include "colorlab/drivers/factory.hpp"
 
 #include "colorlab/core/error.hpp"
+#include "colorlab/drivers/enttec_dmx.hpp"
+#include "colorlab/drivers/hid_relay.hpp"
+#include "colorlab/drivers/hidapi_transport.hpp"
 #include "colorlab/drivers/ls110.hpp"
+#include "colorlab/drivers/spectrolino.hpp"
 
 namespace colorlab::drivers {
 
 namespace {
+
+namespace sl = colorlab::wire::spectrolino;
 
 std::shared_ptr<Instrument> make_ls110(boost::asio::any_io_executor executor, const InstrumentConfig& c) {
   Ls110Options o;
@@ -17,15 +23,107 @@ std::shared_ptr<Instrument> make_ls110(boost::asio::any_io_executor executor, co
   return std::make_shared<Ls110>(executor, o);
 }
 
+std::chrono::milliseconds ms(const nlohmann::json& o, const char* key, std::chrono::milliseconds fallback) {
+  return o.contains(key) ? std::chrono::milliseconds(o[key].get<int>()) : fallback;
+}
+
+ReconnectPolicy reconnect_policy(const nlohmann::json& o) {
+  ReconnectPolicy p;
+  if (o.contains("reconnect_attempts")) p.max_attempts = o["reconnect_attempts"].get<int>();
+  p.initial_backoff = ms(o, "reconnect_backoff_ms", p.initial_backoff);
+  return p;
+}
+
+sl::Illuminant illuminant_option(const std::string& name) {
+  for (std::uint8_t v = 0; v <= 0x23; ++v) {
+    if (sl::valid_illuminant(v) && sl::illuminant_name(static_cast<sl::Illuminant>(v)) == name) return static_cast<sl::Illuminant>(v);
+  }
+  throw Error(ErrorClass::bad_parameter, "unknown Spectrolino illuminant '" + name + "'", "use A, C, D50, D65, F1..F12");
+}
+
+std::shared_ptr<Instrument> make_spectrolino(boost::asio::any_io_executor executor, const InstrumentConfig& c) {
+  SpectrolinoOptions o;
+  o.id = c.id;
+  o.port = c.port;
+  o.simulated = c.simulated;
+  const auto& j = c.options;
+  if (j.contains("max_baud")) o.max_baud = j["max_baud"].get<unsigned>();
+  if (j.contains("initialise_table")) o.initialise_table = j["initialise_table"].get<bool>();
+  if (j.contains("illuminant")) o.illuminant = illuminant_option(j["illuminant"].get<std::string>());
+  if (j.contains("observer")) {
+    int deg = j["observer"].get<int>();
+    if (deg != 2 && deg != 10) throw Error(ErrorClass::bad_parameter, "observer must be 2 or 10 (degrees)");
+    o.observer = deg == 10 ? sl::Observer::Deg10 : sl::Observer::Deg2;
+  }
+  if (j.contains("white_base")) {
+    auto wb = j["white_base"].get<std::string>();
+    if (wb != "absolute" && wb != "paper") throw Error(ErrorClass::bad_parameter, "white_base must be 'absolute' or 'paper'");
+    o.white_base = wb == "paper" ? sl::WhiteBase::Paper : sl::WhiteBase::Absolute;
+  }
+  if (j.contains("white_tile")) o.white_tile = static_cast<std::uint8_t>(j["white_tile"].get<int>() - 1);
+  if (j.contains("calibration_interval")) o.reflective_cal_interval = j["calibration_interval"].get<int>();
+  if (j.contains("attempts")) o.command_attempts = j["attempts"].get<int>();
+  if (j.contains("patch_attempts")) o.patch_attempts = j["patch_attempts"].get<int>();
+  o.timeouts.command = ms(j, "command_timeout_ms", o.timeouts.command);
+  o.timeouts.measure = ms(j, "measure_timeout_ms", o.timeouts.measure);
+  o.timeouts.move = ms(j, "move_timeout_ms", o.timeouts.move);
+  o.reconnect = reconnect_policy(j);
+  return std::make_shared<Spectrolino>(executor, o);
+}
+
+bool allow_multiple(const nlohmann::json& o) { return o.value("allow_multiple_lamps", false); }
+
+std::shared_ptr<Instrument> make_dmx(boost::asio::any_io_executor executor, const InstrumentConfig& c) {
+  EnttecDmxOptions o;
+  o.id = c.id;
+  o.port = c.port;
+  o.simulated = c.simulated;
+  const auto& j = c.options;
+  // "lamps" (+ "dimmer_channel") in colorlabd.toml; colorlab-sim announces one "channels" map with "dimmer" in it.
+  nlohmann::json lamps = j.contains("lamps") ? j["lamps"] : j.value("channels", nlohmann::json::object());
+  if (lamps.contains("dimmer")) {
+    o.dimmer_channel = lamps["dimmer"].get<int>();
+    lamps.erase("dimmer");
+  }
+  if (lamps.empty()) throw Error(ErrorClass::bad_parameter, "instrument '" + c.id + "' needs a lamps = {D65 = 1, ...} channel map");
+  o.lamps = LampMap::from_json(lamps, 512, allow_multiple(j));
+  if (j.contains("dimmer_channel")) o.dimmer_channel = j["dimmer_channel"].get<int>();
+  if (j.contains("ramp_per_second")) o.ramp_per_second = j["ramp_per_second"].get<double>();
+  o.settle = ms(j, "settle_ms", o.settle);
+  o.frame_interval = ms(j, "frame_interval_ms", o.frame_interval);
+  o.reply_timeout = ms(j, "reply_timeout_ms", o.reply_timeout);
+  if (j.contains("slots")) o.slots = j["slots"].get<std::size_t>();
+  o.reconnect = reconnect_policy(j);
+  return std::make_shared<EnttecDmx>(executor, o);
+}
+
+std::shared_ptr<Instrument> make_hidrelay(boost::asio::any_io_executor executor, const InstrumentConfig& c) {
+  HidRelayOptions o;
+  o.id = c.id;
+  o.simulated = c.simulated;
+  const auto& j = c.options;
+  if (!j.contains("lamps")) throw Error(ErrorClass::bad_parameter, "instrument '" + c.id + "' needs a lamps = {D65 = 1, ...} relay map");
+  o.lamps = LampMap::from_json(j["lamps"], 8, allow_multiple(j));
+  o.expected_board_id = j.value("board_id", std::string{});
+  if (j.contains("switch_attempts")) o.switch_attempts = j["switch_attempts"].get<int>();
+  o.reconnect = reconnect_policy(j);
+  // port "auto" takes the first dcttech board; otherwise a /dev/hidrawN path.
+  std::string path = c.port == "auto" ? std::string{} : c.port;
+  return std::make_shared<HidRelay>(executor, std::make_unique<HidapiTransport>(path), o);
+}
+
 }  // namespace
 
-std::vector<std::string> known_instrument_kinds() { return {"ls110"}; }
+std::vector<std::string> known_instrument_kinds() { return {"ls110", "spectrolino", "dmx", "hidrelay"}; }
 
 std::shared_ptr<Instrument> make_instrument(boost::asio::any_io_executor executor, const InstrumentConfig& config) {
   if (config.id.empty()) throw Error(ErrorClass::bad_parameter, "an instrument entry has no id");
   if (config.port.empty()) throw Error(ErrorClass::bad_parameter, "instrument '" + config.id + "' has no port");
   try {
     if (config.kind == "ls110") return make_ls110(executor, config);
+    if (config.kind == "spectrolino") return make_spectrolino(executor, config);
+    if (config.kind == "dmx") return make_dmx(executor, config);
+    if (config.kind == "hidrelay") return make_hidrelay(executor, config);
   } catch (const nlohmann::json::exception& e) {
     throw Error(ErrorClass::bad_parameter, "instrument '" + config.id + "': bad option: " + e.what());
   }

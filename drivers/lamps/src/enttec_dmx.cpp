@@ -261,7 +261,9 @@ asio::awaitable<void> EnttecDmx::set_level(const std::string& lamp, double level
   } catch (const Error& e) {
     fail(e);
   }
-  co_await ramp_with_reconnect({{ch, static_cast<std::uint8_t>(std::lround(level * 255.0))}});
+  std::map<int, std::uint8_t> target;
+  target[ch] = static_cast<std::uint8_t>(std::lround(level * 255.0));
+  co_await ramp_with_reconnect(target);
 }
 
 double EnttecDmx::level(const std::string& lamp) const {

@@ -99,7 +99,8 @@ asio::awaitable<void> Spectrolino::connect() {
   readings_since_cal_ = 0;
   try {
     // The last negotiated speed first: after a daemon restart the devices are usually still there.
-    std::vector<unsigned> speeds{std::min(options_.max_baud, 57600u), 9600, 19200, 28800, 4800, 2400, 1200, 600, 300};
+    // 28800 is left out as Argyll does: termios has no such standard speed (EINVAL on Linux).
+    std::vector<unsigned> speeds{std::min(options_.max_baud, 57600u), 9600, 19200, 4800, 2400, 1200, 600, 300};
     std::vector<unsigned> unique;
     for (unsigned s : speeds) {
       if (s <= options_.max_baud && std::find(unique.begin(), unique.end(), s) == unique.end()) unique.push_back(s);
@@ -294,6 +295,10 @@ asio::awaitable<void> Spectrolino::set_mode(SpectralMode mode) {
 
 asio::awaitable<void> Spectrolino::calibrate() {
   require_ready("calibrate");
+  co_await calibrate_now();
+}
+
+asio::awaitable<void> Spectrolino::calibrate_now() {
   state_ = InstrumentState::busy;
   try {
     const bool table = topology_ != SpectrolinoTopology::standalone;
@@ -505,8 +510,10 @@ asio::awaitable<void> Spectrolino::hold_paper(bool hold) {
   require_table("hold paper");
   require_ready("hold paper");
   try {
-    co_await scan_command(hold ? sl::req::hold_paper() : sl::req::release_paper(), options_.timeouts.command,
-                          hold ? "hold paper" : "release paper");
+    // Kept out of the co_await expression: GCC 12 destroys temporaries of a ?: inside co_await twice.
+    const sl::Bytes body = hold ? sl::req::hold_paper() : sl::req::release_paper();
+    const std::string_view what = hold ? "hold paper" : "release paper";
+    co_await scan_command(body, options_.timeouts.command, what);
   } catch (const Error& e) {
     fail(e);
   }
@@ -573,13 +580,16 @@ asio::awaitable<std::vector<SpectralReading>> Spectrolino::read_chart(const Char
   int done = 0;
   for (const auto& row : rows) {
     // Recalibrate at the start of a row rather than let the count run out in the middle of one.
-    if (!calibrated_ || readings_since_cal_ + static_cast<int>(row.size()) > cal_interval()) co_await calibrate();
+    bool row_start = true;
     for (const auto& patch : row) {
       std::optional<Error> last;
       for (int attempt = 1; attempt <= options_.patch_attempts; ++attempt) {
-        if (!calibrated_ || readings_since_cal_ >= cal_interval()) co_await calibrate();
-        state_ = InstrumentState::busy;
+        const bool row_would_expire = row_start && readings_since_cal_ + static_cast<int>(row.size()) > cal_interval();
         try {
+          // A failed recalibration counts as a failed try of this patch.
+          if (!calibrated_ || row_would_expire || readings_since_cal_ >= cal_interval()) co_await calibrate_now();
+          row_start = false;
+          state_ = InstrumentState::busy;
           auto r = co_await measure_patch(patch);
           r.attempts = attempt;
           ++readings_since_cal_;

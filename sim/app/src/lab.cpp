@@ -3,20 +3,64 @@
 #include <unistd.h>
 
 #include "colorlab/core/error.hpp"
+#include <boost/asio/steady_timer.hpp>
+
 #include "colorlab/sim/clock.hpp"
+#include "colorlab/sim/dmx_sim.hpp"
 #include "colorlab/sim/ls110_sim.hpp"
 #include "colorlab/sim/scene.hpp"
+#include "colorlab/sim/spectrolino_sim.hpp"
 
 namespace colorlab::sim {
 
 using nlohmann::json;
 
 struct Lab::Impl {
+  boost::asio::io_context* io = nullptr;
   LabConfig config;
   std::shared_ptr<SimClock> clock;
   std::unique_ptr<Scene> scene;
   std::shared_ptr<Ls110Sim> ls110;
+  std::shared_ptr<SpectrolinoSim> spectrolino;
+  std::shared_ptr<DmxSim> dmx;
+  std::vector<std::shared_ptr<boost::asio::steady_timer>> dropouts;
   int aim_row = 0, aim_col = 0;
+
+  // Lamp dropout: the lamp goes dark for `seconds` of simulated time, then relights (and warms up
+  // again) if nothing switched it off meanwhile.
+  json lamp_dropout(const json& spec) {
+    if (!spec.is_object()) throw Error(ErrorClass::bad_parameter, "lamp_dropout must be {\"lamp\":NAME,\"seconds\":S}");
+    Lamp lamp = lamp_from_string(spec.value("lamp", std::string()));
+    double seconds = spec.value("seconds", 0.0);
+    if (seconds <= 0) throw Error(ErrorClass::bad_parameter, "lamp_dropout.seconds must be > 0");
+    bool was_on = scene->lamp_on(lamp);
+    scene->set_lamp(lamp, false);
+    if (was_on) {
+      auto timer = std::make_shared<boost::asio::steady_timer>(*io, clock->to_real(seconds));
+      dropouts.push_back(timer);
+      timer->async_wait([this, lamp, timer](boost::system::error_code ec) {
+        if (!ec) scene->set_lamp(lamp, true);
+        std::erase(dropouts, timer);
+      });
+    }
+    return {{"lamp", to_string(lamp)}, {"seconds", seconds}, {"was_on", was_on}};
+  }
+
+  json spectrolino_truth() const {
+    const auto& m = spectrolino->model();
+    auto [x, y] = m.head_mm();
+    json t{{"head_mm", {x, y}},
+           {"on_tile", m.head_on_tile()},
+           {"calibrated", m.calibrated()},
+           {"baud", m.baud()},
+           {"measurements", m.measurements()},
+           {"lines_answered", spectrolino->lines_answered()},
+           {"lines_ignored", spectrolino->lines_ignored()}};
+    auto r = m.true_reflectance();
+    t["true_spectrum"] = std::vector<float>(r.begin(), r.end());
+    if (auto last = m.last_spectrum()) t["last_spectrum"] = std::vector<float>(last->begin(), last->end());
+    return t;
+  }
 
   Ls110Truth ls110_truth() const {
     double l = scene->floor_luminance(aim_row, aim_col);
@@ -26,6 +70,7 @@ struct Lab::Impl {
 
 Lab::Lab(boost::asio::io_context& io, LabConfig config) : impl_(std::make_unique<Impl>()) {
   auto& d = *impl_;
+  d.io = &io;
   d.config = std::move(config);
   d.clock = std::make_shared<SimClock>(d.config.time_scale);
   SceneConfig sc;
@@ -44,10 +89,32 @@ Lab::Lab(boost::asio::io_context& io, LabConfig config) : impl_(std::make_unique
     d.ls110->set_faults(d.config.ls110.faults.get<Ls110Faults>());
     d.ls110->start();
   }
+
+  if (d.config.spectrolino.enabled) {
+    d.spectrolino = std::make_shared<SpectrolinoSim>(io.get_executor(), *d.scene, d.config.spectrolino.device,
+                                                     d.scene->stream_seed("spectrolino"), d.config.time_scale);
+    if (d.config.spectrolino.head_mm) {
+      d.spectrolino->model().place_head(d.config.spectrolino.head_mm->first, d.config.spectrolino.head_mm->second);
+    } else if (!d.config.spectrolino.device.table) {
+      d.spectrolino->model().place_on_tile();
+    }
+    d.spectrolino->set_faults(d.config.spectrolino.faults.get<SpectrolinoFaults>());
+    d.spectrolino->start();
+  }
+
+  if (d.config.dmx.enabled) {
+    d.dmx = std::make_shared<DmxSim>(io.get_executor(), *d.scene, d.config.dmx.device, d.scene->stream_seed("dmx"),
+                                     d.config.time_scale);
+    d.dmx->set_faults(d.config.dmx.faults.get<LinkFaults>());
+    d.dmx->start();
+  }
 }
 
 Lab::~Lab() {
   if (impl_->ls110) impl_->ls110->stop();
+  if (impl_->spectrolino) impl_->spectrolino->stop();
+  if (impl_->dmx) impl_->dmx->stop();
+  for (auto& t : impl_->dropouts) t->cancel();
 }
 
 Scene& Lab::scene() { return *impl_->scene; }
@@ -63,6 +130,28 @@ json Lab::announcement() const {
                            {"port", d.ls110->port_path()},
                            {"serial", {{"baud", 4800}, {"framing", "7E2"}}},
                            {"simulated", true}});
+  }
+  if (d.spectrolino) {
+    const auto& dev = d.config.spectrolino.device;
+    instruments.push_back(
+        {{"id", d.config.spectrolino.id},
+         {"kind", "spectrolino"},
+         {"model", dev.table ? "GretagMacbeth Spectrolino on SpectroScan T" : "GretagMacbeth Spectrolino"},
+         {"port", d.spectrolino->port_path()},
+         {"serial", {{"baud", dev.power_on_baud}, {"framing", "8N1"}}},
+         {"simulated", true},
+         {"driver_options", {{"power_on_baud", dev.power_on_baud}, {"table", dev.table}}}});
+  }
+  if (d.dmx) {
+    json channels = json::object();
+    for (const auto& m : d.config.dmx.device.channels) channels[m.target] = m.channel;
+    instruments.push_back({{"id", d.config.dmx.id},
+                           {"kind", "dmx"},
+                           {"model", "Enttec DMX USB Pro"},
+                           {"port", d.dmx->port_path()},
+                           {"serial", {{"baud", 115200}, {"framing", "8N1"}}},
+                           {"simulated", true},
+                           {"driver_options", {{"channels", channels}}}});
   }
   return {{"colorlab_sim", 1},
           {"pid", ::getpid()},
@@ -89,15 +178,66 @@ json Lab::control(const json& command) {
         t["ls110"] = {{"luminance", lt.luminance}, {"noise_sigma", lt.noise_sigma},
                       {"aim", {d.aim_row, d.aim_col}}, {"readings_served", d.ls110->readings_served()}};
       }
+      if (d.spectrolino) t["spectrolino"] = d.spectrolino_truth();
+      if (d.dmx) {
+        const auto& u = d.dmx->universe();
+        t["dmx"] = {{"packets", d.dmx->packets()},
+                    {"slots", std::vector<int>(u.begin(), u.begin() + static_cast<long>(std::min<std::size_t>(u.size(), 16)))},
+                    {"bad_frames", d.dmx->bad_frames()},
+                    {"rejected_requests", d.dmx->rejected_requests()}};
+      }
       return t;
     }
     if (cmd == "fault") {
       std::string id = command.value("instrument", std::string());
-      if (d.ls110 && id == d.config.ls110.id) {
-        d.ls110->set_faults(command.value("faults", json::object()).get<Ls110Faults>());
-        return {{"ok", true}, {"faults", d.ls110->faults()}};
+      json faults = command.value("faults", json::object());
+      json answer{{"ok", true}};
+      if (faults.is_object() && faults.contains("lamp_dropout")) {
+        answer["lamp_dropout"] = d.lamp_dropout(faults["lamp_dropout"]);
+        faults.erase("lamp_dropout");
+        if (id == "cabinet") return answer;
       }
-      throw Error(ErrorClass::not_found, "no simulated instrument '" + id + "' takes faults");
+      if (d.ls110 && id == d.config.ls110.id) {
+        d.ls110->set_faults(faults.get<Ls110Faults>());
+        answer["faults"] = d.ls110->faults();
+        return answer;
+      }
+      if (d.spectrolino && id == d.config.spectrolino.id) {
+        // Unmentioned faults keep their current values, so faults can be added one at a time.
+        auto f = d.spectrolino->faults();
+        from_json(faults, f);
+        d.spectrolino->set_faults(f);
+        answer["faults"] = d.spectrolino->faults();
+        return answer;
+      }
+      if (d.dmx && id == d.config.dmx.id) {
+        auto f = d.dmx->faults();
+        from_json(faults, f);
+        d.dmx->set_faults(f);
+        answer["faults"] = d.dmx->faults();
+        return answer;
+      }
+      throw Error(ErrorClass::not_found, "no simulated instrument '" + id + "' takes faults",
+                  "use an id from the announcement, or \"cabinet\" for lamp_dropout alone");
+    }
+    if (cmd == "place") {
+      if (!d.spectrolino || command.value("instrument", d.config.spectrolino.id) != d.config.spectrolino.id) {
+        throw Error(ErrorClass::not_found, "no simulated Spectrolino to place");
+      }
+      auto& m = d.spectrolino->model();
+      std::string target = command.value("target", std::string("xy"));
+      if (target == "white_tile") {
+        m.place_on_tile();
+      } else if (target == "patch") {
+        auto idx = d.scene->chart().index_of(command.value("patch", std::string()));
+        if (!idx) throw Error(ErrorClass::bad_parameter, "no chart patch '" + command.value("patch", std::string()) + "'");
+        m.place_on_patch(*idx);
+      } else if (target == "xy") {
+        m.place_head(command.value("x_mm", -1.0), command.value("y_mm", -1.0));
+      } else {
+        throw Error(ErrorClass::bad_parameter, "place target must be white_tile, patch or xy");
+      }
+      return {{"ok", true}, {"spectrolino", d.spectrolino_truth()}};
     }
     if (cmd == "aim") {
       int row = command.value("row", -1), col = command.value("col", -1);
@@ -115,7 +255,7 @@ json Lab::control(const json& command) {
       return {{"ok", true}};
     }
     throw Error(ErrorClass::bad_parameter, "unknown control command '" + cmd + "'",
-                "commands: announce, truth, fault, aim, lamp, dimmer");
+                "commands: announce, truth, fault, place, aim, lamp, dimmer");
   } catch (const Error& e) {
     return {{"ok", false}, {"error", to_string(e.cls())}, {"message", e.info().message}, {"hint", e.hint()}};
   } catch (const json::exception& e) {

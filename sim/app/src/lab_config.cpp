@@ -1,5 +1,7 @@
 #include "colorlab/sim/lab_config.hpp"
 
+#include <tuple>
+
 #include <toml++/toml.h>
 
 #include "colorlab/core/error.hpp"
@@ -101,6 +103,91 @@ LabConfig load_lab_config(const std::filesystem::path& file) {
           c.ls110.faults = to_json(sn);
         } else {
           bad(file, sn, "unknown key ls110." + s);
+        }
+      }
+    } else if (k == "spectrolino") {
+      auto t = node.as_table();
+      if (!t) bad(file, node, "[spectrolino] must be a table");
+      auto& sc = c.spectrolino;
+      for (const auto& [sk, sn] : *t) {
+        std::string s(sk.str());
+        auto pair = [&](const char* what) {
+          auto a = sn.as_array();
+          if (!a || a->size() != 2 || !(*a)[0].is_number() || !(*a)[1].is_number()) {
+            bad(file, sn, std::string(what) + " must be [x_mm, y_mm]");
+          }
+          return std::make_pair((*a)[0].value<double>().value_or(0), (*a)[1].value<double>().value_or(0));
+        };
+        if (s == "enabled") {
+          sc.enabled = sn.value_or(true);
+        } else if (s == "id") {
+          sc.id = sn.value_or(std::string("spectrolino"));
+        } else if (s == "table") {
+          auto v = sn.value<bool>();
+          if (!v) bad(file, sn, "spectrolino.table must be true (SpectroScan T) or false (stand-alone)");
+          sc.device.table = *v;
+        } else if (s == "power_on_baud") {
+          auto v = sn.value<int64_t>();
+          if (!v || !wire::spectrolino::baud_ctt(static_cast<int>(*v))) {
+            bad(file, sn, "spectrolino.power_on_baud must be a Spectrolino speed (300..57600)");
+          }
+          sc.device.power_on_baud = static_cast<int>(*v);
+        } else if (s == "serial") {
+          auto v = sn.value<int64_t>();
+          if (!v || *v < 0 || *v > 65535) bad(file, sn, "spectrolino.serial must be 0..65535");
+          sc.device.serial = static_cast<std::uint32_t>(*v);
+        } else if (s == "filter") {
+          auto v = sn.value<std::string>();
+          using F = wire::spectrolino::Filter;
+          if (v == "none") sc.device.filter = F::None;
+          else if (v == "polarising") sc.device.filter = F::Polarising;
+          else if (v == "d65") sc.device.filter = F::D65;
+          else if (v == "uv_cut") sc.device.filter = F::UvCut;
+          else bad(file, sn, "spectrolino.filter must be none, polarising, d65 or uv_cut");
+        } else if (s == "chart_origin") {
+          std::tie(sc.device.chart_origin_x_mm, sc.device.chart_origin_y_mm) = pair("chart_origin");
+        } else if (s == "tile") {
+          std::tie(sc.device.tile_x_mm, sc.device.tile_y_mm) = pair("tile");
+        } else if (s == "head") {
+          sc.head_mm = pair("head");
+        } else if (s == "faults") {
+          sc.faults = to_json(sn);
+        } else {
+          bad(file, sn, "unknown key spectrolino." + s);
+        }
+      }
+    } else if (k == "dmx") {
+      auto t = node.as_table();
+      if (!t) bad(file, node, "[dmx] must be a table");
+      auto& dc = c.dmx;
+      for (const auto& [sk, sn] : *t) {
+        std::string s(sk.str());
+        if (s == "enabled") {
+          dc.enabled = sn.value_or(true);
+        } else if (s == "id") {
+          dc.id = sn.value_or(std::string("dmx"));
+        } else if (s == "serial") {
+          auto v = sn.value<int64_t>();
+          if (!v || *v < 0 || *v > 99999999) bad(file, sn, "dmx.serial must be 0..99999999");
+          dc.device.serial_decimal = static_cast<std::uint32_t>(*v);
+        } else if (s == "channels") {
+          auto ct = sn.as_table();
+          if (!ct) bad(file, sn, "dmx.channels must be a table like { D65 = 1, dimmer = 6 }");
+          dc.device.channels.clear();
+          for (const auto& [target, ch] : *ct) {
+            auto v = ch.value<int64_t>();
+            if (!v) bad(file, ch, "dmx.channels." + std::string(target.str()) + " must be a channel number");
+            dc.device.channels.push_back({static_cast<int>(*v), std::string(target.str())});
+          }
+          try {
+            validate(dc.device);
+          } catch (const Error& e) {
+            bad(file, sn, e.info().message);
+          }
+        } else if (s == "faults") {
+          dc.faults = to_json(sn);
+        } else {
+          bad(file, sn, "unknown key dmx." + s);
         }
       }
     } else {

@@ -1,6 +1,8 @@
 #include "colorlab/sim/aravis/gv_fake_camera.hpp"
 
 #include <arv.h>
+#include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -64,6 +66,7 @@ struct GvFakeCamera::Impl {
   ArvGvFakeCamera* gv = nullptr;
   ArvFakeCamera* fake = nullptr;
   std::atomic<std::uint64_t> frames{0};
+  int lock_fd = -1;
 
   static void fill(ArvBuffer* buffer, void* self, guint32 exposure_us, guint32 gain, ArvPixelFormat pf) {
     auto* impl = static_cast<Impl*>(self);
@@ -94,6 +97,7 @@ struct GvFakeCamera::Impl {
 
   ~Impl() {
     if (gv) g_object_unref(gv);
+    if (lock_fd >= 0) ::close(lock_fd);  // releases the address for the next fake
     std::error_code ec;
     if (!xml_file.empty()) std::filesystem::remove(xml_file, ec);
   }
@@ -105,6 +109,16 @@ GvFakeCamera::GvFakeCamera(GvFakeOptions options) : impl_(std::make_unique<Impl>
   if (o.serial.empty() || o.serial.size() > 15) {
     throw Error(ErrorClass::bad_parameter, "GigE Vision serial '" + o.serial + "' must have 1..15 characters",
                 "shorten the serial in the simulator config");
+  }
+  // The fake's sockets use SO_REUSEADDR, so a second fake on the same address would start
+  // "successfully" and clients would talk to either. A lock file per address, held for the
+  // fake's lifetime (and dropped by the kernel if the process dies), makes the second one fail.
+  const auto lock_path = std::filesystem::temp_directory_path() / ("colorlab-gvfake-" + o.address + ".lock");
+  impl_->lock_fd = ::open(lock_path.c_str(), O_CREAT | O_RDWR | O_CLOEXEC, 0666);
+  if (impl_->lock_fd < 0 || ::flock(impl_->lock_fd, LOCK_EX | LOCK_NB) != 0) {
+    throw Error(ErrorClass::conflict,
+                "another GigE Vision fake camera is serving " + o.address + " (lock " + lock_path.string() + ")",
+                "stop the other simulated GenICam camera (another colorlab-sim or a test) and retry");
   }
   impl_->xml_file = std::filesystem::temp_directory_path() /
                     ("colorlab-gvfake-" + std::to_string(::getpid()) + "-" + o.serial + ".xml");

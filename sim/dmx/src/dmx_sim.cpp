@@ -32,7 +32,9 @@ DmxSim::DmxSim(boost::asio::any_io_executor executor, Scene& scene, DmxConfig co
 
 void DmxSim::set_faults(const LinkFaults& faults) {
   faults_ = faults;
-  silent_until_ = faults.disconnect_s > 0 ? scene_.clock().now() + faults.disconnect_s : -1;
+  // disconnect_s is one-shot: it silences the widget from now on, and a later fault command does not repeat it.
+  if (faults.disconnect_s > 0) silent_until_ = scene_.clock().now() + faults.disconnect_s;
+  faults_.disconnect_s = 0;
 }
 
 bool DmxSim::link_down() const {

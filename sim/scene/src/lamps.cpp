@@ -5,9 +5,7 @@
 #include <cmath>
 #include <string>
 
-#include "colorlab/analysis/cgats.hpp"
 #include "colorlab/analysis/standard_data.hpp"
-#include "colorlab/core/data_paths.hpp"
 #include "colorlab/core/error.hpp"
 
 namespace colorlab::sim {
@@ -82,13 +80,6 @@ Spectrum load_lamp_spectrum(Lamp lamp) {
     case Lamp::uv: return uv_band();
   }
   Spectrum s = to_spectrum(analysis::load_illuminant(name), 0);
-  // colord's CIE-A.sp names its 1 nm fields SPEC_300000..SPEC_830000; its keywords state the real grid.
-  const auto table = analysis::read_cgats(paths::colord_file(std::string("illuminant/CIE-") + name + ".sp"));
-  const auto start = table.keyword("SPECTRAL_START_NM"), end = table.keyword("SPECTRAL_END_NM");
-  if (start && end && s.values.size() > 1) {
-    s.start_nm = std::stod(*start);
-    s.step_nm = (std::stod(*end) - s.start_nm) / double(s.values.size() - 1);
-  }
   normalise_peak(s);
   return s;
 }

@@ -21,7 +21,7 @@ constexpr double grid_depth_mm = floor_rows * floor_spot_pitch_y_mm;
 
 LuminanceField::LuminanceField(Lamp lamp, std::uint64_t seed) {
   switch (lamp) {
-    case Lamp::d65:  peak_ = 322; side_ = 0.30; depth_ = 0.15; cross_ = 0.04; centre_y_ = 0.0; flatten_ = 0.03; break;
+    case Lamp::d65:  peak_ = 322; side_ = 0.33; depth_ = 0.12; cross_ = 0.05; centre_y_ = 0.0; flatten_ = 0.03; break;
     // TL84 and CWF tubes in this cabinet are older and sit differently: steeper side fall-off (TL84) and a
     // bright region in the middle of the cabinet rather than at the front (CWF), as §6.2 reports.
     case Lamp::tl84: peak_ = 345; side_ = 0.40; depth_ = 0.24; cross_ = 0.06; centre_y_ = 0.0; flatten_ = 0.03; break;

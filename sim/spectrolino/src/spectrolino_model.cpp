@@ -164,6 +164,7 @@ double SpectrolinoModel::move_seconds(double x_mm, double y_mm) const {
 
 bool SpectrolinoModel::calibration_valid() const {
   if (!cal_ratio_) return false;
+  if (mode_ != sp::ctt::ModeEmission && cal_mode_ != mode_) return false;
   if (cal_lifetime_s_ > 0 && scene_.clock().now() - cal_time_ > cal_lifetime_s_) return false;
   return true;
 }
@@ -245,6 +246,7 @@ std::uint8_t SpectrolinoModel::reference_measure(std::uint8_t mode, double& seco
     for (std::size_t i = 0; i < raw.size(); ++i) ratio[i] = white_reference_[i] / std::max(raw[i], 1e-6f);
   }
   cal_ratio_ = ratio;
+  cal_mode_ = mode_;
   cal_time_ = scene_.clock().now();
   new_meas_ = sp::NewMeasurement::WhiteCal;
   return sp::exec_err::WhiteMeasOK;

@@ -77,9 +77,11 @@ void SpectrolinoSim::set_faults(const SpectrolinoFaults& faults) {
     clear_replies();
     line_.clear();
   }
+  // One-shot faults act now and are not kept, so a later fault command does not repeat them.
   faults_.expire_calibration = false;
   faults_.power_cycle = false;
-  silent_until_ = faults.link.disconnect_s > 0 ? scene_.clock().now() + faults.link.disconnect_s : -1;
+  if (faults.link.disconnect_s > 0) silent_until_ = scene_.clock().now() + faults.link.disconnect_s;
+  faults_.link.disconnect_s = 0;
 }
 
 bool SpectrolinoSim::link_down() const {

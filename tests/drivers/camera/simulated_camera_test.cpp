@@ -262,3 +262,19 @@ TEST(camera_simulated, callback_api_returns_before_the_series_ends) {
   auto report = done.get_future().get();
   EXPECT_TRUE(report.complete());
 }
+
+TEST(camera_simulated, raw_plus_jpeg_pairs_the_processed_image_by_basename) {
+  Rig rig;
+  cam::CameraSettings s;
+  s.image_format = cam::ImageFormat::raw_and_jpeg;
+  rig.camera->configure(s).get();
+  auto report = capture_n(*rig.camera, 2);
+  ASSERT_TRUE(report.complete()) << (report.error ? report.error->what() : "");
+  ASSERT_EQ(report.saved_files.size(), 4U);
+  for (std::size_t i = 0; i < 4; i += 2) {
+    EXPECT_EQ(report.saved_files[i].extension(), ".DNG");
+    EXPECT_EQ(report.saved_files[i].stem(), report.saved_files[i + 1].stem());
+    EXPECT_TRUE(report.saved_files[i + 1].extension() == ".JPG" || report.saved_files[i + 1].extension() == ".TIF");
+    EXPECT_GT(fs::file_size(report.saved_files[i + 1]), 1000U);
+  }
+}

@@ -168,10 +168,7 @@ TEST(SimChart, PatchLabTruthIsColorimetryOfTheScenesOwnSpectra) {
     cfg.lamps_on_at_start = {lamp};
     cfg.dimmer_percent_at_start = 70;
     const Scene scene(cfg, std::make_shared<SimClock>());
-    auto illuminant = analysis::load_illuminant(lamp == Lamp::d65 ? "D65" : lamp == Lamp::tl84 ? "F11" : "A");
-    // colord's CIE-A.sp names its fields SPEC_300000.. (nm × 1000); undo that if the reader took them literally.
-    if (illuminant.wavelengths.front() > 1000)
-      for (double& nm : illuminant.wavelengths) nm /= 1000.0;
+    const auto illuminant = analysis::load_illuminant(lamp == Lamp::d65 ? "D65" : lamp == Lamp::tl84 ? "F11" : "A");
     const auto observer = analysis::load_observer(analysis::Observer::cie1931_2deg);
     analysis::IntegrationOptions opt;
     opt.step_nm = 5;
@@ -219,6 +216,47 @@ TEST(SimTable, ApertureSeesPatchesSurroundAndPlate) {
   EXPECT_LT(gap.reflectance->at(550), 0.1);
   EXPECT_THROW(scene.table_sample(311, 10), Error);
   EXPECT_THROW(scene.table_sample(10, -0.1), Error);
+}
+
+}  // namespace
+}  // namespace colorlab::sim
+
+namespace colorlab::sim {
+namespace {
+
+// §6.2's reason for choosing the chart position: equal white border patches must not differ much, but the
+// field's non-uniformity does show on them.
+TEST(SimChart, FieldNonUniformityShowsOnIdenticalBorderPatches) {
+  SceneConfig cfg;
+  cfg.force_synthetic_chart = true;
+  cfg.lamps_on_at_start = {Lamp::d65};
+  const Scene scene(cfg, std::make_shared<SimClock>());
+  const auto& patches = scene.chart().patches;
+  double lo = 1e300, hi = 0;
+  int whites = 0;
+  for (int i = 0; i < chart_patch_count; ++i) {
+    if (patches[static_cast<std::size_t>(i)].reflectance.values != patches[0].reflectance.values) continue;
+    const double y = scene.patch_xyz(i)[1];
+    lo = std::min(lo, y);
+    hi = std::max(hi, y);
+    ++whites;
+  }
+  std::printf("%d identical white patches: luminance %.1f..%.1f cd/m2 (%.1f %%)\n", whites, lo, hi, 100 * (hi / lo - 1));
+  EXPECT_GE(whites, 8);
+  EXPECT_GT(hi / lo, 1.02);
+  EXPECT_LT(hi / lo, 1.20);
+  // Switching the lamp to CWF (less uniform) widens the spread.
+  SceneConfig cwf = cfg;
+  cwf.lamps_on_at_start = {Lamp::cwf};
+  const Scene cwf_scene(cwf, std::make_shared<SimClock>());
+  double clo = 1e300, chi = 0;
+  for (int i = 0; i < chart_patch_count; ++i) {
+    if (patches[static_cast<std::size_t>(i)].reflectance.values != patches[0].reflectance.values) continue;
+    const double y = cwf_scene.patch_xyz(i)[1];
+    clo = std::min(clo, y);
+    chi = std::max(chi, y);
+  }
+  EXPECT_GT(chi / clo, hi / lo);
 }
 
 }  // namespace

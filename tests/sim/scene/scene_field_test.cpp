@@ -3,6 +3,7 @@
 
 #include <cstdio>
 
+#include "colorlab/analysis/uniformity.hpp"
 #include "colorlab/core/error.hpp"
 #include "colorlab/sim/scene.hpp"
 #include "field_metrics.hpp"
@@ -73,6 +74,36 @@ TEST_P(SimFieldTest, Tl84AndCwfAreLessUniformThanD65) {
   const double best_d65 = test::best_window_std(lamp_grid(scene, Lamp::d65, 100));
   EXPECT_GT(test::best_window_std(lamp_grid(scene, Lamp::tl84, 100)), best_d65);
   EXPECT_GT(test::best_window_std(lamp_grid(scene, Lamp::cwf, 100)), best_d65);
+}
+
+// The same numbers through analysis' §6.2 implementation, fed the way the dissertation measured: the left
+// half of the grid (8 × 10 spots), mirrored.
+TEST_P(SimFieldTest, AnalysisLibraryMeasuresTheDissertationsNumbers) {
+  const Scene scene(synthetic_config(GetParam()), std::make_shared<SimClock>());
+  auto left_half = [&](double dimmer) {
+    const Grid g = lamp_grid(scene, Lamp::d65, dimmer);
+    Eigen::MatrixXd m(floor_rows, floor_cols / 2);
+    for (int r = 0; r < floor_rows; ++r)
+      for (int c = 0; c < floor_cols / 2; ++c) m(r, c) = g[r][c];
+    return m;
+  };
+  const auto full = analysis::analyse_uniformity(left_half(100));
+  std::printf("analysis: D65 100%% min %.1f max %.1f best window %.2f at (%d,%d)\n", full.min, full.max,
+              full.best.stdev, full.best.row, full.best.col);
+  EXPECT_NEAR(full.min, 173.0, 15.0);
+  EXPECT_NEAR(full.max, 320.0, 15.0);
+  EXPECT_GT(full.best.stdev, 3.5);
+  EXPECT_LT(full.best.stdev, 9.0);
+  // Best placement: the middle of the cabinet (§6.2: "the middle part of the front region").
+  EXPECT_GE(full.best.col, 6);
+  EXPECT_LE(full.best.col, 9);
+  for (double d : {50.0, 25.0, 15.0}) {
+    const auto low = analysis::analyse_uniformity(left_half(d));
+    const auto check = analysis::dimmer_proportionality(full.difference, low.difference, d / 100.0);
+    std::printf("analysis: dimmer %.0f%% max abs error %.1f\n", d, check.max_abs_error);
+    EXPECT_GT(check.max_abs_error, 15.0) << d;
+    EXPECT_LT(check.max_abs_error, 28.0) << d;
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(SimSeeds, SimFieldTest, ::testing::Values(1u, 7u, 12345u));

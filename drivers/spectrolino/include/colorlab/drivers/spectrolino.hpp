@@ -94,6 +94,7 @@ class Spectrolino final : public Spectrometer, public XyTable {
   Transcript& transcript() { return link_.transcript(); }
 
  private:
+  boost::asio::awaitable<void> calibrate_now();
   boost::asio::awaitable<void> negotiate_standalone(unsigned found_baud);
   boost::asio::awaitable<void> negotiate_table(unsigned found_baud);
   boost::asio::awaitable<void> identify();

@@ -9,6 +9,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "colorlab/sim/dmx_sim.hpp"
+#include "colorlab/sim/spectrolino_model.hpp"
+
 namespace colorlab::sim {
 
 struct Ls110SimConfig {
@@ -16,6 +19,22 @@ struct Ls110SimConfig {
   std::string id = "ls110";
   int aim_row = 0;   // floor grid spot the meter is aimed at (row 0 = front)
   int aim_col = 9;
+  nlohmann::json faults = nlohmann::json::object();
+};
+
+struct SpectrolinoLabConfig {
+  bool enabled = true;
+  std::string id = "spectrolino";
+  SpectrolinoConfig device;
+  std::optional<std::pair<double, double>> head_mm;  // initial head position (default: home, or the tile
+                                                      // for a stand-alone Spectrolino)
+  nlohmann::json faults = nlohmann::json::object();
+};
+
+struct DmxLabConfig {
+  bool enabled = true;
+  std::string id = "dmx";
+  DmxConfig device;
   nlohmann::json faults = nlohmann::json::object();
 };
 
@@ -27,6 +46,8 @@ struct LabConfig {
   std::optional<std::filesystem::path> chart_file;
   std::optional<std::filesystem::path> control_socket;  // default: a fresh path under $XDG_RUNTIME_DIR or /tmp
   Ls110SimConfig ls110;
+  SpectrolinoLabConfig spectrolino;
+  DmxLabConfig dmx;
 };
 
 // Throws Error{bad_parameter} naming file, line and key.

@@ -17,7 +17,7 @@ struct LinkFaults {
   double garble_probability = 0;   // corrupt characters inside a reply (the frame ends stay)
   double partial_probability = 0;  // send only the first half of a reply
   bool silent = false;             // no answers at all until cleared
-  double disconnect_s = 0;         // no answers for this many simulated seconds from when it is set
+  double disconnect_s = 0;         // one-shot: no answers for this many simulated seconds from when it is set
 };
 // Unknown keys are ignored here so each instrument can add its own; values are range-checked
 // (probabilities 0..1, times >= 0) with Error{bad_parameter}.

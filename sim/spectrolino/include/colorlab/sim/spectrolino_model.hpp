@@ -127,6 +127,7 @@ class SpectrolinoModel {
   wire::spectrolino::ParameterAnswer params_;
   std::optional<wire::spectrolino::Spectrum> cal_ratio_;  // per band, from the last white calibration
   double cal_time_ = 0;
+  std::uint8_t cal_mode_ = wire::spectrolino::ctt::ModeReflectance;  // a calibration serves one mode
   bool emission_cal_ = false;
   double cal_lifetime_s_ = 0;
   bool button_enabled_ = true;

@@ -9,6 +9,7 @@
 // Each capture downloads the raw (and its JPEG partner, paired by basename from FILE_ADDED
 // events) and deletes them from the card, since the canon camlib's capture cost grows with the
 // number of files on the card.
+#include <chrono>
 #include <cstdint>
 #include <filesystem>
 #include <future>
@@ -50,6 +51,9 @@ struct Gphoto2Options {
   std::filesystem::path keep_dir;  // downloaded raw + JPEG are saved here; empty: memory only
   bool delete_on_card = true;
   int pair_wait_ms = 3000;  // how long to wait for the JPEG partner of a RAW+JPEG capture
+  // Longest a single libgphoto2 call may take (Canon captures take 4-15 s; init a few s) before
+  // the camera is declared stuck: Error(hardware_fail), camera in fault state.
+  std::chrono::milliseconds call_timeout{60'000};
 };
 
 struct CardFile {
@@ -77,7 +81,8 @@ class Gphoto2Camera final : public Camera {
  private:
   struct Session;
   Gphoto2Options options_;
-  std::unique_ptr<Session> session_;  // touched only on the gphoto2 thread
+  // Owned jointly with in-flight libgphoto2 calls; always released on the gphoto2 thread.
+  std::shared_ptr<Session> session_;
 };
 
 // Raw file extensions LibRaw can decode, upper case without dot (CR2, DNG, ...).

@@ -3,6 +3,9 @@
 // into a capture directory and hands the file's bytes to the same LibRaw decode stage a real
 // DSLR's CR2 goes through, so everything downstream of the camera runs its production path.
 //
+// Image format RAW + JPEG adds the camera's own processed JPEG with the same basename, as the
+// EOS 20D pairs IMG_nnnn.CR2 and IMG_nnnn.JPG (an 8-bit TIFF when built without libjpeg).
+//
 // Fault injection (one-shot, armed for a frame index of the next series): a capture that times
 // out, a camera that answers "busy", and a camera that disappears (stays gone until connect()).
 #include <chrono>
@@ -26,6 +29,9 @@ struct SimulatedCameraOptions {
   // How long a capture waits before reporting a timeout when that fault is armed.
   std::chrono::milliseconds timeout_after{50};
   bool keep_files = true;  // false: delete each DNG once it has been read back
+  // Also write the camera's processed 16-bit TIFF next to each raw (the camera-colour-space
+  // method's input); the JPEG partner is written when the image format is RAW + JPEG.
+  bool write_tiff16 = false;
 };
 
 enum class CameraFault { capture_timeout, busy, disconnect };
@@ -55,6 +61,7 @@ class SimulatedCamera final : public Camera {
   std::optional<std::pair<CameraFault, std::size_t>> fault_;
   bool unplugged_ = false;
   sim::camera::CameraSettings exposure_;
+  ImageFormat format_ = ImageFormat::raw;
   std::atomic<std::uint64_t> shots_{0};
   std::array<double, 9> color_matrix_{};
   std::array<double, 3> neutral_{};

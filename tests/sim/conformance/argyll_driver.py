@@ -1,0 +1,157 @@
+#!/usr/bin/env python3
+"""Drives ArgyllCMS spotread/chartread against a running colorlab-sim Spectrolino.
+
+Argyll needs a tty on stdin and, on machines without /dev/bus/usb, a private /dev (instrument-protocols
+§5.2/5.3): the tool runs under `unshare -m` with a small tmpfs /dev whose ttyS7 links to our pty. Prompts
+are answered by pressing keys; between prompts the simulated head is moved through the control socket.
+Prints one JSON line with what it saw. Exit status 0 when the run completed.
+"""
+import argparse
+import json
+import os
+import pty
+import re
+import select
+import socket
+import sys
+import time
+
+NAMESPACE_SCRIPT = r'''
+F=$(mktemp -d); mount -t tmpfs tmpfs $F
+mkdir -p $F/bus/usb/001 $F/pts $F/shm
+for n in null zero random urandom tty full; do touch $F/$n; mount --bind /dev/$n $F/$n; done
+mount --bind /dev/pts $F/pts; mount --bind /dev/shm $F/shm; ln -s pts/ptmx $F/ptmx
+ln -s /proc/self/fd $F/fd
+ln -s "$COLORLAB_PTY" $F/ttyS7
+mount --rbind $F /dev
+cd "$COLORLAB_WORKDIR"
+exec "$@"
+'''
+
+
+def control(sock_path, cmd):
+    s = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    s.connect(sock_path)
+    s.sendall((json.dumps(cmd) + "\n").encode())
+    buf = b""
+    while not buf.endswith(b"\n"):
+        chunk = s.recv(65536)
+        if not chunk:
+            break
+        buf += chunk
+    s.close()
+    return json.loads(buf)
+
+
+class Session:
+    def __init__(self, argv, pty_path, workdir, log):
+        env = dict(os.environ, COLORLAB_PTY=pty_path, COLORLAB_WORKDIR=workdir)
+        self.pid, self.fd = pty.fork()
+        if self.pid == 0:
+            os.execvpe("unshare", ["unshare", "-m", "--propagation", "private", "sh", "-c", NAMESPACE_SCRIPT,
+                                   "sh"] + argv, env)
+        self.out = ""
+        self.log = log
+
+    def expect(self, pattern, timeout):
+        rx = re.compile(pattern, re.S)
+        deadline = time.time() + timeout
+        while True:
+            m = rx.search(self.out)
+            if m:
+                self.out = self.out[m.end():]
+                return m
+            left = deadline - time.time()
+            if left <= 0:
+                raise TimeoutError("waiting for %r; last output: %r" % (pattern, self.out[-800:]))
+            r, _, _ = select.select([self.fd], [], [], min(left, 0.5))
+            if r:
+                try:
+                    data = os.read(self.fd, 4096).decode(errors="replace")
+                except OSError:
+                    data = ""
+                if not data:
+                    m = rx.search(self.out)
+                    if m:
+                        return m
+                    raise EOFError("tool exited; last output: %r" % self.out[-800:])
+                self.log.write(data)
+                self.out += data
+
+    def send(self, keys):
+        os.write(self.fd, keys.encode())
+
+    def wait(self, timeout):
+        deadline = time.time() + timeout
+        while time.time() < deadline:
+            pid, status = os.waitpid(self.pid, os.WNOHANG)
+            if pid:
+                return os.waitstatus_to_exitcode(status)
+            try:
+                r, _, _ = select.select([self.fd], [], [], 0.2)
+                if r:
+                    data = os.read(self.fd, 4096).decode(errors="replace")
+                    self.log.write(data)
+            except OSError:
+                time.sleep(0.1)
+        os.kill(self.pid, 9)
+        return None
+
+
+def run_spotread(a, log):
+    control(a.control, {"cmd": "place", "target": "white_tile"})
+    s = Session(["spotread", "-v", "-c", "1", "-s"], a.port, a.workdir, log)
+    result = {}
+    m = s.expect(r"Device:\s*(\S+)\s+Serial No:\s*(\S+)", 60)
+    result["device"] = m.group(1)
+    result["serial"] = m.group(2)
+    # Calibration prompt for a stand-alone instrument: the head is already on the tile.
+    s.expect(r"white reference.*?(hit any key|continue)", 60)
+    s.send(" ")
+    s.expect(r"Place instrument on spot to be measured", 60)
+    result["calibrated"] = True
+    control(a.control, {"cmd": "place", "target": "patch", "patch": a.patch})
+    s.send(" ")
+    m = s.expect(r"Result is XYZ: *([-\d.]+) +([-\d.]+) +([-\d.]+)", 60)
+    result["xyz"] = [float(m.group(i)) for i in (1, 2, 3)]
+    truth = control(a.control, {"cmd": "truth"})
+    result["last_spectrum"] = truth["spectrolino"].get("last_spectrum")
+    result["true_spectrum"] = truth["spectrolino"]["true_spectrum"]
+    s.expect(r"Place instrument on spot to be measured", 30)
+    s.send("q")
+    time.sleep(0.3)
+    s.send("q")
+    result["exit"] = s.wait(30)
+    return result
+
+
+def run_chartread(a, log):
+    s = Session(["chartread", "-c", "1", "-a", "-N", a.basename], a.port, a.workdir, log)
+    result = {}
+    m = s.expect(r"(Spectroscan|SpectroScan|table|strip|patch|sight|chart|\n)", 60)
+    result["first"] = m.group(0)
+    return result
+
+
+def main():
+    p = argparse.ArgumentParser()
+    p.add_argument("mode", choices=["spotread", "chartread"])
+    p.add_argument("--port", required=True)
+    p.add_argument("--control", required=True)
+    p.add_argument("--patch", default="D4")
+    p.add_argument("--workdir", default=os.getcwd())
+    p.add_argument("--basename", default="chart")
+    p.add_argument("--log", default="-")
+    a = p.parse_args()
+    log = sys.stderr if a.log == "-" else open(a.log, "w")
+    try:
+        result = run_spotread(a, log) if a.mode == "spotread" else run_chartread(a, log)
+        result["ok"] = True
+    except (TimeoutError, EOFError) as e:
+        result = {"ok": False, "error": str(e)}
+    print(json.dumps(result))
+    return 0 if result["ok"] else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
