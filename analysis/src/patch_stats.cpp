@@ -41,16 +41,6 @@ PatchValue robust_of(std::vector<double>& px, std::size_t total, double k, const
   PatchValue pv;
   pv.total = total;
   pv.good = px.size();
-  const double n = static_cast<double>(px.size());
-  // Shifted sums (by the first pixel) keep the one-pass variance exact for offset data such as 16-bit counts.
-  const double shift = px.front();
-  double s1 = 0, s2 = 0;
-  for (double v : px) {
-    const double d = v - shift;
-    s1 += d;
-    s2 += d * d;
-  }
-  pv.stdev = px.size() > 1 ? std::sqrt(std::max(0.0, (s2 - s1 * s1 / n) / (n - 1))) : 0.0;
   pv.median = median_of(px);
   double sum = 0;
   for (double v : px)

@@ -6,6 +6,9 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
+
+#include <unistd.h>
 
 #include "colorlab/core/data_paths.hpp"
 
@@ -18,11 +21,22 @@ inline bool have_tool(const std::string& tool) {
   return std::system(("command -v " + tool + " >/dev/null 2>&1").c_str()) == 0;
 }
 
+// Scratch directories are removed when the test program exits (kept with COLORLAB_KEEP_TEST_FILES=1 for debugging).
+struct TempDirs {
+  std::vector<std::filesystem::path> dirs;
+  ~TempDirs() {
+    if (std::getenv("COLORLAB_KEEP_TEST_FILES")) return;
+    std::error_code ec;
+    for (const auto& d : dirs) std::filesystem::remove_all(d, ec);
+  }
+};
+
 inline std::filesystem::path temp_dir(const std::string& tag) {
+  static TempDirs registry;
   auto base = std::filesystem::temp_directory_path() /
-              ("colorlab-analysis-" + tag + "-" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-               "-" + std::to_string(std::rand()));
+              ("colorlab-analysis-" + tag + "-" + std::to_string(::getpid()) + "-" + std::to_string(registry.dirs.size()));
   std::filesystem::create_directories(base);
+  registry.dirs.push_back(base);
   return base;
 }
 

@@ -183,10 +183,13 @@ Camera::Connected AravisCamera::do_connect() {
   }
   g_free(formats);
 
+  Region r;
   if (options_.region) {
-    const Region& r = *options_.region;
-    arv_camera_set_region(d->camera, r.x, r.y, r.width, r.height, Check("set region of interest"));
+    r = *options_.region;
+  } else {
+    arv_camera_get_sensor_size(d->camera, &r.width, &r.height, Check("read sensor size"));
   }
+  arv_camera_set_region(d->camera, r.x, r.y, r.width, r.height, Check("set region of interest"));
   if (options_.frame_rate_hz && arv_camera_is_frame_rate_available(d->camera, nullptr)) {
     arv_camera_set_frame_rate(d->camera, *options_.frame_rate_hz, Check("set frame rate"));
   }
@@ -290,6 +293,7 @@ CapturedFrame AravisCamera::do_capture_frame(std::size_t index) {
     m.row_stride = m.raw_width = m.width = static_cast<std::size_t>(w);
     m.raw_height = m.height = static_cast<std::size_t>(h);
     m.white_level = px.white;
+    m.black_level.fill(options_.black_level);
     m.bits_per_sample = px.bits;
     // The Bayer phase is fixed by the sensor origin: an odd ROI offset shifts RGGB.
     const CfaPattern rggb = CfaPattern::rggb();

@@ -77,6 +77,13 @@ void Spectrolino::fail(const Error& e) {
   throw e;
 }
 
+void Spectrolino::verify_serial(const std::string& expected) const {
+  if (identity_.serial != expected) {
+    throw Error(ErrorClass::needs_operator, "after reconnecting, the instrument's serial is " + identity_.serial + ", not " + expected,
+                "another instrument is on this port: check the cabling before the chart continues");
+  }
+}
+
 void Spectrolino::require_table(std::string_view what) const {
   if (topology_ == SpectrolinoTopology::standalone) {
     throw Error(ErrorClass::unsupported, std::string(what) + " needs a SpectroScan table; " + options_.id +
@@ -583,7 +590,20 @@ asio::awaitable<std::vector<SpectralReading>> Spectrolino::read_chart(const Char
     bool row_start = true;
     for (const auto& patch : row) {
       std::optional<Error> last;
+      bool lost_link = false;
       for (int attempt = 1; attempt <= options_.patch_attempts; ++attempt) {
+        if (lost_link) {
+          // Silence mid-chart usually means a power cycle or a replugged cable: the device is back at
+          // its power-on speed without calibration. Reconnect (same instrument only) and carry on.
+          lost_link = false;
+          // A named std::function, not a temporary inside co_await (GCC 12 double-destroys those).
+          const Reconnector::Verify same_instrument = [this, serial = identity_.serial]() -> asio::awaitable<void> {
+            verify_serial(serial);
+            co_return;
+          };
+          co_await reconnector_.reconnect(*this, same_instrument);
+          state_ = InstrumentState::busy;
+        }
         const bool row_would_expire = row_start && readings_since_cal_ + static_cast<int>(row.size()) > cal_interval();
         try {
           // A failed recalibration counts as a failed try of this patch.
@@ -607,6 +627,7 @@ asio::awaitable<std::vector<SpectralReading>> Spectrolino::read_chart(const Char
                                           std::to_string(attempt) + " failed: " + e.what());
           // After a failed reading the white reference is suspect: recalibrate before trying again.
           calibrated_ = false;
+          lost_link = calls_for_reconnect(e);
         }
       }
       if (last) {

@@ -58,6 +58,8 @@ struct Lab::Impl {
            {"lines_ignored", spectrolino->lines_ignored()}};
     auto r = m.true_reflectance();
     t["true_spectrum"] = std::vector<float>(r.begin(), r.end());
+    auto surface = m.surface_reflectance();
+    t["surface_spectrum"] = std::vector<float>(surface.begin(), surface.end());
     if (auto last = m.last_spectrum()) t["last_spectrum"] = std::vector<float>(last->begin(), last->end());
     return t;
   }

@@ -180,6 +180,10 @@ sp::Spectrum SpectrolinoModel::target_spectrum() const {
   }
   if (mode_ == sp::ctt::ModeTransmission) return to_bands(scene_.transmission_sample());
   if (config_.table && !head_down_) return flat(static_cast<float>(kAirReflectance));
+  return surface_reflectance();
+}
+
+sp::Spectrum SpectrolinoModel::surface_reflectance() const {
   if (head_on_tile()) return to_bands(scene_.white_tile());
   auto [x, y] = head_mm();
   double cx = x - config_.chart_origin_x_mm, cy = y - config_.chart_origin_y_mm;

@@ -228,6 +228,7 @@ TEST(camera_aravis, scene_frames_average_to_the_scene_ground_truth) {
   const int w = (x1 - x0 + 1) & ~1, h = (y1 - y0 + 1) & ~1;
   auto o = small_roi();
   o.region = cam::Region{x0, y0, w, h};
+  o.black_level = 256;  // the simulated sensor's offset, as a lab would configure it
   cam::AravisCamera camera(o);
   camera.connect().get();
   cam::CameraSettings s;
@@ -242,6 +243,7 @@ TEST(camera_aravis, scene_frames_average_to_the_scene_ground_truth) {
                     .capture(n,
                              [&](const cam::RawImage& img) {
                                ASSERT_EQ(img.width, static_cast<std::size_t>(w));
+                               EXPECT_EQ(img.black_at(0, 0), 256);
                                for (std::size_t y = 0; y < img.height; ++y) {
                                  for (std::size_t x = 0; x < img.width; ++x) sum[y * img.width + x] += img.at(x, y);
                                }

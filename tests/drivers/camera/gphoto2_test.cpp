@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <thread>
 
 #include "colorlab/drivers/camera/gphoto2_camera.hpp"
 #include "colorlab/drivers/camera/raw_decoder.hpp"
@@ -186,4 +187,35 @@ TEST(camera_gphoto2, dng_downloaded_from_card_decodes_exactly) {
   const auto img = decoder.decode_buffer(bytes, "IMG_0009.DNG");
   ASSERT_EQ(img.width, static_cast<std::size_t>(frame.width));
   EXPECT_TRUE(std::equal(frame.pixels.begin(), frame.pixels.end(), img.contiguous().begin()));
+}
+
+TEST(camera_gphoto2, a_call_overrunning_its_deadline_is_a_typed_failure_not_a_hang) {
+  CardDir card;
+  auto o = card.options();
+  o.call_timeout = std::chrono::milliseconds(1);  // init takes longer than this
+  cam::Gphoto2Camera impatient(o);
+  try {
+    impatient.connect().get();
+    FAIL() << "connect cannot finish in 1 ms";
+  } catch (const colorlab::Error& e) {
+    EXPECT_EQ(e.cls(), ErrorClass::hardware_fail) << e.what();
+    EXPECT_NE(e.hint().find("power-cycle"), std::string::npos);
+  }
+  EXPECT_EQ(impatient.state(), cam::CameraState::disconnected);
+
+  // Once the late call has returned, the library is usable again.
+  cam::Gphoto2Camera patient(card.options());
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  for (;;) {
+    try {
+      patient.connect().get();
+      break;
+    } catch (const colorlab::Error& e) {
+      ASSERT_EQ(e.cls(), ErrorClass::hardware_fail) << e.what();  // "still stuck", fast
+      ASSERT_LT(std::chrono::steady_clock::now(), deadline);
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+  }
+  EXPECT_EQ(patient.state(), cam::CameraState::ready);
+  EXPECT_FALSE(patient.list_files("/").get().empty());
 }

@@ -11,6 +11,7 @@
 #include "colorlab/core/error.hpp"
 #include "colorlab/drivers/camera/raw_decoder.hpp"
 #include "colorlab/sim/camera/dng.hpp"
+#include "margin_dng.hpp"
 #include "sim_fixture.hpp"
 
 namespace cam = colorlab::drivers::camera;
@@ -110,6 +111,58 @@ TEST(camera_raw_decoder, full_size_20d_frame_round_trips_exactly) {
   ASSERT_EQ(img.width, 3504U);
   ASSERT_EQ(img.height, 2336U);
   EXPECT_EQ(differing_counts(img, frame), 0U);  // 0 of 8,185,344
+}
+
+TEST(camera_raw_decoder, masked_margins_are_kept_and_skipped_like_dcraw) {
+  cam::test::TempDir dir;
+  cam::test::MarginDng d;
+  d.raw_width = 180;
+  d.raw_height = 124;
+  d.top = 12;
+  d.left = 10;
+  d.bottom = 12 + 100;
+  d.right = 10 + 160;
+  d.pixels.resize(std::size_t(d.raw_width) * d.raw_height);
+  for (std::uint32_t y = 0; y < d.raw_height; ++y) {
+    for (std::uint32_t x = 0; x < d.raw_width; ++x) {
+      const bool masked = y < d.top || y >= d.bottom || x < d.left || x >= d.right;
+      d.pixels[y * d.raw_width + x] = static_cast<std::uint16_t>(masked ? 250 + (x + y) % 9 : 300 + (7 * x + 13 * y) % 3700);
+    }
+  }
+  const fs::path file = dir.path() / "MARGINS.DNG";
+  cam::test::write_margin_dng(file, d);
+
+  cam::RawDecoder decoder;
+  const cam::RawImage img = decoder.decode_file(file);
+  EXPECT_EQ(img.raw_width, 180U);
+  EXPECT_EQ(img.raw_height, 124U);
+  EXPECT_EQ(img.left_margin, 10U);
+  EXPECT_EQ(img.top_margin, 12U);
+  EXPECT_EQ(img.width, 160U);
+  EXPECT_EQ(img.height, 100U);
+  EXPECT_EQ(img.cfa, cam::CfaPattern::rggb());
+  EXPECT_EQ(img.black_at(0, 0), 256);
+  std::size_t wrong_visible = 0, wrong_raw = 0;
+  for (std::size_t y = 0; y < img.height; ++y) {
+    for (std::size_t x = 0; x < img.width; ++x) {
+      wrong_visible += img.at(x, y) != d.pixels[(y + d.top) * d.raw_width + x + d.left];
+    }
+  }
+  for (std::size_t y = 0; y < img.raw_height; ++y) {
+    for (std::size_t x = 0; x < img.raw_width; ++x) wrong_raw += img.pixels[y * img.row_stride + x] != d.pixels[y * d.raw_width + x];
+  }
+  EXPECT_EQ(wrong_visible, 0U);
+  EXPECT_EQ(wrong_raw, 0U);  // the masked border stays available (dark reference)
+
+  if (find_tool("dcraw").empty()) return;
+  const Pgm pgm = run_dcraw(file);  // document mode writes the visible area only
+  ASSERT_EQ(pgm.width, img.width);
+  ASSERT_EQ(pgm.height, img.height);
+  std::size_t wrong = 0;
+  for (std::size_t y = 0; y < pgm.height; ++y) {
+    for (std::size_t x = 0; x < pgm.width; ++x) wrong += img.at(x, y) != pgm.pixels[y * pgm.width + x];
+  }
+  EXPECT_EQ(wrong, 0U);
 }
 
 TEST(camera_raw_decoder, agrees_with_dcraw_document_mode) {

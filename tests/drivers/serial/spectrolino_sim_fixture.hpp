@@ -36,10 +36,11 @@ class SpectrolinoSimTest : public ::testing::Test {
     o.id = "spectro";
     o.port = sim_->port_path();
     o.simulated = true;
-    o.timeouts.command = std::chrono::milliseconds(1500);
-    o.timeouts.measure = std::chrono::milliseconds(2000);
-    o.timeouts.move = std::chrono::milliseconds(2000);
-    o.timeouts.init = std::chrono::milliseconds(3000);
+    // Device times are divided by the time scale, so these bound real waits of a few ms.
+    o.timeouts.command = std::chrono::milliseconds(600);
+    o.timeouts.measure = std::chrono::milliseconds(800);
+    o.timeouts.move = std::chrono::milliseconds(800);
+    o.timeouts.init = std::chrono::milliseconds(1000);
     o.timeouts.probe = std::chrono::milliseconds(100);
     o.reconnect.initial_backoff = std::chrono::milliseconds(10);
     o.reconnect.max_attempts = 3;

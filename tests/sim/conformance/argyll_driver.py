@@ -125,11 +125,63 @@ def run_spotread(a, log):
     return result
 
 
+def make_chart(a, log):
+    """A one-strip SpectroScan chart of a.patches patches made by Argyll itself (targen + printtarg)."""
+    import subprocess
+    base = os.path.join(a.workdir, a.basename)
+    for argv in (["targen", "-v0", "-d2", "-f", str(a.patches), base],
+                 ["printtarg", "-i", "SS", "-p", "A4", base]):
+        r = subprocess.run(argv, cwd=a.workdir, capture_output=True, text=True)
+        log.write(r.stdout + r.stderr)
+        if r.returncode != 0:
+            raise EOFError("%s failed: %s" % (argv[0], r.stderr[-400:]))
+
+
+def read_ti3(path):
+    fields, rows, in_data = [], [], False
+    for line in open(path):
+        t = line.split()
+        if not t:
+            continue
+        if t[0] == "BEGIN_DATA_FORMAT":
+            fields = None
+            continue
+        if fields is None:
+            fields = [x for x in t]
+            continue
+        if t[0] == "BEGIN_DATA":
+            in_data = True
+            continue
+        if t[0] == "END_DATA":
+            in_data = False
+            continue
+        if in_data:
+            rows.append(t)
+    loc = fields.index("SAMPLE_LOC")
+    spec = [i for i, f in enumerate(fields) if f.startswith("SPEC_")]
+    return {r[loc].strip('"'): [float(r[i]) / 100.0 for i in spec] for r in rows}
+
+
 def run_chartread(a, log):
-    s = Session(["chartread", "-c", "1", "-a", "-N", a.basename], a.port, a.workdir, log)
+    make_chart(a, log)
+    first = [float(v) for v in a.first.split(",")]
+    last = [float(v) for v in a.last.split(",")]
+    s = Session(["chartread", "-v", "-c", "1", a.basename], a.port, a.workdir, log)
     result = {}
-    m = s.expect(r"(Spectroscan|SpectroScan|table|strip|patch|sight|chart|\n)", 60)
-    result["first"] = m.group(0)
+    m = s.expect(r"Device:\s*(SpectroScan\S*)", 60)
+    result["table"] = m.group(1)
+    s.expect(r"place sheet 1 of 1 on table.*?hit return", 60)
+    s.send("\r")
+    located = []
+    for xy in (first, last):
+        m = s.expect(r"locate patch (\S+) with the sight", 60)
+        located.append(m.group(1))
+        control(a.control, {"cmd": "place", "x_mm": xy[0], "y_mm": xy[1]})
+        s.send("\r")
+    result["located"] = located
+    s.expect(r"Sheet 1 of 1 read OK", 120)
+    result["exit"] = s.wait(30)
+    result["patches"] = read_ti3(os.path.join(a.workdir, a.basename + ".ti3"))
     return result
 
 
@@ -141,6 +193,9 @@ def main():
     p.add_argument("--patch", default="D4")
     p.add_argument("--workdir", default=os.getcwd())
     p.add_argument("--basename", default="chart")
+    p.add_argument("--patches", type=int, default=12)
+    p.add_argument("--first", default="30,20", help="x,y mm of the strip's first patch")
+    p.add_argument("--last", default="250,20", help="x,y mm of the strip's last patch")
     p.add_argument("--log", default="-")
     a = p.parse_args()
     log = sys.stderr if a.log == "-" else open(a.log, "w")

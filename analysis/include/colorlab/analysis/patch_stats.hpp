@@ -39,7 +39,6 @@ struct RobustOptions {
 struct PatchValue {
   double value = 0;   // mean of pixels within ±k of the median
   double median = 0;
-  double stdev = 0;   // of all good pixels in the region
   std::size_t used = 0, good = 0, total = 0;
 };
 

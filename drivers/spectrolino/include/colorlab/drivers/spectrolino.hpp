@@ -105,6 +105,7 @@ class Spectrolino final : public Spectrometer, public XyTable {
   boost::asio::awaitable<SpectralReading> measure_patch(const PatchVisit& patch);
   SpectralReading make_reading(const sl::Spectrum& spectrum);
   void require_table(std::string_view what) const;
+  void verify_serial(const std::string& expected) const;
   void require_ready(std::string_view what);
   int cal_interval() const;
   [[noreturn]] void fail(const Error& e);

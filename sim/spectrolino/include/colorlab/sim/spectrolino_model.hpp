@@ -87,8 +87,12 @@ class SpectrolinoModel {
   bool calibrated() const;
   const SpectrolinoConfig& config() const { return config_; }
   const SpectrolinoTiming& timing() const { return timing_; }
-  // True reflectance under the head now (36 bands), for ground truth.
+  // What the instrument would read now without noise (36 bands): the current mode's target, air when
+  // the table's head is up. Ground truth.
   wire::spectrolino::Spectrum true_reflectance() const;
+  // The true reflectance of the surface under the head (tile, patch, chart border or table), whatever
+  // the mode or head state.
+  wire::spectrolino::Spectrum surface_reflectance() const;
   // The last measured spectrum and its XYZ under the current parameters, for ground truth.
   std::optional<wire::spectrolino::Spectrum> last_spectrum() const;
   std::uint64_t measurements() const { return measurements_; }

@@ -5,6 +5,7 @@
 // a free-running camera ends up in an average. The stream socket buffer is fixed at 4 MB: with
 // the automatic size the non-root UDP path drops packets (MISSING_PACKETS) at full frame.
 #include <chrono>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -29,6 +30,9 @@ struct AravisOptions {
   std::chrono::milliseconds frame_timeout{2000};
   unsigned max_retries_per_frame = 3;     // re-trigger after a timed-out or incomplete buffer
   bool software_trigger = true;
+  // GenICam has no standard way to report the sensor's black offset in the pixel data, so it is
+  // configured (from the camera's data sheet or a dark frame) and attached to every frame.
+  std::uint16_t black_level = 0;
 };
 
 class AravisCamera final : public Camera {

@@ -10,10 +10,13 @@
 //
 // State machine (the function behind each transition in brackets):
 //
-//   disconnected --[connect]--> initialising --ok--> ready --[capture]--> busy --done--> ready
-//        ^                           |                 ^                    |
-//        |                           +--error----------+---- no_comms ------+--> disconnected
-//        +---------------[disconnect]------------------+---- other fatal ---+--> fault
+//   disconnected --[connect/reconnect]--> initialising --ok--> ready --[capture]--> busy
+//        ^  ^                                  |                 ^  ^                 |
+//        |  +------------- error --------------+                 |  +-- done, timeout,-+
+//        |                                                       |      busy, bad data  |
+//        +------------- [disconnect], or no_comms in a series/configure -----------------+
+//   fault <-- hardware, protocol or internal error in a series/configure (after_failure);
+//             left only through [connect] or [reconnect].
 //
 // A capture series streams: frame k is decoded and handed to the sink while frame k+1 is being
 // captured (FramePipeline). A series that stops early is reported with `delivered < requested`
