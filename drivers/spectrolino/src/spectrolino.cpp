@@ -259,16 +259,17 @@ asio::awaitable<void> Spectrolino::apply_parameters() {
 
 asio::awaitable<void> Spectrolino::set_colorimetry(sl::Illuminant il, sl::Observer ob, sl::WhiteBase wb) {
   require_ready("set colorimetry");
-  options_.illuminant = il;
-  options_.observer = ob;
-  options_.white_base = wb;
-  integrator_.reset();
-  integrator_failed_ = false;
   try {
     co_await download(sl::req::parameter_download(options_.density_standard, wb, il, ob), "set colorimetric parameters");
   } catch (const Error& e) {
     fail(e);
   }
+  // Only once the instrument accepted them: XYZ must be computed under what the instrument uses.
+  options_.illuminant = il;
+  options_.observer = ob;
+  options_.white_base = wb;
+  integrator_.reset();
+  integrator_failed_ = false;
 }
 
 // ---------------------------------------------------------------- modes and calibration
@@ -328,8 +329,11 @@ asio::awaitable<void> Spectrolino::calibrate_now() {
       }
     };
     if (mode_ == SpectralMode::emission) {
-      // Emission calibration is a dark calibration taken while the head is still on the white tile.
+      // A reflective white calibration first, then the emission (dark) calibration while the head is
+      // still on the white tile (Argyll ss.c order: 4D 9B, 22 09 07, 4D 9D, 22 09 08).
+      co_await download(sl::req::meas_control_download(sl::ctt::ModeReflectance), "set reflectance mode");
       co_await run_ref(sl::RefMode::WhiteCalWarn, sl::exec_err::WhiteMeasOK, "white calibration");
+      co_await download(sl::req::meas_control_download(sl::ctt::ModeEmission), "set emission mode");
       co_await run_ref(sl::RefMode::EmissionCal, sl::exec_err::EmissionCalOK, "emission calibration");
     } else {
       co_await run_ref(sl::RefMode::WhiteCalWarn, sl::exec_err::WhiteMeasOK, "white calibration");

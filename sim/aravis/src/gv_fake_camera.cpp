@@ -68,6 +68,8 @@ struct GvFakeCamera::Impl {
   std::atomic<std::uint64_t> frames{0};
   int lock_fd = -1;
 
+  void start();  // (re)creates the GigE Vision server with the current options
+
   static void fill(ArvBuffer* buffer, void* self, guint32 exposure_us, guint32 gain, ArvPixelFormat pf) {
     auto* impl = static_cast<Impl*>(self);
     size_t reported = 0;
@@ -121,23 +123,51 @@ GvFakeCamera::GvFakeCamera(GvFakeOptions options) : impl_(std::make_unique<Impl>
                 "stop the other simulated GenICam camera (another colorlab-sim or a test) and retry");
   }
   impl_->xml_file = std::filesystem::temp_directory_path() /
-                    ("colorlab-gvfake-" + std::to_string(::getpid()) + "-" + o.serial + ".xml");
+                    ("colorlab-gvfake-" + std::to_string(::getpid()) + "-" + o.address + ".xml");
   {
     std::ofstream xml(impl_->xml_file);
     xml << genicam_xml();
     if (!xml) throw Error(ErrorClass::io_error, "cannot write " + impl_->xml_file.string(), "check /tmp");
   }
-  impl_->gv = arv_gv_fake_camera_new_full(o.address.c_str(), o.serial.c_str(), impl_->xml_file.c_str());
-  if (!impl_->gv || !arv_gv_fake_camera_is_running(impl_->gv)) {
+  impl_->start();
+}
+
+void GvFakeCamera::Impl::start() {
+  const auto& o = options;
+  gv = arv_gv_fake_camera_new_full(o.address.c_str(), o.serial.c_str(), xml_file.c_str());
+  if (!gv || !arv_gv_fake_camera_is_running(gv)) {
+    if (gv) g_object_unref(gv);
+    gv = nullptr;
     throw Error(ErrorClass::conflict,
                 "GigE Vision fake camera could not start on " + o.address + " (GVCP port 3956 in use?)",
                 "stop the other simulated GenICam camera (another colorlab-sim or a test) and retry");
   }
-  impl_->fake = arv_gv_fake_camera_get_fake_camera(impl_->gv);
-  arv_fake_camera_write_register(impl_->fake, ARV_FAKE_CAMERA_REGISTER_SENSOR_WIDTH, static_cast<guint32>(o.sensor_width));
-  arv_fake_camera_write_register(impl_->fake, ARV_FAKE_CAMERA_REGISTER_SENSOR_HEIGHT, static_cast<guint32>(o.sensor_height));
-  arv_fake_camera_set_fill_pattern(impl_->fake, &Impl::fill, impl_.get());
+  fake = arv_gv_fake_camera_get_fake_camera(gv);
+  arv_fake_camera_write_register(fake, ARV_FAKE_CAMERA_REGISTER_SENSOR_WIDTH, static_cast<guint32>(o.sensor_width));
+  arv_fake_camera_write_register(fake, ARV_FAKE_CAMERA_REGISTER_SENSOR_HEIGHT, static_cast<guint32>(o.sensor_height));
+  arv_fake_camera_set_fill_pattern(fake, &Impl::fill, this);
 }
+
+void GvFakeCamera::unplug() {
+  if (!impl_->gv) return;
+  g_object_unref(impl_->gv);
+  impl_->gv = nullptr;
+  impl_->fake = nullptr;
+}
+
+void GvFakeCamera::plug_in(std::optional<std::string> serial) {
+  unplug();
+  if (serial) {
+    if (serial->empty() || serial->size() > 15) {
+      throw Error(ErrorClass::bad_parameter, "GigE Vision serial '" + *serial + "' must have 1..15 characters",
+                  "shorten the serial");
+    }
+    impl_->options.serial = *serial;
+  }
+  impl_->start();
+}
+
+bool GvFakeCamera::plugged_in() const { return impl_->gv != nullptr; }
 
 GvFakeCamera::~GvFakeCamera() = default;
 
@@ -145,6 +175,8 @@ const std::string& GvFakeCamera::address() const { return impl_->options.address
 const std::string& GvFakeCamera::serial() const { return impl_->options.serial; }
 std::uint64_t GvFakeCamera::frames_filled() const { return impl_->frames.load(); }
 
-void GvFakeCamera::stall() { arv_fake_camera_write_register(impl_->fake, ARV_FAKE_CAMERA_REGISTER_ACQUISITION, 0); }
+void GvFakeCamera::stall() {
+  if (impl_->fake) arv_fake_camera_write_register(impl_->fake, ARV_FAKE_CAMERA_REGISTER_ACQUISITION, 0);
+}
 
 }  // namespace colorlab::sim::aravis

@@ -180,7 +180,7 @@ TEST(camera_aravis, camera_vanishing_mid_series_is_a_typed_partial_failure) {
                     .capture(8,
                              [&](const cam::RawImage& img) {
                                EXPECT_FALSE(img.cfa.is_mosaic());
-                               if (++seen == 3) fake.reset();  // the camera disappears from the network
+                               if (++seen == 3) fake->unplug();  // the camera disappears from the network
                              })
                     .get();
   EXPECT_FALSE(report.complete());
@@ -277,10 +277,7 @@ TEST(camera_aravis, reconnect_verifies_the_camera_is_the_same_body) {
   cam::CameraSettings s;
   s.pixel_format = cam::PixelFormat::bayer_rg12;  // must survive the reconnect (the new fake starts in Mono8)
   camera.configure(s).get();
-  fake.reset();
-  gv::GvFakeOptions other;
-  other.serial = "CLGV0002";
-  fake = start_fake(other);
+  fake->plug_in("CLGV0002");  // another body at the same address
   try {
     camera.reconnect(2, std::chrono::milliseconds(10)).get();
     FAIL() << "a different serial must not be accepted silently";
@@ -289,8 +286,7 @@ TEST(camera_aravis, reconnect_verifies_the_camera_is_the_same_body) {
     EXPECT_NE(std::string(e.what()).find("CLGV0002"), std::string::npos);
   }
   EXPECT_EQ(camera.state(), cam::CameraState::disconnected);
-  fake.reset();
-  fake = start_fake();  // the original body is back
+  fake->plug_in("CLGV0001");  // the original body is back
   camera.reconnect(2, std::chrono::milliseconds(10)).get();
   EXPECT_EQ(camera.state(), cam::CameraState::ready);
   auto report = camera.capture(1, [](const cam::RawImage&) {}).get();

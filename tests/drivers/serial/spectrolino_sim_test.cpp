@@ -149,6 +149,54 @@ TEST_F(SpectrolinoSimTest, ChartReadIsSerpentineWithRecalibrationAtRowStarts) {
   EXPECT_LT(worst, 0.03);
 }
 
+TEST_F(SpectrolinoSimTest, EmissionModeMeasuresTheCabinetLight) {
+  start(true);
+  Spectrolino s(io_.get_executor(), options());
+  run(io_, s.connect());
+  run(io_, s.set_mode(drivers::SpectralMode::emission));
+  EXPECT_EQ(s.state(), drivers::InstrumentState::needs_calibration);
+  run(io_, s.calibrate());
+  scene_->set_lamp(sim::Lamp::d65, true);
+  auto r = run(io_, s.measure());
+  EXPECT_EQ(r.mode, drivers::SpectralMode::emission);
+  auto truth = sim_->model().true_reflectance();  // in emission mode: the irradiance the head sees
+  int checked = 0;
+  for (std::size_t i = 4; i < 32; ++i) {
+    if (truth[i] > 1.0f) {
+      EXPECT_NEAR(r.values[i] / truth[i], 1.0, 0.02) << "band " << i;
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 20) << "the D65 lamp must light the cabinet";
+  ASSERT_TRUE(r.xyz.has_value());
+  EXPECT_GT((*r.xyz)[1], 0.0);
+}
+
+TEST_F(SpectrolinoSimTest, TransmissionOnSpectroScanT) {
+  start(true);
+  Spectrolino s(io_.get_executor(), options());
+  run(io_, s.connect());
+  run(io_, s.set_mode(drivers::SpectralMode::transmission));
+  run(io_, s.calibrate());
+  auto r = run(io_, s.measure());
+  EXPECT_LT(max_abs_diff(r.values, scene_->transmission_sample()), 0.02);
+  EXPECT_EQ(s.calibration().front().readings_left, 9) << "transmission recalibrates every 10 readings";
+  run(io_, s.set_mode(drivers::SpectralMode::reflectance));
+  EXPECT_FALSE(s.calibration().front().valid);
+}
+
+TEST_F(SpectrolinoSimTest, TransmissionNeedsTheTTable) {
+  start(false);
+  Spectrolino s(io_.get_executor(), options());
+  run(io_, s.connect());
+  try {
+    run(io_, s.set_mode(drivers::SpectralMode::transmission));
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.cls(), ErrorClass::unsupported);
+  }
+}
+
 TEST_F(SpectrolinoSimTest, StandaloneMeasureReadsWhatIsUnderTheInstrument) {
   start(false);
   Spectrolino s(io_.get_executor(), options());
@@ -180,6 +228,35 @@ TEST_F(SpectrolinoSimTest, LampFailureIsTypedHardwareError) {
     EXPECT_FALSE(e.info().transcript.empty());
   }
   EXPECT_EQ(s.state(), drivers::InstrumentState::fault);
+}
+
+TEST_F(SpectrolinoSimTest, EveryErrorTypeCodeIsTypedWithDeviceCodeAndHint) {
+  start(true);
+  Spectrolino s(io_.get_executor(), options());
+  run(io_, s.connect());
+  const std::vector<std::uint8_t> codes{0x01, 0x02, 0x04, 0x05, 0x06, 0x07, 0x08, 0x09, 0x0A, 0x0D, 0x0E,
+                                        0x10, 0x11, 0x15, 0x32, 0x33, 0x35, 0x36, 0x37, 0x38, 0x3C};
+  for (auto code : codes) {
+    sim::SpectrolinoFaults f;
+    f.exec_error = code;
+    f.exec_error_once = true;
+    sim_->set_faults(f);
+    const std::string hex = wire::spectrolino::to_hex(std::vector<std::uint8_t>{code});
+    try {
+      run(io_, s.calibrate());
+      ADD_FAILURE() << "error type " << hex << " was taken for success";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.info().device_code, "spectrolino:" + hex);
+      // Notify codes (reset done) have no error class of their own: out of place, they are a protocol error.
+      auto expected = wire::spectrolino::describe_exec_error(code).cls;
+      if (expected == ErrorClass::internal) expected = ErrorClass::protocol_error;
+      EXPECT_EQ(e.cls(), expected) << hex << ": " << e.what();
+      EXPECT_FALSE(e.hint().empty()) << hex;
+    }
+  }
+  // Nothing is left broken: the next calibration works.
+  run(io_, s.calibrate());
+  EXPECT_EQ(s.state(), drivers::InstrumentState::ready);
 }
 
 TEST_F(SpectrolinoSimTest, WrongWhiteOnStandaloneAsksForTheOperator) {

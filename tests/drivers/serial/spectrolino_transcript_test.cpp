@@ -180,6 +180,79 @@ TEST_F(TranscriptTest, ScanErrorAnswerToMoveIsTyped) {
   EXPECT_TRUE(p->done());
 }
 
+std::vector<ScriptStep> table_connect_script() {
+  return {
+      {";D024\r\n", ":D18310\r\n", 9600},
+      {";D00A\r\n", scan_ok},
+      {";D010\r\n", scan_ok},
+      {";D02102\r\n", scan_ok},
+      {";D0200A\r\n", scan_ok},
+      {";D024\r\n", ":D18310\r\n", 57600},
+      {";D00B\r\n", scan_ok},
+      {";D030\r\n", table_type()},
+      {";B5\r\n", device_data()},
+      {";2B\r\n", target_id()},
+      {";D031\r\n", ":D19131D40000\r\n"},
+      {";D034\r\n", answer(sl::SoftwareVersionAnswer{"V2.10"}.encode())},
+      {";1601010300\r\n", ok1f},
+      {";D00D00\r\n", scan_ok},
+  };
+}
+
+std::string hex2(std::uint8_t v) { return sl::to_hex(std::vector<std::uint8_t>{v}); }
+
+// Every code of the §1.8 tables reaches the caller as a typed Error carrying the device code,
+// the class of the wire codec's table, and a hint.
+TEST_F(TranscriptTest, EveryScanComAndRemoteErrorIsTyped) {
+  const std::vector<std::uint8_t> scan_codes{0x01, 0x02, 0x03, 0x04, 0x05, 0x06, 0x07, 0x08, 0x09, 0x0A};
+  const std::vector<std::uint8_t> com_codes{0x01, 0x02, 0x03, 0x04, 0x06, 0x07, 0x08, 0x10};
+  const std::vector<std::uint16_t> remote_bits{0x0001, 0x0002, 0x0004, 0x0008, 0x0010, 0x0020, 0x0040, 0x0080,
+                                               0x0100, 0x0200, 0x0400, 0x0800, 0x1000, 0x2000, 0x4000, 0x8000};
+  auto script = table_connect_script();
+  for (auto c : scan_codes) script.push_back({";D002\r\n", ":D180" + hex2(c) + "\r\n"});            // move home
+  for (auto c : com_codes) script.push_back({";D024\r\n", ":26" + hex2(c) + "\r\n"});                // status
+  for (auto b : remote_bits) {
+    std::string rem = hex2(static_cast<std::uint8_t>(b & 0xFF)) + hex2(static_cast<std::uint8_t>(b >> 8));
+    script.push_back({";1601010201\r\n", ":1F" + rem + "\r\n"});  // D65, 10°, absolute
+  }
+  auto p = peer(std::move(script));
+  drivers::Spectrolino s(io_.get_executor(), options(p->path()));
+  run(io_, s.connect());
+  for (auto c : scan_codes) {
+    try {
+      run(io_, s.home());
+      ADD_FAILURE() << "scan error " << hex2(c) << " was not reported";
+    } catch (const Error& e) {
+      auto d = sl::describe_scan_error(c);
+      EXPECT_EQ(e.info().device_code, "spectroscan:" + hex2(c));
+      EXPECT_EQ(e.cls(), d.cls) << hex2(c);
+      EXPECT_FALSE(e.hint().empty()) << hex2(c);
+    }
+  }
+  for (auto c : com_codes) {
+    try {
+      run(io_, s.table_status());
+      ADD_FAILURE() << "COM error " << hex2(c) << " was not reported";
+    } catch (const Error& e) {
+      auto d = sl::describe_com_error(c);
+      EXPECT_EQ(e.info().device_code, "spectrolino-com:" + hex2(c));
+      EXPECT_EQ(e.cls(), d.cls) << hex2(c);
+      EXPECT_FALSE(e.hint().empty());
+    }
+  }
+  for (auto b : remote_bits) {
+    try {
+      run(io_, s.set_colorimetry(sl::Illuminant::D65, sl::Observer::Deg10, sl::WhiteBase::Absolute));
+      ADD_FAILURE() << "remote error bit " << b << " was not reported";
+    } catch (const Error& e) {
+      EXPECT_NE(e.cls(), ErrorClass::internal) << b;
+      EXPECT_FALSE(e.info().device_code.empty()) << b;
+      EXPECT_FALSE(e.info().transcript.empty());
+    }
+  }
+  EXPECT_TRUE(p->done());
+}
+
 TEST_F(TranscriptTest, UnexpectedRequestFailsTheExchange) {
   // A peer that expects a different first request never answers: the driver must end in a typed
   // no_comms after its bounded scan, and the peer records the unexpected bytes.

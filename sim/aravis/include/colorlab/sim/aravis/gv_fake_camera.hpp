@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -47,12 +48,18 @@ class GvFakeCamera {
   GvFakeCamera& operator=(const GvFakeCamera&) = delete;
 
   const std::string& address() const;
-  const std::string& serial() const;
+  const std::string& serial() const;  // of the body currently plugged in
   std::uint64_t frames_filled() const;
 
   // Fault injection "capture timeout": the camera stops acquiring as if its firmware hung, so
   // every frame request times out until the client starts a new acquisition.
   void stall();
+  // Fault injection "disconnect": the camera leaves the network (its GVCP/GVSP sockets close) but
+  // the address stays reserved for it, so no other fake answers a client that is still retrying.
+  void unplug();
+  // Back on the network, optionally as a different body (another serial) to test identity checks.
+  void plug_in(std::optional<std::string> serial = std::nullopt);
+  bool plugged_in() const;
 
   // Aravis's built-in fake GenICam XML with BayerRG12/BayerRG16 added to PixelFormat.
   static std::string genicam_xml();
