@@ -11,7 +11,7 @@
 #include "colorlab/sim/clock.hpp"
 #include "colorlab/sim/scene.hpp"
 #include "colorlab/sim/spectrolino_sim.hpp"
-#include "../../../tests/drivers/serial/run_support.hpp"
+#include "run_support.hpp"  // tests/drivers/serial: runs a driver coroutine with a hard limit
 
 namespace {
 

@@ -38,6 +38,11 @@ bool calls_for_reconnect(const Error& e) {
 Reconnector::Reconnector(asio::any_io_executor executor, ReconnectPolicy policy)
     : executor_(executor), policy_(policy) {}
 
+asio::awaitable<void> Reconnector::reconnect(Instrument& instrument) {
+  const Verify none;
+  co_await reconnect(instrument, none);
+}
+
 asio::awaitable<void> Reconnector::reconnect(Instrument& instrument, const Verify& verify) {
   std::optional<Error> last;
   for (attempts_ = 1; attempts_ <= policy_.max_attempts; ++attempts_) {

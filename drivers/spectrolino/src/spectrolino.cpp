@@ -587,7 +587,8 @@ asio::awaitable<std::vector<SpectralReading>> Spectrolino::read_chart(const Char
   auto rows = serpentine_rows(layout);
   int total = 0;
   for (const auto& row : rows) total += static_cast<int>(row.size());
-  std::vector<SpectralReading> out(static_cast<std::size_t>(layout.patches_per_strip * layout.strips));
+  // Patches are numbered strip by strip and a short last strip only drops the highest numbers.
+  std::vector<SpectralReading> out(static_cast<std::size_t>(total));
   int done = 0;
   for (const auto& row : rows) {
     // Recalibrate at the start of a row rather than let the count run out in the middle of one.

@@ -36,7 +36,9 @@ class Reconnector {
   Reconnector(boost::asio::any_io_executor executor, ReconnectPolicy policy = {});
 
   // Throws the last Error (class unchanged, message prefixed) once the attempts are used up.
-  boost::asio::awaitable<void> reconnect(Instrument& instrument, const Verify& verify = {});
+  // `verify` must outlive the operation (pass a named object: GCC 12 mishandles temporaries in co_await).
+  boost::asio::awaitable<void> reconnect(Instrument& instrument, const Verify& verify);
+  boost::asio::awaitable<void> reconnect(Instrument& instrument);  // identity check by connect() only
 
   ReconnectPhase phase() const { return phase_; }
   int attempts_used() const { return attempts_; }
