@@ -5,6 +5,10 @@
 #include "colorlab/core/error.hpp"
 #include <boost/asio/steady_timer.hpp>
 
+#include "colorlab/core/log.hpp"
+#include "colorlab/sim/aravis/gv_fake_camera.hpp"
+#include "colorlab/sim/aravis/scene_fill.hpp"
+#include "colorlab/sim/camera/camera_model.hpp"
 #include "colorlab/sim/clock.hpp"
 #include "colorlab/sim/dmx_sim.hpp"
 #include "colorlab/sim/ls110_sim.hpp"
@@ -23,6 +27,8 @@ struct Lab::Impl {
   std::shared_ptr<Ls110Sim> ls110;
   std::shared_ptr<SpectrolinoSim> spectrolino;
   std::shared_ptr<DmxSim> dmx;
+  std::shared_ptr<const camera::CameraModel> camera_model;
+  std::unique_ptr<aravis::GvFakeCamera> genicam;
   std::vector<std::shared_ptr<boost::asio::steady_timer>> dropouts;
   int aim_row = 0, aim_col = 0;
 
@@ -110,9 +116,30 @@ Lab::Lab(boost::asio::io_context& io, LabConfig config) : impl_(std::make_unique
     d.dmx->set_faults(d.config.dmx.faults.get<LinkFaults>());
     d.dmx->start();
   }
+
+  if (d.config.genicam.enabled) {
+    // A camera that cannot start (GVCP port taken by another simulator, no loopback) leaves the rest of
+    // the lab running; the announcement then simply lists no GenICam camera.
+    try {
+      // The Lab owns the scene and outlives the camera, so the model gets a non-owning pointer.
+      std::shared_ptr<const Scene> scene(std::shared_ptr<const Scene>{}, d.scene.get());
+      camera::CameraConfig cc;
+      cc.width = d.config.genicam.width;
+      cc.height = d.config.genicam.height;
+      d.camera_model = std::make_shared<camera::CameraModel>(scene, cc);
+      auto options = aravis::scene_camera_options(d.camera_model);
+      options.address = d.config.genicam.address;
+      options.serial = d.config.genicam.serial;
+      d.genicam = std::make_unique<aravis::GvFakeCamera>(options);
+    } catch (const Error& e) {
+      log::warning("sim", std::string("GenICam camera not started: ") + e.what());
+      d.genicam.reset();
+    }
+  }
 }
 
 Lab::~Lab() {
+  impl_->genicam.reset();
   if (impl_->ls110) impl_->ls110->stop();
   if (impl_->spectrolino) impl_->spectrolino->stop();
   if (impl_->dmx) impl_->dmx->stop();
@@ -154,6 +181,15 @@ json Lab::announcement() const {
                            {"serial", {{"baud", 115200}, {"framing", "8N1"}}},
                            {"simulated", true},
                            {"driver_options", {{"channels", channels}}}});
+  }
+  if (d.genicam) {
+    instruments.push_back({{"id", d.config.genicam.id},
+                           {"kind", "genicam"},
+                           {"model", "Aravis GigE Vision fake camera (simulated EOS 20D sensor, BayerRG12)"},
+                           {"address", d.genicam->address()},
+                           {"device_id", d.genicam->address()},
+                           {"serial", d.genicam->serial()},
+                           {"simulated", true}});
   }
   return {{"colorlab_sim", 1},
           {"pid", ::getpid()},
@@ -210,6 +246,11 @@ json Lab::control(const json& command) {
         from_json(faults, f);
         d.spectrolino->set_faults(f);
         answer["faults"] = d.spectrolino->faults();
+        return answer;
+      }
+      if (d.genicam && id == d.config.genicam.id) {
+        if (faults.value("capture_timeout", false)) d.genicam->stall();
+        answer["faults"] = {{"capture_timeout", faults.value("capture_timeout", false)}};
         return answer;
       }
       if (d.dmx && id == d.config.dmx.id) {

@@ -190,6 +190,35 @@ LabConfig load_lab_config(const std::filesystem::path& file) {
           bad(file, sn, "unknown key dmx." + s);
         }
       }
+    } else if (k == "genicam") {
+      auto t = node.as_table();
+      if (!t) bad(file, node, "[genicam] must be a table");
+      auto& gc = c.genicam;
+      for (const auto& [sk, sn] : *t) {
+        std::string s(sk.str());
+        if (s == "enabled") {
+          gc.enabled = sn.value_or(true);
+        } else if (s == "id") {
+          gc.id = sn.value_or(std::string("genicam"));
+        } else if (s == "address") {
+          gc.address = sn.value_or(std::string("127.0.0.1"));
+        } else if (s == "serial") {
+          auto v = sn.value<std::string>();
+          if (!v || v->empty() || v->size() > 15) bad(file, sn, "genicam.serial must be 1..15 characters");
+          gc.serial = *v;
+        } else if (s == "size") {
+          auto a = sn.as_array();
+          auto w = a && a->size() == 2 ? (*a)[0].value<int64_t>() : std::nullopt;
+          auto h = a && a->size() == 2 ? (*a)[1].value<int64_t>() : std::nullopt;
+          if (!w || !h || *w < 16 || *h < 16 || *w % 2 || *h % 2 || *w > 8192 || *h > 8192) {
+            bad(file, sn, "genicam.size must be [width, height], even, 16..8192");
+          }
+          gc.width = static_cast<int>(*w);
+          gc.height = static_cast<int>(*h);
+        } else {
+          bad(file, sn, "unknown key genicam." + s);
+        }
+      }
     } else {
       bad(file, node, "unknown key '" + k + "'");
     }

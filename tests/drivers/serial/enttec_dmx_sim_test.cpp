@@ -6,6 +6,7 @@
 
 #include "colorlab/core/error.hpp"
 #include "colorlab/drivers/enttec_dmx.hpp"
+#include "colorlab/drivers/factory.hpp"
 #include "colorlab/sim/clock.hpp"
 #include "colorlab/sim/dmx_sim.hpp"
 #include "colorlab/sim/scene.hpp"
@@ -147,6 +148,25 @@ TEST_F(EnttecDmxSimTest, NonWidgetPortIsRefused) {
   o.port = "/dev/null";
   EnttecDmx d(io_.get_executor(), o);
   EXPECT_THROW(run(io_, d.connect(), std::chrono::seconds(5)), Error);
+}
+
+TEST_F(EnttecDmxSimTest, FactoryBuildsItFromTheSimulatorsAnnouncement) {
+  // The shape colorlab-sim announces: one channel map with the dimmer in it.
+  nlohmann::json channels = nlohmann::json::object();
+  for (const auto& m : sim_->config().channels) channels[m.target] = m.channel;
+  auto inst = drivers::make_instrument(io_.get_executor(),
+                                       drivers::InstrumentConfig{"dmx", "dmx", sim_->port_path(), true, {{"channels", channels}}});
+  run(io_, inst->connect());
+  auto* lamps = dynamic_cast<drivers::LampController*>(inst.get());
+  auto* dimmer = dynamic_cast<drivers::Dimmer*>(inst.get());
+  ASSERT_NE(lamps, nullptr);
+  ASSERT_NE(dimmer, nullptr);
+  run(io_, lamps->set_lamps({"CWF"}));
+  run(io_, dimmer->set_level("dimmer", 0.5));
+  settle(io_, std::chrono::milliseconds(20));
+  EXPECT_TRUE(scene_->lamp_on(sim::Lamp::cwf));
+  EXPECT_GT(scene_->dimmer(), 45.0);
+  EXPECT_LT(scene_->dimmer(), 55.0);
 }
 
 TEST(EnttecDmxOptionsTest, BadChannelMapsAreRefused) {

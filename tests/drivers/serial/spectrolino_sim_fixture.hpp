@@ -24,6 +24,7 @@ class SpectrolinoSimTest : public ::testing::Test {
     sim::SceneConfig sc;
     sc.seed = 7;
     sc.force_synthetic_chart = true;  // deterministic without the shared data set
+    sc.lamps_on_at_start = {sim::Lamp::d65};  // already warm: emission truth does not drift during a test
     scene_ = std::make_unique<sim::Scene>(sc, clock_);
     sim::SpectrolinoConfig cfg;
     cfg.table = table;

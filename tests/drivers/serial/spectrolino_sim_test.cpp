@@ -5,6 +5,7 @@
 
 #include "colorlab/analysis/colorimetry.hpp"
 #include "colorlab/core/error.hpp"
+#include "colorlab/drivers/factory.hpp"
 #include "spectrolino_sim_fixture.hpp"
 
 namespace colorlab::test {
@@ -51,6 +52,19 @@ TEST_F(SpectrolinoSimTest, ConnectsToStandaloneSpectrolino) {
   } catch (const Error& e) {
     EXPECT_EQ(e.cls(), ErrorClass::unsupported);
   }
+}
+
+TEST_F(SpectrolinoSimTest, FactoryBuildsItFromTheSimulatorsAnnouncement) {
+  start(true);
+  auto inst = drivers::make_instrument(
+      io_.get_executor(), drivers::InstrumentConfig{"spectro", "spectrolino", sim_->port_path(), true,
+                                                    {{"power_on_baud", 9600}, {"table", true}, {"command_timeout_ms", 600}}});
+  run(io_, inst->connect());
+  EXPECT_EQ(inst->identity().serial, "12345/table:54321");
+  auto caps = inst->capabilities();
+  EXPECT_NE(std::find(caps.begin(), caps.end(), drivers::Capability::xy_table), caps.end());
+  ASSERT_NE(dynamic_cast<drivers::XyTable*>(inst.get()), nullptr);
+  ASSERT_NE(dynamic_cast<drivers::Spectrometer*>(inst.get()), nullptr);
 }
 
 TEST_F(SpectrolinoSimTest, ReconnectFindsDeviceStillAtNegotiatedSpeed) {
@@ -156,7 +170,6 @@ TEST_F(SpectrolinoSimTest, EmissionModeMeasuresTheCabinetLight) {
   run(io_, s.set_mode(drivers::SpectralMode::emission));
   EXPECT_EQ(s.state(), drivers::InstrumentState::needs_calibration);
   run(io_, s.calibrate());
-  scene_->set_lamp(sim::Lamp::d65, true);
   auto r = run(io_, s.measure());
   EXPECT_EQ(r.mode, drivers::SpectralMode::emission);
   auto truth = sim_->model().true_reflectance();  // in emission mode: the irradiance the head sees

@@ -33,7 +33,10 @@ std::string run(const std::string& cmd) {
 
 }  // namespace
 
-TEST(SimConformance, SpotreadReadsTheSimulatedSpectrolino) {
+// power_on_baud 19200 also exercises Argyll's speed scan and the 4D 27 switch back to 9600 (§5.4 d).
+class SimSpotread : public ::testing::TestWithParam<int> {};
+
+TEST_P(SimSpotread, ReadsTheSimulatedSpectrolino) {
   if (::geteuid() != 0) GTEST_SKIP() << "needs root for unshare -m and a private /dev (instrument-protocols §5.3)";
   if (!on_path("spotread")) GTEST_SKIP() << "ArgyllCMS spotread is not installed (Debian package argyll)";
   if (!on_path("unshare") || !on_path("python3")) GTEST_SKIP() << "needs unshare and python3";
@@ -42,9 +45,12 @@ TEST(SimConformance, SpotreadReadsTheSimulatedSpectrolino) {
 time_scale = 10.0
 [spectrolino]
 table = false
+power_on_baud = )" + std::to_string(GetParam()) + R"(
 [ls110]
 enabled = false
 [dmx]
+enabled = false
+[genicam]
 enabled = false
 )");
   std::string driver = std::string(COLORLAB_SOURCE_DIR) + "/tests/sim/conformance/argyll_driver.py";
@@ -73,7 +79,10 @@ enabled = false
   EXPECT_NEAR(got[1], truth.Y, 0.6);
   EXPECT_NEAR(got[2], truth.Z, 0.6);
   EXPECT_GT(std::abs(got[1] - 100.0), 5.0) << "a patch, not the white tile, was read";
+  EXPECT_EQ(sim.control({{"cmd", "truth"}})["spectrolino"]["baud"], 9600);
 }
+
+INSTANTIATE_TEST_SUITE_P(PowerOnSpeed, SimSpotread, ::testing::Values(9600, 19200));
 
 // chartread drives the SpectroScan T itself: white calibration on the tile, then D0 07 MoveAndMeasure
 // along a strip whose ends the "operator" (this test, through the control socket) located with the
@@ -91,6 +100,8 @@ time_scale = 20.0
 [ls110]
 enabled = false
 [dmx]
+enabled = false
+[genicam]
 enabled = false
 )");
   constexpr int kPatches = 12;  // SG columns B..M of row 3

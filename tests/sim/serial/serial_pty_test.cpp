@@ -24,6 +24,8 @@ time_scale = 10.0
 table = false
 [dmx]
 serial = 12345678
+[genicam]
+enabled = false
 )";
 
 void sleep_s(double s) { std::this_thread::sleep_for(std::chrono::duration<double>(s)); }

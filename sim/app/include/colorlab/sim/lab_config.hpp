@@ -38,6 +38,16 @@ struct DmxLabConfig {
   nlohmann::json faults = nlohmann::json::object();
 };
 
+// The GenICam camera: Aravis's GigE Vision fake on loopback, filled by the scene's camera model.
+struct GenicamLabConfig {
+  bool enabled = true;
+  std::string id = "genicam";
+  std::string address = "127.0.0.1";
+  std::string serial = "CLGV0001";
+  int width = 3504;
+  int height = 2336;
+};
+
 struct LabConfig {
   std::uint64_t seed = 1;
   double time_scale = 1.0;
@@ -48,6 +58,7 @@ struct LabConfig {
   Ls110SimConfig ls110;
   SpectrolinoLabConfig spectrolino;
   DmxLabConfig dmx;
+  GenicamLabConfig genicam;
 };
 
 // Throws Error{bad_parameter} naming file, line and key.
