@@ -50,8 +50,8 @@ unsigned page_limit(const HttpRequest& req) {
 }
 
 HttpResponse get_root(ApiContext& ctx) {
-  json features = json::array({"instruments", "campaigns", "executions", "runs", "problem+json", "cursor-paging",
-                               "idempotency-key"});
+  json features = json::array({"instruments", "ports", "events", "campaigns", "executions", "runs", "problem+json",
+                               "cursor-paging", "idempotency-key"});
   return HttpResponse::json(200, {{"server", "colorlabd"},
                                   {"server_version", COLORLAB_VERSION},
                                   {"api_version", protocol::kApiVersion},
@@ -105,6 +105,44 @@ HttpResponse get_execution(ApiContext& ctx, const std::string& id) {
   return HttpResponse::json(200, e->to_json());
 }
 
+json discovered_json(const drivers::DiscoveredInstrument& d) {
+  json j{{"id", d.id}, {"kind", d.kind}, {"port", d.port}, {"from_config", d.from_rule}};
+  if (!d.stable_port.empty()) j["stable_port"] = d.stable_port;
+  if (d.usb_vid) j["usb_vid"] = *d.usb_vid;
+  if (d.usb_pid) j["usb_pid"] = *d.usb_pid;
+  if (!d.usb_serial.empty()) j["usb_serial"] = d.usb_serial;
+  if (!d.product.empty()) j["product"] = d.product;
+  return j;
+}
+
+HttpResponse get_ports(ApiContext& ctx) {
+  json items = json::array();
+  if (ctx.discovery) {
+    for (const auto& d : ctx.discovery->present()) items.push_back(discovered_json(d));
+  }
+  return HttpResponse::json(200, {{"items", items}, {"hotplug", ctx.hotplug_status}});
+}
+
+HttpResponse get_events(ApiContext& ctx, const HttpRequest& req) {
+  std::int64_t after = 0;
+  if (auto it = req.query.find("after"); it != req.query.end()) {
+    try {
+      std::size_t used = 0;
+      after = std::stoll(it->second, &used);
+      if (used != it->second.size() || after < 0) throw std::invalid_argument("after");
+    } catch (const std::exception&) {
+      throw Error(ErrorClass::bad_parameter, "after must be a non-negative event sequence number");
+    }
+  }
+  std::optional<std::string> topic;
+  if (auto it = req.query.find("topic"); it != req.query.end()) topic = it->second;
+  auto events = ctx.store.events(after, page_limit(req), topic);
+  json items = json::array();
+  for (const auto& e : events) items.push_back({{"seq", e.seq}, {"time", e.time}, {"topic", e.topic}, {"payload", e.payload}});
+  std::int64_t last = events.empty() ? after : events.back().seq;
+  return HttpResponse::json(200, {{"items", items}, {"last_seq", last}});
+}
+
 HttpResponse get_runs(ApiContext& ctx, const HttpRequest& req) {
   unsigned limit = page_limit(req);
   std::optional<std::string> cursor;
@@ -142,6 +180,14 @@ HttpResponse handle_api(ApiContext& ctx, const HttpRequest& req) {
     if (p == prefix + "/instruments") {
       if (req.method != "GET") return method_not_allowed(req, "GET");
       return get_instruments(ctx);
+    }
+    if (p == prefix + "/ports") {
+      if (req.method != "GET") return method_not_allowed(req, "GET");
+      return get_ports(ctx);
+    }
+    if (p == prefix + "/events") {
+      if (req.method != "GET") return method_not_allowed(req, "GET");
+      return get_events(ctx, req);
     }
     if (p == prefix + "/campaigns") {
       if (req.method != "GET") return method_not_allowed(req, "GET");

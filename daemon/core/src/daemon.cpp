@@ -17,6 +17,7 @@
 #include "colorlab/daemon/embedded_sim.hpp"
 #include "colorlab/daemon/executions.hpp"
 #include "colorlab/daemon/systemd_notify.hpp"
+#include "colorlab/drivers/discovery_monitor.hpp"
 #include "colorlab/http/server.hpp"
 
 namespace colorlab::daemon {
@@ -33,8 +34,49 @@ struct Daemon::Impl {
   std::unique_ptr<Executions> executions;
   std::unique_ptr<ApiContext> api;
   std::unique_ptr<http::Server> server;
+  std::unique_ptr<drivers::Discovery> discovery;
+  std::unique_ptr<drivers::DiscoveryMonitor> monitor;
   SystemdNotifier notifier{io};
+
+  void on_discovery_change(const drivers::DiscoveryChange& change);
 };
+
+namespace {
+
+asio::awaitable<void> connect_instrument(std::shared_ptr<drivers::Instrument> instrument) {
+  try {
+    co_await instrument->connect();
+    log::info("colorlabd", instrument->id() + " ready on " + instrument->identity().port);
+  } catch (const Error& e) {
+    log::warning("colorlabd", instrument->id() + ": " + e.what() + (e.hint().empty() ? "" : " — " + e.hint()));
+  }
+}
+
+}  // namespace
+
+// Instruments that come and go: recorded in the event log, configured ones (re)connected when
+// their port appears and released when it disappears.
+void Daemon::Impl::on_discovery_change(const drivers::DiscoveryChange& change) {
+  const auto& d = change.instrument;
+  log::info("colorlabd", std::string(change.added ? "instrument appeared: " : "instrument went away: ") + d.id + " (" +
+                             d.kind + " on " + d.port + ")");
+  try {
+    store->append_event("instrument", {{"event", change.added ? "added" : "removed"},
+                                       {"id", d.id},
+                                       {"kind", d.kind},
+                                       {"port", d.port},
+                                       {"from_config", d.from_rule}});
+  } catch (const Error& e) {
+    log::warning("colorlabd", std::string("cannot record a discovery event: ") + e.what());
+  }
+  auto instrument = instruments.find(d.id);
+  if (!instrument) return;
+  if (!change.added) {
+    instrument->disconnect();
+  } else if (instrument->state() == drivers::InstrumentState::disconnected) {
+    asio::co_spawn(io, connect_instrument(instrument), asio::detached);
+  }
+}
 
 Daemon::Daemon(DaemonConfig config) : impl_(std::make_unique<Impl>()) {
   auto& d = *impl_;
@@ -55,9 +97,14 @@ Daemon::Daemon(DaemonConfig config) : impl_(std::make_unique<Impl>()) {
       log::warning("colorlabd", std::string("instrument skipped: ") + e.what());
     }
   }
+  std::vector<drivers::DiscoveryRule> rules;
+  for (const auto& c : instrument_configs) {
+    if (d.instruments.find(c.id)) rules.push_back(drivers::DiscoveryRule{c.id, c.kind, c.port, {}, {}, {}});
+  }
+  d.discovery = std::make_unique<drivers::Discovery>(std::move(rules));
   d.executions = std::make_unique<Executions>(d.io, *d.store, d.campaigns, d.instruments);
   d.api = std::make_unique<ApiContext>(ApiContext{*d.store, d.instruments, d.campaigns, *d.executions,
-                                                  d.config.simulator.enabled, now_iso8601()});
+                                                  d.config.simulator.enabled, now_iso8601(), d.discovery.get(), ""});
 
   http::ServerOptions so;
   so.tcp_host = d.config.listen_host;
@@ -97,19 +144,11 @@ void Daemon::write_endpoint_file() {
 int Daemon::run() {
   auto& d = *impl_;
   // Connect instruments in the background: the API is useful (stored data) while they come up.
-  for (const auto& instrument : d.instruments.all()) {
-    asio::co_spawn(
-        d.io,
-        [instrument]() -> asio::awaitable<void> {
-          try {
-            co_await instrument->connect();
-            log::info("colorlabd", instrument->id() + " ready on " + instrument->identity().port);
-          } catch (const Error& e) {
-            log::warning("colorlabd", instrument->id() + ": " + e.what() + (e.hint().empty() ? "" : " — " + e.hint()));
-          }
-        },
-        asio::detached);
-  }
+  // Discovery's first scan reports every present port as added, which starts each connection.
+  d.discovery->subscribe([&d](const drivers::DiscoveryChange& c) { d.on_discovery_change(c); });
+  d.monitor = std::make_unique<drivers::DiscoveryMonitor>(d.io.get_executor(), *d.discovery);
+  d.monitor->start();
+  d.api->hotplug_status = d.monitor->hotplug_status();
 
   asio::signal_set signals(d.io, SIGINT, SIGTERM);
   signals.async_wait([&](boost::system::error_code ec, int sig) {
@@ -117,6 +156,7 @@ int Daemon::run() {
     log::info("colorlabd", "signal " + std::to_string(sig) + ": stopping");
     d.notifier.stopping();
     d.server->stop();
+    d.monitor->stop();
     d.io.stop();
   });
 

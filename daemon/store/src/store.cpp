@@ -304,4 +304,13 @@ std::int64_t Store::append_event(const std::string& topic, const nlohmann::json&
   return db_.last_insert_rowid();
 }
 
+std::vector<EventRecord> Store::events(std::int64_t after, unsigned limit, const std::optional<std::string>& topic) {
+  auto st = db_.prepare(
+      "SELECT seq, time, topic, payload FROM event_log WHERE seq > ?1 AND (?2 IS NULL OR topic = ?2) ORDER BY seq LIMIT ?3");
+  st.bind(1, after).bind(2, topic).bind(3, static_cast<std::int64_t>(limit));
+  std::vector<EventRecord> out;
+  while (st.step()) out.push_back(EventRecord{st.int64(0), st.text(1), st.text(2), parse_json_column(st.text(3))});
+  return out;
+}
+
 }  // namespace colorlab::store

@@ -5,6 +5,8 @@ Argyll needs a tty on stdin and, on machines without /dev/bus/usb, a private /de
 §5.2/5.3): the tool runs under `unshare -m` with a small tmpfs /dev whose ttyS7 links to our pty. Prompts
 are answered by pressing keys; between prompts the simulated head is moved through the control socket.
 Prints one JSON line with what it saw. Exit status 0 when the run completed.
+With --trace, the tool runs under strace so a benchmark can time every byte it sends and receives
+(bench/drivers/serial/serial_timeline.py reads that log).
 """
 import argparse
 import json
@@ -98,9 +100,17 @@ class Session:
         return None
 
 
+def tool_argv(a, argv):
+    if not a.trace:
+        return argv
+    # -ttt: epoch timestamps comparable with time.time(); -T: time inside the call; seccomp-bpf stops the tool only on the traced calls.
+    return ["strace", "-f", "--seccomp-bpf", "-ttt", "-T", "-s", "1024", "-e", "trace=openat,read,write,close",
+            "-o", a.trace] + argv
+
+
 def run_spotread(a, log):
     control(a.control, {"cmd": "place", "target": "white_tile"})
-    s = Session(["spotread", "-v", "-c", "1", "-s"], a.port, a.workdir, log)
+    s = Session(tool_argv(a, ["spotread", "-v", "-c", "1", "-s"]), a.port, a.workdir, log)
     result = {}
     m = s.expect(r"Device:\s*(\S+)\s+Serial No:\s*(\S+)", 60)
     result["device"] = m.group(1)
@@ -166,11 +176,14 @@ def run_chartread(a, log):
     make_chart(a, log)
     first = [float(v) for v in a.first.split(",")]
     last = [float(v) for v in a.last.split(",")]
-    s = Session(["chartread", "-v", "-c", "1", a.basename], a.port, a.workdir, log)
+    t_start = time.time()
+    s = Session(tool_argv(a, ["chartread", "-v", "-c", "1", a.basename]), a.port, a.workdir, log)
     result = {}
+    times = {"start": t_start}
     m = s.expect(r"Device:\s*(SpectroScan\S*)", 60)
     result["table"] = m.group(1)
     s.expect(r"place sheet 1 of 1 on table.*?hit return", 60)
+    times["sheet_prompt"] = time.time()
     s.send("\r")
     located = []
     for xy in (first, last):
@@ -179,8 +192,12 @@ def run_chartread(a, log):
         control(a.control, {"cmd": "place", "x_mm": xy[0], "y_mm": xy[1]})
         s.send("\r")
     result["located"] = located
-    s.expect(r"Sheet 1 of 1 read OK", 120)
+    times["located"] = time.time()
+    s.expect(r"Sheet 1 of 1 read OK", a.read_timeout)
+    times["read_ok"] = time.time()
     result["exit"] = s.wait(30)
+    times["exit"] = time.time()
+    result["times"] = times
     result["patches"] = read_ti3(os.path.join(a.workdir, a.basename + ".ti3"))
     return result
 
@@ -197,6 +214,8 @@ def main():
     p.add_argument("--first", default="30,20", help="x,y mm of the strip's first patch")
     p.add_argument("--last", default="250,20", help="x,y mm of the strip's last patch")
     p.add_argument("--log", default="-")
+    p.add_argument("--read-timeout", type=float, default=120, help="seconds allowed for reading the sheet")
+    p.add_argument("--trace", default="", help="run the tool under strace, writing its log here")
     a = p.parse_args()
     log = sys.stderr if a.log == "-" else open(a.log, "w")
     try:

@@ -67,7 +67,13 @@ std::optional<std::string> Process::read_line(std::chrono::milliseconds timeout)
     if (::poll(&p, 1, static_cast<int>(left.count())) <= 0) continue;
     char buf[4096];
     ssize_t n = ::read(stdout_fd_, buf, sizeof buf);
-    if (n <= 0) return std::nullopt;
+    if (n <= 0) {
+      // EOF: a last line without a newline is still a line.
+      if (buffer_.empty()) return std::nullopt;
+      std::string rest = std::move(buffer_);
+      buffer_.clear();
+      return rest;
+    }
     buffer_.append(buf, static_cast<std::size_t>(n));
   }
 }

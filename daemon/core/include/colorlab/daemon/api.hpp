@@ -5,6 +5,7 @@
 
 #include "colorlab/campaigns/campaign.hpp"
 #include "colorlab/daemon/executions.hpp"
+#include "colorlab/drivers/discovery.hpp"
 #include "colorlab/http/message.hpp"
 #include "colorlab/store/store.hpp"
 
@@ -17,6 +18,8 @@ struct ApiContext {
   Executions& executions;
   bool simulated_lab = false;
   std::string started_at;
+  const drivers::Discovery* discovery = nullptr;
+  std::string hotplug_status;
 };
 
 http::HttpResponse handle_api(ApiContext& ctx, const http::HttpRequest& req);

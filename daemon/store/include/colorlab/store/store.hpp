@@ -64,6 +64,13 @@ struct RunRecord {
   nlohmann::json to_json() const;  // without measurements
 };
 
+struct EventRecord {
+  std::int64_t seq = 0;
+  std::string time;
+  std::string topic;
+  nlohmann::json payload;
+};
+
 struct RunPage {
   std::vector<RunRecord> runs;
   std::optional<std::string> next_cursor;
@@ -101,6 +108,8 @@ class Store {
   RunPage runs(unsigned limit, const std::optional<std::string>& cursor);
 
   std::int64_t append_event(const std::string& topic, const nlohmann::json& payload);
+  // Events with seq > after, oldest first (a client resumes from the last seq it saw).
+  std::vector<EventRecord> events(std::int64_t after, unsigned limit, const std::optional<std::string>& topic);
   int interrupted_at_open() const { return interrupted_at_open_; }
 
  private:
