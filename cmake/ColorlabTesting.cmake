@@ -1,8 +1,10 @@
-# colorlab_add_gtest(NAME name LABEL unit|integration|conformance|hardware SOURCES ... LIBS ... [TIMEOUT s])
+# colorlab_add_gtest(NAME name LABEL unit|integration|conformance|hardware SOURCES ... LIBS ... [TIMEOUT s]
+#                   [RESOURCE_LOCK name])  — tests sharing a lock never run at the same time (e.g. the one
+#                   GigE Vision fake camera that can serve 127.0.0.1).
 # Tests find the built executables through COLORLAB_BIN_DIR and the source tree through
 # COLORLAB_SOURCE_DIR; the shared reference data is optional (tests skip with a reason).
 function(colorlab_add_gtest)
-  cmake_parse_arguments(T "" "NAME;LABEL;TIMEOUT" "SOURCES;LIBS" ${ARGN})
+  cmake_parse_arguments(T "" "NAME;LABEL;TIMEOUT;RESOURCE_LOCK" "SOURCES;LIBS" ${ARGN})
   if(NOT T_TIMEOUT)
     set(T_TIMEOUT 300)
   endif()
@@ -13,7 +15,9 @@ function(colorlab_add_gtest)
     COLORLAB_BIN_DIR="${CMAKE_BINARY_DIR}/bin"
     COLORLAB_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
   colorlab_warnings(${T_NAME})
-  gtest_discover_tests(${T_NAME}
-    PROPERTIES LABELS ${T_LABEL} TIMEOUT ${T_TIMEOUT}
-    DISCOVERY_TIMEOUT 60)
+  set(_props LABELS ${T_LABEL} TIMEOUT ${T_TIMEOUT})
+  if(T_RESOURCE_LOCK)
+    list(APPEND _props RESOURCE_LOCK ${T_RESOURCE_LOCK})
+  endif()
+  gtest_discover_tests(${T_NAME} PROPERTIES ${_props} DISCOVERY_TIMEOUT 60)
 endfunction()

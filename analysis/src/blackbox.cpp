@@ -115,6 +115,18 @@ BlackBoxModel fit_blackbox(const Eigen::MatrixXd& spectra, const Eigen::MatrixXd
   const double scale = X.squaredNorm() / std::max(1.0, D.squaredNorm());
   BlackBoxModel model;
   model.sensitivities.resize(3, m);
+  if (o.prior) {
+    if (o.prior->wavelengths.size() != static_cast<std::size_t>(m))
+      throw Error(ErrorClass::bad_data, "black box: prior has " + std::to_string(o.prior->wavelengths.size()) +
+                                            " bands, spectra " + std::to_string(m));
+    model.with_prior = true;
+    for (int c = 0; c < 3; ++c) {
+      PriorFit fit = fit_with_prior(o.prior->channels[static_cast<std::size_t>(c)], X, raw.col(c));
+      model.lambda[static_cast<std::size_t>(c)] = fit.lambda;
+      model.sensitivities.row(c) = fit.curve.transpose() / xscale;
+    }
+    return model;
+  }
   for (int c = 0; c < 3; ++c) {
     Eigen::VectorXd y = raw.col(c);
     double lambda = 0;

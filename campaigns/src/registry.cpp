@@ -1,4 +1,5 @@
 #include "colorlab/campaigns/campaign.hpp"
+#include "colorlab/campaigns/image_averaging.hpp"
 #include "colorlab/campaigns/luminance_spot.hpp"
 
 namespace colorlab::campaigns {
@@ -6,6 +7,7 @@ namespace colorlab::campaigns {
 CampaignRegistry CampaignRegistry::with_builtin_campaigns() {
   CampaignRegistry r;
   r.add(std::make_unique<LuminanceSpot>());
+  r.add(std::make_unique<ImageAveraging>());
   return r;
 }
 

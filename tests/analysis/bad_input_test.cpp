@@ -69,6 +69,26 @@ TEST(AnalysisBadInput, MismatchedGridsAndPatchCounts) {
                "5 spectra but 4 RAW");
 }
 
+// Camera-curve collections for the black-box prior: too few cameras, a grid they do not cover, a dead channel.
+TEST(AnalysisBadInput, SensitivityPriorCurves) {
+  ca::SpectralSet curves;
+  curves.source = "cams.csv";
+  curves.wavelengths = {400, 500, 600, 700};
+  for (const char* cam : {"A", "B", "C"})
+    for (const char* ch : {"_R", "_G", "_B"}) curves.names.push_back(std::string(cam) + ch);
+  curves.values = Eigen::MatrixXd::Random(9, 4).cwiseAbs() + Eigen::MatrixXd::Constant(9, 4, 0.1);
+  EXPECT_EQ(ca::learn_sensitivity_prior(curves, {400, 450, 500}).cameras.size(), 3u);
+  expect_error([&] { ca::learn_sensitivity_prior(curves, {400, 450, 500}, {"B"}); }, ErrorClass::bad_data, "2 complete cameras");
+  expect_error([&] { ca::learn_sensitivity_prior(curves, {380, 400, 500}); }, ErrorClass::bad_data, "do not cover");
+  curves.values.row(4).setZero();  // B_G
+  expect_error([&] { ca::learn_sensitivity_prior(curves, {400, 450, 500}); }, ErrorClass::bad_data, "'B_G' in cams.csv");
+  curves.values.row(4).setOnes();
+  ca::BlackBoxOptions o;
+  o.prior = ca::learn_sensitivity_prior(curves, {400, 450, 500});
+  expect_error([&] { ca::fit_blackbox(Eigen::MatrixXd::Ones(5, 4), Eigen::MatrixXd::Ones(5, 3), o); }, ErrorClass::bad_data,
+               "prior has 3 bands, spectra 4");
+}
+
 TEST(AnalysisBadInput, EmptyRegionsAndOutOfImageRegions) {
   std::vector<float> px(100, 1.0f);
   ca::ImageView v{px.data(), 10, 10, 10};

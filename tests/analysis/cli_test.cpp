@@ -4,7 +4,11 @@
 
 #include <fstream>
 
+#include <nlohmann/json.hpp>
+
+#include "colorlab/analysis/blackbox.hpp"
 #include "colorlab/analysis/chart_io.hpp"
+#include "colorlab/analysis/standard_data.hpp"
 #include "colorlab/cli/analyze_command.hpp"
 #include "colorlab/core/error.hpp"
 #include "test_support.hpp"
@@ -57,6 +61,52 @@ TEST(AnalysisCli, FitWithCrossValidationAndTestChart) {
   out = run_cli({"analyze", "fit", "--train", sg.string(), "--json"});
   EXPECT_NE(out.find("\"model\""), std::string::npos);
   EXPECT_THROW(run_cli({"analyze", "fit", "--method", "poly:12", "--train", sg.string()}), colorlab::Error);
+}
+
+// --basis: the CLI's curves equal the library's prior fit on the same inputs, and (noise-free RAW from the Canon 20D,
+// the 20D left out of the basis) lie within 10 % of peak of the truth.
+TEST(AnalysisCli, BlackBoxWithBasisOfOtherCameras) {
+  COLORLAB_REQUIRE_SHARED(ssf_file, "camera_ssf_canon_eos_20d_camspec_10nm_400_720.csv");
+  COLORLAB_REQUIRE_SHARED(cams_file, "camera_ssf_camspec_jiang2013_28cams_10nm_400_720.csv");
+  COLORLAB_REQUIRE_SHARED(sg_file, "colorcheckersg_xrite_before_nov2014_dcamprof_10nm_380_730.csv");
+  ca::SpectralSet ssf = ca::read_spectra(ssf_file);
+  ca::SpectralSet sg = ca::read_spectra(sg_file);  // 380–730 nm: the CLI crops to the basis's 400–720 nm
+  ca::SpectralSet refl = ca::resample(sg, ssf.wavelengths, ca::Interpolation::linear);
+  ca::SpectralSet lamp = ca::resample(ca::load_illuminant("D65"), ssf.wavelengths, ca::Interpolation::linear);
+  Eigen::MatrixXd spectra = refl.values.array().rowwise() * lamp.values.row(0).array();
+  Eigen::MatrixXd raw = spectra * ssf.values.transpose();
+  const double gain = 4095 * 0.9 / raw.maxCoeff();
+  raw *= gain;
+  auto dir = ca::testing::temp_dir("cli-blackbox");
+  {
+    std::ofstream f(dir / "raw.csv");
+    f.precision(17);
+    f << "patch,R,G,B\n";
+    for (Eigen::Index i = 0; i < raw.rows(); ++i)
+      f << sg.names[static_cast<std::size_t>(i)] << ',' << raw(i, 0) << ',' << raw(i, 1) << ',' << raw(i, 2) << '\n';
+  }
+  const std::string out = run_cli({"analyze", "fit", "--method", "blackbox", "--train", (dir / "raw.csv").string(), "--spectra",
+                                   sg_file.string(), "--illuminant", "D65", "--basis", cams_file.string(), "--exclude-camera",
+                                   "Canon_20D", "--json"});
+  const auto j = nlohmann::json::parse(out);
+  const auto& rows = j.at("sensitivities");
+  ASSERT_EQ(rows.size(), ssf.wavelengths.size());
+  ca::BlackBoxOptions o;
+  o.prior = ca::learn_sensitivity_prior(ca::read_spectra(cams_file), ssf.wavelengths, {"Canon_20D"});
+  const auto lib = ca::fit_blackbox(spectra, raw, o);
+  for (int c = 0; c < 3; ++c) {
+    const double peak = gain * ssf.values.row(c).maxCoeff();
+    double worst = 0;
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+      const double v = rows[k].at(std::string(1, "RGB"[c])).get<double>();
+      EXPECT_NEAR(v, lib.sensitivities(c, static_cast<Eigen::Index>(k)), 1e-6 * peak);
+      worst = std::max(worst, std::abs(v - gain * ssf.values(c, static_cast<Eigen::Index>(k))) / peak);
+    }
+    EXPECT_LE(worst, 0.10) << "RGB"[c];
+  }
+  EXPECT_THROW(run_cli({"analyze", "fit", "--method", "blackbox", "--train", (dir / "raw.csv").string(), "--spectra",
+                        sg_file.string(), "--exclude-camera", "Canon_20D"}),
+               colorlab::Error);
 }
 
 TEST(AnalysisCli, UniformityAndAveraging) {

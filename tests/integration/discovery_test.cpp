@@ -28,7 +28,9 @@ bool eventually(Pred pred, std::chrono::seconds limit = std::chrono::seconds(15)
 
 TEST(Discovery, DaemonReportsInstrumentsThatComeAndGo) {
   TempDir dir;
-  Process sim({colorlab::testing::bin_path("colorlab-sim"), "--time-scale", "20", "--control", (dir / "sim.sock").string()},
+  Process sim({colorlab::testing::bin_path("colorlab-sim"), "--config",
+               colorlab::testing::write_sim_config_without_camera(dir.path()), "--time-scale", "20", "--control",
+               (dir / "sim.sock").string()},
               dir / "sim.log");
   auto line = sim.read_line(std::chrono::seconds(20));
   ASSERT_TRUE(line);

@@ -11,10 +11,18 @@ namespace colorlab::testing {
 
 using nlohmann::json;
 
+std::string write_sim_config_without_camera(const std::filesystem::path& dir) {
+  auto path = dir / "lab.toml";
+  // The GigE Vision fake can serve 127.0.0.1 only once; tests without a camera leave it to those with one.
+  std::ofstream(path) << "[genicam]\nenabled = false\n";
+  return path.string();
+}
+
 LabFixture::LabFixture(double time_scale, std::string ls110_options) {
   sim_ = std::make_unique<Process>(
-      std::vector<std::string>{bin_path("colorlab-sim"), "--seed", "7", "--time-scale", std::to_string(time_scale),
-                               "--control", (dir / "sim.sock").string()},
+      std::vector<std::string>{bin_path("colorlab-sim"), "--config", write_sim_config_without_camera(dir.path()),
+                               "--seed", "7", "--time-scale", std::to_string(time_scale), "--control",
+                               (dir / "sim.sock").string()},
       dir / "sim.log");
   auto line = sim_->read_line(std::chrono::seconds(20));
   if (!line) throw std::runtime_error("colorlab-sim did not announce itself");

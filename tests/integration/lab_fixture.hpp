@@ -11,6 +11,9 @@
 
 namespace colorlab::testing {
 
+// A colorlab-sim configuration with every instrument but the GigE Vision camera.
+std::string write_sim_config_without_camera(const std::filesystem::path& dir);
+
 class LabFixture {
  public:
   explicit LabFixture(double time_scale = 20, std::string ls110_options = "{ reply_timeout_ms = 1500 }");

@@ -122,31 +122,3 @@ TEST(ThinPath, CommittedReadingsSurviveKillNineAndTheRunIsMarkedInterrupted) {
   }
 }
 
-TEST(EmbeddedDefault, DaemonWithoutConfigStartsTheSimulatedLab) {
-  colorlab::testing::TempDir dir;
-  Process daemon({colorlab::testing::bin_path("colorlabd"), "--state", (dir / "state").string(), "--listen",
-                  "127.0.0.1:0"},
-                 dir / "colorlabd.log");
-  auto endpoint_file = dir / "state" / "colorlabd.endpoint";
-  for (int i = 0; i < 400 && !std::filesystem::exists(endpoint_file); ++i) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(25));
-  }
-  ASSERT_TRUE(std::filesystem::exists(endpoint_file));
-  std::string url = json::parse(std::ifstream(endpoint_file))["url"];
-  auto cli = [&](std::vector<std::string> args) {
-    std::vector<std::string> argv{colorlab::testing::bin_path("colorlab"), "--url", url, "--json"};
-    argv.insert(argv.end(), args.begin(), args.end());
-    return colorlab::testing::run_command(argv);
-  };
-  auto status = cli({"status"});
-  ASSERT_EQ(status.exit_code, 0) << status.err;
-  EXPECT_TRUE(json::parse(status.out)["simulated_lab"]);
-  auto run = cli({"run", "luminance-spot"});
-  ASSERT_EQ(run.exit_code, 0) << run.err;
-  json j = json::parse(run.out);
-  EXPECT_EQ(j["status"], "finished_ok");
-  EXPECT_TRUE(j["simulated"]);
-  EXPECT_TRUE(j["instruments"][0]["simulated"]);
-  daemon.signal(SIGTERM);
-  EXPECT_EQ(daemon.wait(std::chrono::seconds(10)), 0) << "colorlabd must stop cleanly on SIGTERM";
-}

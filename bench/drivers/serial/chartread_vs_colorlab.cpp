@@ -54,6 +54,11 @@ struct Run {
   std::string why;  // set when the run could not happen
   double init = 0, locate = 0, calibrate = 0, first_patch = 0, steady_patch = 0, patches = 0;
   int calibrations = 0, commands = 0;
+  unsigned baud = 0;           // link speed the client left the device at
+  double measure_answer = 0;   // chartread only: mean D0 07 round trip (patches 2..N)
+  double extra_queries = 0;    // chartread only: mean time in the other commands of a patch (BA 09 04)
+  double read_wait = 0;        // chartread only: mean time per patch blocked in read() (VMIN/VTIME)
+  json phase_split;            // chartread only: init and calibration cut into device wait, VTIME, host gaps
   std::vector<double> cycles;  // per patch, from its measure command to the next one
   double total() const { return init + locate + calibrate + patches; }
 };
@@ -159,6 +164,15 @@ void BM_ArgyllChartread(benchmark::State& state) {
     r.patches = t["patches_s"];
     r.calibrations = t["calibrations"];
     r.commands = t["commands_to_last_patch"];
+    r.baud = sim.control({{"cmd", "truth"}})["spectrolino"]["baud"].get<unsigned>();
+    r.phase_split = {{"init", t["init_split"]}, {"calibration", t["calibrate_split"]}};
+    const auto& pp = t["per_patch"];
+    for (std::size_t i = 1; i < pp.size(); ++i) {
+      r.measure_answer += pp[i]["measure_answer"].get<double>() / static_cast<double>(pp.size() - 1);
+      r.read_wait += pp[i]["read_wait"].get<double>() / static_cast<double>(pp.size() - 1);
+      r.extra_queries += (pp[i]["in_commands"].get<double>() - pp[i]["measure_answer"].get<double>()) /
+                         static_cast<double>(pp.size() - 1);
+    }
     // Cycle = from one D0 07 to the next; the last patch ends with its last answer.
     for (const auto& p : t["per_patch"]) r.cycles.push_back(p["cycle"].get<double>());
     finish_patch_stats(r);
@@ -213,6 +227,7 @@ void BM_ColorlabReadChart(benchmark::State& state) {
     finish_patch_stats(r);
     r.calibrations = driver.calibrations_done();
     r.commands = static_cast<int>(driver.commands_sent());
+    r.baud = sim.control({{"cmd", "truth"}})["spectrolino"]["baud"].get<unsigned>();
     r.done = true;
     driver.disconnect();
     state.SetIterationTime(r.total());
@@ -293,12 +308,37 @@ void print_report() {
   for (std::size_t i = 0; i < a.cycles.size() && i < c.cycles.size(); ++i) {
     std::printf("%3zu %10.3f %9.3f %6.2fx\n", i + 1, a.cycles[i], c.cycles[i], a.cycles[i] / c.cycles[i]);
   }
+  // Where a steady patch's time goes. The D0 07 request and its spectrum answer are 15 + 303 bytes
+  // (10 bits each at 8N1); the device time is the same simulator model for both clients.
+  const double d007_bits = (15 + 303) * 10.0;
+  const double device = a.measure_answer - d007_bits / a.baud;
+  const double wire_a = d007_bits / a.baud, wire_c = d007_bits / c.baud;
+  std::printf("\nsteady patch decomposition (s)     chartread   colorlab\n");
+  std::printf("%-34s %10u %10u\n", "link speed (baud)", a.baud, c.baud);
+  std::printf("%-34s %10.3f %10.3f\n", "device time (D0 07, simulator)", device, device);
+  std::printf("%-34s %10.3f %10.3f\n", "D0 07 wire time", wire_a, wire_c);
+  std::printf("%-34s %10.3f %10.3f\n", "BA 09 04 XYZ query (device+wire)", a.extra_queries - a.read_wait, 0.0);
+  std::printf("%-34s %10.3f %10.3f\n", "read() VMIN/VTIME waits", a.read_wait, 0.0);
+  std::printf("%-34s %10.3f %10.3f\n", "host: gaps between commands", a.steady_patch - device - wire_a - a.extra_queries,
+              c.steady_patch - device - wire_c);
+  std::printf("%-34s %10.3f %10.3f\n", "= per patch", a.steady_patch, c.steady_patch);
+  std::printf("ceiling with zero host and wire time: %.2fx per patch\n", a.steady_patch / device);
+  std::printf("\nchartread phases (s)   waiting for answers (of which read() VTIME)   host gaps\n");
+  for (const char* phase : {"init", "calibration"}) {
+    const auto& p = a.phase_split[phase];
+    std::printf("%-22s %20.3f %12.3f %20.3f\n", phase, p["waiting_for_device"].get<double>(),
+                p["read_wait"].get<double>(), p["host_gaps"].get<double>());
+  }
   const int cals_a = calibrations_for(chunks(kChartPatches, kArgyllStepsInPass));
   const int cals_c = calibrations_for(colorlab_sg_rows());
   const double ta = extrapolate(a, cals_a), tc = extrapolate(c, cals_c);
-  std::printf("\n140 patches extrapolated: chartread %.1f s (%d calibrations, strips of %d), colorlab %.1f s "
-              "(%d calibrations, rows of %d): %.2fx\n",
-              ta, cals_a, kArgyllStepsInPass, tc, cals_c, sim::chart_columns, ta / tc);
+  const double ia = a.init + a.locate, ic = c.init + c.locate;
+  std::printf("\n140 patches extrapolated (chartread: %d calibrations, strips of %d; colorlab: %d calibrations, "
+              "rows of %d)\n",
+              cals_a, kArgyllStepsInPass, cals_c, sim::chart_columns);
+  std::printf("%-34s %10.1f %10.1f %8.2fx\n", "init .. last patch (s)", ta, tc, ta / tc);
+  std::printf("%-34s %10.1f %10.1f %8.2fx\n", "chart read only, no init/locate (s)", ta - ia, tc - ic,
+              (ta - ia) / (tc - ic));
 }
 
 }  // namespace

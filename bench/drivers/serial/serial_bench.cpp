@@ -1,8 +1,7 @@
 // Spectrolino/SpectroScan T driver speed against the simulator at time scale 1 (real device and
 // wire time): a chart read, and the per-command overhead above wire time + device time.
-// ArgyllCMS's side is computed from its documented behaviour (instrument-protocols §5.4: 9600 baud,
-// VMIN=64/VTIME=1 so every short reply waits a further 0.1 s, a 20 ms drain before each command,
-// and an extra BA 09 04 XYZ query per patch); see docs/perf/drivers-serial.md.
+// ArgyllCMS chartread itself is driven on the same simulator by bench_chartread_vs_colorlab
+// (chartread_vs_colorlab.cpp); see docs/perf/drivers-serial.md.
 #include <benchmark/benchmark.h>
 
 #include <boost/asio/io_context.hpp>

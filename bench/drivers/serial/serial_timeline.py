@@ -97,11 +97,29 @@ def timeline(path, port, patches):
             elif pending is not None:
                 in_commands += e[1] - pending
                 pending = None
-        per_patch.append({"start": w[0], "measure_answer": answer[1] - w[0], "done": done,
+        # Time spent inside read() is Argyll's VMIN=64/VTIME=1 wait: a short answer is handed over
+        # only after 0.1 s of silence on the line.
+        read_wait = sum(e[1] - e[0] for e in window if e[2] == "r")
+        per_patch.append({"start": w[0], "measure_answer": answer[1] - w[0], "done": done, "read_wait": read_wait,
                           "cycle": nxt - w[0], "commands": writes, "in_commands": in_commands,
                           "host_gaps": (nxt - w[0]) - in_commands,
                           "recalibrated": any(e[3].startswith(";220907") for e in window if e[2] == "w")})
     last_done = per_patch[-1]["done"]
+
+    def split(t0, t1):
+        """Waiting for answers (request sent .. answer handed over) vs the host's own gaps, and the share
+        of the waiting spent inside read() on VTIME."""
+        in_commands, read_wait, pending = 0.0, 0.0, None
+        for e in port_ev:
+            if not t0 <= e[0] < t1:
+                continue
+            if e[2] == "w":
+                pending = e[0]
+            elif pending is not None:
+                in_commands += e[1] - pending
+                read_wait += e[1] - e[0]
+                pending = None
+        return {"waiting_for_device": in_commands, "read_wait": read_wait, "host_gaps": (t1 - t0) - in_commands}
     writes = [e for e in port_ev if e[2] == "w"]
     return {
         "t_open": t_open,
@@ -113,6 +131,8 @@ def timeline(path, port, patches):
         "patches": len(per_patch),
         "calibrations": sum(1 for e in writes if e[3].startswith(";220907") and e[0] <= last_done),
         "commands_to_last_patch": sum(1 for e in writes if e[0] <= last_done),
+        "init_split": split(t_open, sheet),
+        "calibrate_split": split(located, first_measure),
         "per_patch": per_patch,
     }
 

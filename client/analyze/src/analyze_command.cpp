@@ -2,6 +2,7 @@
 
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include "analyze_output.hpp"
@@ -78,7 +79,8 @@ void run_de2000(const De2000Options& o) {
 }
 
 struct FitCliOptions {
-  std::string method = "auto", train, test, cv = "loo", target = "xyz", spectra, illuminant = "D65";
+  std::string method = "auto", train, test, cv = "loo", target = "xyz", spectra, illuminant = "D65", basis;
+  std::vector<std::string> exclude_cameras;
   double ridge = 0, tolerance = 0.1, full_scale = 4095, input_scale = 0;
   bool json = false;
 };
@@ -90,10 +92,35 @@ ca::FitTarget parse_target(const std::string& t) {
   throw Error(ErrorClass::bad_parameter, "--target must be xyz, xyzw or lab, not '" + t + "'");
 }
 
+// Camera-curve collections rarely span a chart's whole spectral range (camspec: 400–720 nm); the fit then uses the
+// bands both share, and says so.
+ca::SpectralSet crop_to_range(const ca::SpectralSet& s, double from_nm, double to_nm) {
+  std::vector<std::size_t> keep;
+  for (std::size_t k = 0; k < s.bands(); ++k)
+    if (s.wavelengths[k] >= from_nm - 1e-9 && s.wavelengths[k] <= to_nm + 1e-9) keep.push_back(k);
+  if (keep.size() == s.bands()) return s;
+  if (keep.size() < 3)
+    throw Error(ErrorClass::bad_data, "blackbox: spectra in " + s.source + " and the --basis curves share fewer than 3 wavelengths");
+  ca::SpectralSet out = s;
+  out.wavelengths.clear();
+  out.values.resize(s.values.rows(), static_cast<Eigen::Index>(keep.size()));
+  for (std::size_t j = 0; j < keep.size(); ++j) {
+    out.wavelengths.push_back(s.wavelengths[keep[j]]);
+    out.values.col(static_cast<Eigen::Index>(j)) = s.values.col(static_cast<Eigen::Index>(keep[j]));
+  }
+  std::cerr << "blackbox: fitting " << out.wavelengths.front() << "–" << out.wavelengths.back() << " nm, the range of the --basis curves\n";
+  return out;
+}
+
 void run_blackbox(const FitCliOptions& o) {
   if (o.spectra.empty()) throw Error(ErrorClass::bad_parameter, "--method blackbox needs --spectra (one spectrum per patch)");
   ca::CsvTable raw_t = ca::read_csv(o.train);
   ca::SpectralSet spectra = ca::read_spectra(o.spectra);
+  std::optional<ca::SpectralSet> basis;
+  if (!o.basis.empty()) {
+    basis = ca::read_spectra(o.basis);
+    spectra = crop_to_range(spectra, basis->wavelengths.front(), basis->wavelengths.back());
+  }
   const auto id = raw_t.require_column(raw_t.header[0]), R = raw_t.require_column("R"), G = raw_t.require_column("G"),
              B = raw_t.require_column("B");
   // Reflectances (≤ 1.5) are lit by the illuminant; anything brighter is taken as radiance already.
@@ -108,6 +135,8 @@ void run_blackbox(const FitCliOptions& o) {
   }
   ca::BlackBoxOptions bo;
   bo.full_scale = o.full_scale;
+  if (basis) bo.prior = ca::learn_sensitivity_prior(*basis, spectra.wavelengths, o.exclude_cameras);
+  else if (!o.exclude_cameras.empty()) throw Error(ErrorClass::bad_parameter, "--exclude-camera needs --basis");
   auto model = ca::fit_blackbox(X, Y, bo);
   auto res = ca::blackbox_residuals(model, X, Y, o.full_scale);
   Table t13{"residuals", {"channel", "min", "max", "median", "mean", "stdev", "min_pct", "max_pct", "median_pct", "mean_pct", "stdev_pct"}, {}};
@@ -330,6 +359,10 @@ void add_analyze_command(CLI::App& app) {
     c->add_option("--spectra", o->spectra, "blackbox: spectra per patch (reflectance is lit by --illuminant)");
     c->add_option("--illuminant", o->illuminant, "blackbox: illuminant for reflectance spectra")->capture_default_str();
     c->add_option("--full-scale", o->full_scale, "blackbox: RAW full scale for % residuals")->capture_default_str();
+    c->add_option("--basis", o->basis,
+                  "blackbox: measured curves of other cameras (CSV/CGATS, columns <camera>_R/_G/_B); fits under their "
+                  "statistical prior instead of the second-difference penalty");
+    c->add_option("--exclude-camera", o->exclude_cameras, "blackbox: leave this camera of --basis out (repeatable)");
     c->add_flag("--json", o->json, "JSON instead of CSV");
     c->callback([o] { run_fit(*o); });
   }

@@ -36,6 +36,7 @@ struct Daemon::Impl {
   std::unique_ptr<http::Server> server;
   std::unique_ptr<drivers::Discovery> discovery;
   std::unique_ptr<drivers::DiscoveryMonitor> monitor;
+  std::vector<std::shared_ptr<drivers::Instrument>> connect_at_start;
   SystemdNotifier notifier{io};
 
   void on_discovery_change(const drivers::DiscoveryChange& change);
@@ -99,7 +100,12 @@ Daemon::Daemon(DaemonConfig config) : impl_(std::make_unique<Impl>()) {
   }
   std::vector<drivers::DiscoveryRule> rules;
   for (const auto& c : instrument_configs) {
-    if (d.instruments.find(c.id)) rules.push_back(drivers::DiscoveryRule{c.id, c.kind, c.port, {}, {}, {}});
+    // Device paths are watched; network addresses (GenICam cameras) are simply connected at start.
+    if (d.instruments.find(c.id) && c.port.starts_with('/')) {
+      rules.push_back(drivers::DiscoveryRule{c.id, c.kind, c.port, {}, {}, {}});
+    } else if (auto i = d.instruments.find(c.id)) {
+      d.connect_at_start.push_back(i);
+    }
   }
   d.discovery = std::make_unique<drivers::Discovery>(std::move(rules));
   d.executions = std::make_unique<Executions>(d.io, *d.store, d.campaigns, d.instruments);
@@ -146,6 +152,7 @@ int Daemon::run() {
   // Connect instruments in the background: the API is useful (stored data) while they come up.
   // Discovery's first scan reports every present port as added, which starts each connection.
   d.discovery->subscribe([&d](const drivers::DiscoveryChange& c) { d.on_discovery_change(c); });
+  for (const auto& instrument : d.connect_at_start) asio::co_spawn(d.io, connect_instrument(instrument), asio::detached);
   d.monitor = std::make_unique<drivers::DiscoveryMonitor>(d.io.get_executor(), *d.discovery);
   d.monitor->start();
   d.api->hotplug_status = d.monitor->hotplug_status();

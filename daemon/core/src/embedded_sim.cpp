@@ -110,7 +110,8 @@ std::vector<drivers::InstrumentConfig> EmbeddedSim::instruments() const {
     drivers::InstrumentConfig c;
     c.id = i.value("id", std::string());
     c.kind = i.value("kind", std::string());
-    c.port = i.value("port", std::string());
+    // Cameras are reached by network address rather than a device path.
+    c.port = i.value("port", i.value("address", std::string()));
     c.simulated = true;
     if (i.contains("driver_options")) c.options = i["driver_options"];
     if (!c.port.empty()) out.push_back(std::move(c));

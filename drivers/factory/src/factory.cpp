@@ -1,6 +1,8 @@
 #include "colorlab/drivers/factory.hpp"
 
 #include "colorlab/core/error.hpp"
+#include "colorlab/drivers/camera/aravis_camera.hpp"
+#include "colorlab/drivers/camera/camera_instrument.hpp"
 #include "colorlab/drivers/enttec_dmx.hpp"
 #include "colorlab/drivers/hid_relay.hpp"
 #include "colorlab/drivers/hidapi_transport.hpp"
@@ -114,7 +116,19 @@ std::shared_ptr<Instrument> make_hidrelay(boost::asio::any_io_executor executor,
 
 }  // namespace
 
-std::vector<std::string> known_instrument_kinds() { return {"ls110", "spectrolino", "dmx", "hidrelay"}; }
+std::shared_ptr<Instrument> make_genicam(const InstrumentConfig& c) {
+  camera::AravisOptions o;
+  o.device_id = c.port;
+  if (c.options.contains("black_level")) o.black_level = c.options["black_level"].get<std::uint16_t>();
+  if (c.options.contains("frame_timeout_ms")) o.frame_timeout = std::chrono::milliseconds(c.options["frame_timeout_ms"].get<int>());
+  if (c.options.contains("region")) {
+    const auto& r = c.options["region"];
+    o.region = camera::Region{r.at(0).get<int>(), r.at(1).get<int>(), r.at(2).get<int>(), r.at(3).get<int>()};
+  }
+  return std::make_shared<camera::CameraInstrument>(c.id, c.port, c.simulated, std::make_unique<camera::AravisCamera>(o));
+}
+
+std::vector<std::string> known_instrument_kinds() { return {"ls110", "spectrolino", "dmx", "hidrelay", "genicam"}; }
 
 std::shared_ptr<Instrument> make_instrument(boost::asio::any_io_executor executor, const InstrumentConfig& config) {
   if (config.id.empty()) throw Error(ErrorClass::bad_parameter, "an instrument entry has no id");
@@ -124,6 +138,7 @@ std::shared_ptr<Instrument> make_instrument(boost::asio::any_io_executor executo
     if (config.kind == "spectrolino") return make_spectrolino(executor, config);
     if (config.kind == "dmx") return make_dmx(executor, config);
     if (config.kind == "hidrelay") return make_hidrelay(executor, config);
+    if (config.kind == "genicam") return make_genicam(config);
   } catch (const nlohmann::json::exception& e) {
     throw Error(ErrorClass::bad_parameter, "instrument '" + config.id + "': bad option: " + e.what());
   }

@@ -27,7 +27,8 @@ class SimProcess {
     dir_ = std::filesystem::temp_directory_path() /
            ("colorlab-simserial-" + std::to_string(::getpid()) + "-" + std::to_string(counter()++));
     std::filesystem::create_directories(dir_);
-    std::ofstream(dir_ / "lab.toml") << toml;
+    // These tests need no camera; leaving the GigE Vision fake off keeps 127.0.0.1 free for the tests that do.
+    std::ofstream(dir_ / "lab.toml") << toml << (toml.find("[genicam]") == std::string::npos ? "\n[genicam]\nenabled = false\n" : "");
     int out[2];
     if (::pipe(out) != 0) throw std::runtime_error("pipe");
     pid_ = ::fork();

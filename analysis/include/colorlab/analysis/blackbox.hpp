@@ -6,6 +6,7 @@
 #include <optional>
 #include <vector>
 
+#include "colorlab/analysis/sensitivity_prior.hpp"
 #include "colorlab/analysis/statistics.hpp"
 
 namespace colorlab::analysis {
@@ -19,11 +20,15 @@ struct BlackBoxOptions {
   std::optional<double> lambda;       // relative penalty weight; unset = chosen by GCV per channel
   double lambda_min = 1e-9, lambda_max = 1e2;
   int lambda_steps = 45;
+  // When set, the curves are fitted under a prior learned from other cameras' measured curves instead of the
+  // second-difference penalty (see sensitivity_prior.hpp for why); its grid must be the spectra's grid.
+  std::optional<SensitivityPrior> prior;
 };
 
 struct BlackBoxModel {
   Eigen::MatrixXd sensitivities;  // 3 × bands (R, G, B)
-  std::array<double, 3> lambda{};  // relative penalty weights used
+  std::array<double, 3> lambda{};  // penalty weights used: relative smoothness weight, or the prior's λ
+  bool with_prior = false;
   Eigen::MatrixXd predict(const Eigen::MatrixXd& spectra) const;  // n × bands → n × 3 RAW
 };
 

@@ -1,0 +1,203 @@
+#include "colorlab/analysis/sensitivity_prior.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <limits>
+#include <map>
+
+#include "colorlab/analysis/blackbox.hpp"
+#include "colorlab/core/error.hpp"
+
+namespace colorlab::analysis {
+
+namespace {
+
+// "<camera>_R" → {"<camera>", 0}; "G" → {"", 1}; anything else → channel −1.
+std::pair<std::string, int> split_channel(const std::string& name) {
+  auto channel_of = [](char c) {
+    switch (std::toupper(static_cast<unsigned char>(c))) {
+      case 'R': return 0;
+      case 'G': return 1;
+      case 'B': return 2;
+      default: return -1;
+    }
+  };
+  if (name.size() == 1) return {"", channel_of(name[0])};
+  if (name.size() > 2 && name[name.size() - 2] == '_') return {name.substr(0, name.size() - 2), channel_of(name.back())};
+  return {name, -1};
+}
+
+}  // namespace
+
+std::vector<std::string> camera_names(const SpectralSet& curves) {
+  std::vector<std::string> out;
+  for (const auto& n : curves.names) {
+    auto [camera, channel] = split_channel(n);
+    if (channel >= 0 && std::find(out.begin(), out.end(), camera) == out.end()) out.push_back(camera);
+  }
+  return out;
+}
+
+SensitivityPrior learn_sensitivity_prior(const SpectralSet& curves, const std::vector<double>& wavelengths,
+                                         const std::vector<std::string>& exclude) {
+  curves.check_shape();
+  if (wavelengths.size() < 3) throw Error(ErrorClass::bad_parameter, "sensitivity prior: need at least 3 wavelengths");
+  if (curves.wavelengths.empty() || wavelengths.front() < curves.wavelengths.front() - 1e-9 ||
+      wavelengths.back() > curves.wavelengths.back() + 1e-9)
+    throw Error(ErrorClass::bad_data, "sensitivity prior: curves in " + curves.source + " do not cover " +
+                                          std::to_string(wavelengths.front()) + "–" + std::to_string(wavelengths.back()) +
+                                          " nm of the spectra");
+  std::map<std::string, std::array<int, 3>> rows;  // camera → sample row per channel
+  for (std::size_t i = 0; i < curves.names.size(); ++i) {
+    auto [camera, channel] = split_channel(curves.names[i]);
+    if (channel < 0) continue;
+    if (std::find(exclude.begin(), exclude.end(), camera) != exclude.end()) continue;
+    auto it = rows.try_emplace(camera, std::array<int, 3>{-1, -1, -1}).first;
+    it->second[static_cast<std::size_t>(channel)] = static_cast<int>(i);
+  }
+  SensitivityPrior prior;
+  prior.wavelengths = wavelengths;
+  std::vector<std::array<int, 3>> complete;
+  for (const auto& [camera, r] : rows)
+    if (r[0] >= 0 && r[1] >= 0 && r[2] >= 0) {
+      complete.push_back(r);
+      prior.cameras.push_back(camera.empty() ? "camera" : camera);
+    }
+  if (complete.size() < 3)
+    throw Error(ErrorClass::bad_data, "sensitivity prior: " + curves.source + " has " + std::to_string(complete.size()) +
+                                          " complete cameras (columns <camera>_R/_G/_B) after exclusions; need at least 3");
+  const Eigen::MatrixXd resample_rows = resampling_matrix(curves.wavelengths, wavelengths, Interpolation::linear);
+  const auto bands = static_cast<Eigen::Index>(wavelengths.size());
+  const auto ncam = static_cast<Eigen::Index>(complete.size());
+  for (std::size_t c = 0; c < 3; ++c) {
+    Eigen::MatrixXd M(bands, ncam);
+    for (Eigen::Index j = 0; j < ncam; ++j) {
+      const auto row = static_cast<Eigen::Index>(complete[static_cast<std::size_t>(j)][c]);
+      Eigen::VectorXd v = resample_rows * curves.values.row(row).transpose();
+      const double peak = v.maxCoeff();
+      if (!v.allFinite() || !(peak > 0) || (v.array() < -1e-6 * peak).any())
+        throw Error(ErrorClass::bad_data, "sensitivity prior: curve '" + curves.names[static_cast<std::size_t>(row)] +
+                                              "' in " + curves.source + " is not finite, non-negative and non-zero");
+      M.col(j) = v / peak;  // shape only: the fit supplies the camera's gain
+    }
+    ChannelPrior& p = prior.channels[c];
+    p.mean = M.rowwise().mean();
+    M.colwise() -= p.mean;
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(M, Eigen::ComputeThinU);
+    const Eigen::VectorXd sdev = svd.singularValues() / std::sqrt(static_cast<double>(ncam - 1));
+    Eigen::Index k = 0;
+    while (k < sdev.size() && sdev(k) > 1e-9 * std::max(sdev(0), 1e-300)) ++k;  // drop the null space
+    p.directions = svd.matrixU().leftCols(k);
+    p.sdev = sdev.head(k);
+  }
+  return prior;
+}
+
+namespace {
+
+// Restricted log-likelihood of y under y = a·(X mean) + X U c + e, c ~ N(0, σ²/λ · diag(sdev²)), e ~ N(0, σ²),
+// with the amplitude a integrated out (flat prior) and σ² profiled. With P the projector orthogonal to X·mean and
+// P X U diag(sdev) = W D Vᵀ, the (n−1)-dimensional covariance I + Z Zᵀ/λ is diagonal in W, so each λ costs O(n k).
+struct Reml {
+  Eigen::VectorXd d2;   // squared singular values
+  Eigen::VectorXd wPy;  // Wᵀ P y
+  double Py2 = 0;       // ‖P y‖²
+  double m = 0;         // n − 1
+
+  double operator()(double lambda) const {
+    double logdet = 0, q = Py2;
+    for (Eigen::Index i = 0; i < d2.size(); ++i) {
+      logdet += std::log1p(d2(i) / lambda);
+      q -= wPy(i) * wPy(i) * d2(i) / (lambda + d2(i));
+    }
+    q = std::max(q, 1e-300 * std::max(Py2, 1e-300));
+    return -0.5 * logdet - 0.5 * m * std::log(q / m);
+  }
+};
+
+// Lawson & Hanson (1974) ch. 23: least squares with linear inequalities, min ‖E c − f‖ s.t. G c ≥ 0, reduced to a
+// least-distance problem and then to NNLS — exact, and reuses the tested NNLS.
+Eigen::VectorXd least_squares_nonnegative_image(const Eigen::MatrixXd& E, const Eigen::VectorXd& f, const Eigen::MatrixXd& G) {
+  const Eigen::Index k = E.cols();
+  Eigen::HouseholderQR<Eigen::MatrixXd> qr(E);
+  const Eigen::MatrixXd R = qr.matrixQR().topRows(k).triangularView<Eigen::Upper>();
+  const double rmax = R.diagonal().cwiseAbs().maxCoeff();
+  if (!(R.diagonal().cwiseAbs().minCoeff() > 1e-12 * rmax))
+    throw Error(ErrorClass::bad_data, "black box with prior: design is rank-deficient (spectra do not see the prior's mean curve)");
+  const Eigen::VectorXd fq = (qr.householderQ().transpose() * f).head(k);
+  // Gt = G R⁻¹, so that with z = R c − fq the constraint reads Gt z ≥ −Gt fq.
+  const Eigen::MatrixXd Gt = R.transpose().triangularView<Eigen::Lower>().solve(G.transpose()).transpose();
+  const Eigen::VectorXd ht = -Gt * fq;
+  Eigen::MatrixXd M(k + 1, G.rows());
+  M.topRows(k) = Gt.transpose();
+  M.row(k) = ht.transpose();
+  Eigen::VectorXd e = Eigen::VectorXd::Zero(k + 1);
+  e(k) = 1;
+  const Eigen::VectorXd u = nnls(M, e);
+  const Eigen::VectorXd r = M * u - e;
+  if (!(std::abs(r(k)) > 1e-12))  // cannot happen for G c ≥ 0 (c = 0 is feasible); guards against round-off
+    throw Error(ErrorClass::internal, "black box with prior: non-negativity constraints reported incompatible");
+  const Eigen::VectorXd z = -r.head(k) / r(k);
+  return R.triangularView<Eigen::Upper>().solve(z + fq);
+}
+
+}  // namespace
+
+PriorFit fit_with_prior(const ChannelPrior& prior, const Eigen::MatrixXd& X, const Eigen::VectorXd& y) {
+  const Eigen::Index bands = X.cols(), n = X.rows(), k = prior.directions.cols();
+  if (prior.mean.size() != bands || prior.directions.rows() != bands || prior.sdev.size() != k)
+    throw Error(ErrorClass::bad_data, "black box with prior: prior has " + std::to_string(prior.mean.size()) +
+                                          " bands, spectra " + std::to_string(bands));
+  if (y.size() != n) throw Error(ErrorClass::bad_data, "black box with prior: RAW and spectra differ in length");
+  if (n < 3) throw Error(ErrorClass::bad_data, "black box with prior: need at least 3 patches");
+  const Eigen::VectorXd a = X * prior.mean;
+  if (!(a.squaredNorm() > 0)) throw Error(ErrorClass::bad_data, "black box with prior: spectra are zero where the prior's curve is not");
+  auto project = [&](const Eigen::MatrixXd& v) -> Eigen::MatrixXd { return v - a * (a.transpose() * v) / a.squaredNorm(); };
+
+  Reml reml;
+  reml.m = static_cast<double>(n - 1);
+  const Eigen::VectorXd Py = project(y);
+  reml.Py2 = Py.squaredNorm();
+  double lambda = 1;
+  if (k > 0) {
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(project(X * prior.directions * prior.sdev.asDiagonal()), Eigen::ComputeThinU);
+    reml.d2 = svd.singularValues().array().square();
+    reml.wPy = svd.matrixU().transpose() * Py;
+    const double top = std::max(reml.d2(0), 1e-300);
+    // Coarse log grid over every regime from "prior ignored" to "mean curve only", then a golden-section polish.
+    double best = -std::numeric_limits<double>::infinity();
+    const int steps = 97;
+    for (int s = 0; s < steps; ++s) {
+      const double l = top * std::pow(10.0, -14.0 + 18.0 * s / (steps - 1));
+      const double v = reml(l);
+      if (v > best) {
+        best = v;
+        lambda = l;
+      }
+    }
+    double lo = std::log(lambda) - std::log(10.0) * 18.0 / (steps - 1), hi = std::log(lambda) + std::log(10.0) * 18.0 / (steps - 1);
+    const double g = (std::sqrt(5.0) - 1) / 2;
+    for (int it = 0; it < 40; ++it) {
+      const double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo);
+      if (reml(std::exp(x1)) >= reml(std::exp(x2))) hi = x2;
+      else lo = x1;
+    }
+    lambda = std::exp(0.5 * (lo + hi));
+  }
+
+  Eigen::MatrixXd B(bands, k + 1);
+  B.col(0) = prior.mean;
+  B.rightCols(k) = prior.directions;
+  Eigen::MatrixXd E = Eigen::MatrixXd::Zero(n + k, k + 1);
+  E.topRows(n) = X * B;
+  for (Eigen::Index i = 0; i < k; ++i) E(n + i, i + 1) = std::sqrt(lambda) / prior.sdev(i);
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(n + k);
+  f.head(n) = y;
+  PriorFit fit;
+  fit.lambda = lambda;
+  fit.curve = (B * least_squares_nonnegative_image(E, f, B)).cwiseMax(0.0);  // clears round-off below zero
+  return fit;
+}
+
+}  // namespace colorlab::analysis
