@@ -476,6 +476,18 @@ asio::awaitable<SpectralReading> Spectrolino::measure_patch(const PatchVisit& pa
 
 // ---------------------------------------------------------------- table
 
+// Every simple table command: refused without a table or while not ready, a failure recorded
+// in the instrument state. `body` is a value, never a temporary inside the co_await (GCC 12).
+asio::awaitable<void> Spectrolino::table_command(sl::Bytes body, std::chrono::milliseconds timeout, std::string_view what) {
+  require_table(what);
+  require_ready(what);
+  try {
+    co_await scan_command(body, timeout, what);
+  } catch (const Error& e) {
+    fail(e);
+  }
+}
+
 asio::awaitable<void> Spectrolino::move_to(double x_mm, double y_mm) {
   require_table("move");
   require_ready("move");
@@ -487,47 +499,20 @@ asio::awaitable<void> Spectrolino::move_to(double x_mm, double y_mm) {
   }
 }
 
-asio::awaitable<void> Spectrolino::home() {
-  require_table("home");
-  require_ready("home");
-  try {
-    co_await scan_command(sl::req::move_home(), options_.timeouts.move, "move home");
-  } catch (const Error& e) {
-    fail(e);
-  }
-}
+asio::awaitable<void> Spectrolino::home() { co_await table_command(sl::req::move_home(), options_.timeouts.move, "move home"); }
 
 asio::awaitable<void> Spectrolino::head_up() {
-  require_table("raise the head");
-  require_ready("raise the head");
-  try {
-    co_await scan_command(sl::req::move_up(), options_.timeouts.move, "raise head");
-  } catch (const Error& e) {
-    fail(e);
-  }
+  co_await table_command(sl::req::move_up(), options_.timeouts.move, "raise the head");
 }
 
 asio::awaitable<void> Spectrolino::head_down() {
-  require_table("lower the head");
-  require_ready("lower the head");
-  try {
-    co_await scan_command(sl::req::move_down(), options_.timeouts.move, "lower head");
-  } catch (const Error& e) {
-    fail(e);
-  }
+  co_await table_command(sl::req::move_down(), options_.timeouts.move, "lower the head");
 }
 
 asio::awaitable<void> Spectrolino::hold_paper(bool hold) {
-  require_table("hold paper");
-  require_ready("hold paper");
-  try {
-    // Kept out of the co_await expression: GCC 12 destroys temporaries of a ?: inside co_await twice.
-    const sl::Bytes body = hold ? sl::req::hold_paper() : sl::req::release_paper();
-    const std::string_view what = hold ? "hold paper" : "release paper";
-    co_await scan_command(body, options_.timeouts.command, what);
-  } catch (const Error& e) {
-    fail(e);
-  }
+  sl::Bytes body = hold ? sl::req::hold_paper() : sl::req::release_paper();
+  const std::string_view what = hold ? "hold paper" : "release paper";
+  co_await table_command(std::move(body), options_.timeouts.command, what);
 }
 
 asio::awaitable<TablePosition> Spectrolino::position() {

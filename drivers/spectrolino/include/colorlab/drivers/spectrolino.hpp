@@ -100,6 +100,7 @@ class Spectrolino final : public Spectrometer, public XyTable {
   boost::asio::awaitable<void> identify();
   boost::asio::awaitable<void> apply_parameters();
   boost::asio::awaitable<void> scan_command(const sl::Bytes& body, std::chrono::milliseconds timeout, std::string_view what);
+  boost::asio::awaitable<void> table_command(sl::Bytes body, std::chrono::milliseconds timeout, std::string_view what);
   boost::asio::awaitable<void> download(const sl::Bytes& body, std::string_view what);
   boost::asio::awaitable<SpectralReading> read_spectrum_after_exec();
   boost::asio::awaitable<SpectralReading> measure_patch(const PatchVisit& patch);
