@@ -16,7 +16,7 @@ packages=(
   # standard CIE data at run time
   colord-data
   # independent references and test tools
-  argyll aravis-tools aravis-tools-cli libraw-bin dcraw python3-numpy hyperfine sqlite3 curl util-linux procps
+  argyll aravis-tools aravis-tools-cli libraw-bin dcraw python3-numpy hyperfine sqlite3 curl util-linux procps strace
 )
 
 missing=()

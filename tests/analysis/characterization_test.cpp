@@ -284,7 +284,7 @@ TEST(AnalysisBlackBox, PriorFromOtherCamerasRecoversCanon20dWithinTenPercent) {
   const double gain = 4095 * 0.9 / clean.maxCoeff();
   clean *= gain;
   const Eigen::MatrixXd true_curves = ssf.values * gain;
-  // Twelve noise draws. Over 200 draws (docs/perf/analysis.md) the per-draw error is ≤ 10 % of peak in 100 % (G),
+  // Twelve noise draws. Over 200 draws (docs/PERFORMANCE.md, "Analysis") the per-draw error is ≤ 10 % of peak in 100 % (G),
   // 94 % (R) and 86 % (B) of them, worst 6.4 / 15.7 / 14.4 %: at 0.5 % noise the SG under D65 cannot pin the B
   // channel's 410→430 nm edge in every draw. So the 10 % is asserted on the median draw, and every draw
   // against the measured worst case.

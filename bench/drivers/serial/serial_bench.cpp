@@ -1,7 +1,7 @@
 // Spectrolino/SpectroScan T driver speed against the simulator at time scale 1 (real device and
 // wire time): a chart read, and the per-command overhead above wire time + device time.
 // ArgyllCMS chartread itself is driven on the same simulator by bench_chartread_vs_colorlab
-// (chartread_vs_colorlab.cpp); see docs/perf/drivers-serial.md.
+// (chartread_vs_colorlab.cpp); see docs/PERFORMANCE.md ("Serial drivers").
 #include <benchmark/benchmark.h>
 
 #include <boost/asio/io_context.hpp>

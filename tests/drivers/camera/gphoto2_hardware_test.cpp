@@ -1,5 +1,5 @@
 // On the bench with the lab's EOS 20D (USB, Communication = normal mode). Skips with the reason
-// when no camera is attached, so CI runs it harmlessly. Bench command (see docs/perf/camera.md):
+// when no camera is attached, so CI runs it harmlessly. Bench command (see docs/PERFORMANCE.md, "Cameras"):
 //   ctest --test-dir build -L hardware -R camera_gphoto2_hardware --output-on-failure
 #include <gtest/gtest.h>
 
