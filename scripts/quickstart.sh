@@ -9,7 +9,8 @@ state="${COLORLAB_STATE:-./colorlab-state}"
 listen="${COLORLAB_LISTEN:-127.0.0.1:8765}"
 bin=build/bin
 
-"$bin/colorlabd" --state "$state" --listen "$listen" &
+mkdir -p "$state"
+"$bin/colorlabd" --state "$state" --listen "$listen" 2>>"$state/colorlabd.log" &
 daemon=$!
 trap 'kill -TERM $daemon 2>/dev/null; wait $daemon 2>/dev/null || true' EXIT
 
@@ -25,7 +26,8 @@ run_id=$("$bin/colorlab" --url "$url" run luminance-spot --id-only --param readi
 "$bin/colorlab" --url "$url" show "$run_id"
 cat <<MSG
 
-The reading above is stored in $state/colorlab.db (simulated instruments, flagged as such).
+The reading above is stored in $state/colorlab.db (simulated instruments, flagged as such);
+the daemon's log is $state/colorlabd.log.
 Query it again while a daemon runs:
   $bin/colorlabd --state $state --listen $listen &
   $bin/colorlab --url $url runs

@@ -1,5 +1,9 @@
 #include "colorlab/drivers/ls110.hpp"
 
+#include <boost/asio/steady_timer.hpp>
+#include <boost/asio/this_coro.hpp>
+#include <boost/asio/use_awaitable.hpp>
+
 #include "colorlab/core/log.hpp"
 #include "colorlab/drivers/ls110_protocol.hpp"
 
@@ -88,7 +92,14 @@ asio::awaitable<LuminanceReading> Ls110::measure_luminance() {
   if (state_ == InstrumentState::busy) {
     throw Error(ErrorClass::conflict, options_.id + " is busy with another measurement");
   }
-  if (!link_.is_open()) co_await connect();
+  // A campaign may start while the daemon is still connecting: wait for that exchange to finish
+  // rather than interleave our bytes with it on the same line.
+  auto give_up = std::chrono::steady_clock::now() + options_.reply_timeout * (options_.attempts + 1);
+  while (state_ == InstrumentState::initialising && std::chrono::steady_clock::now() < give_up) {
+    boost::asio::steady_timer pause(co_await boost::asio::this_coro::executor, std::chrono::milliseconds(20));
+    co_await pause.async_wait(boost::asio::use_awaitable);
+  }
+  if (!link_.is_open() || state_ == InstrumentState::disconnected) co_await connect();
   state_ = InstrumentState::busy;
   try {
     for (int attempt = 1;; ++attempt) {
