@@ -2,6 +2,8 @@
 
 #include <toml++/toml.h>
 
+#include "colorlab/core/toml_json.hpp"
+
 #include "colorlab/core/error.hpp"
 #include "colorlab/protocol/api.hpp"
 
@@ -49,23 +51,6 @@ namespace {
               file.string() + ":" + std::to_string(where.begin.line) + ": " + what, "see docs/configuration.md");
 }
 
-nlohmann::json to_json(const toml::node& node) {
-  if (auto t = node.as_table()) {
-    nlohmann::json j = nlohmann::json::object();
-    for (const auto& [k, v] : *t) j[std::string(k.str())] = to_json(v);
-    return j;
-  }
-  if (auto a = node.as_array()) {
-    nlohmann::json j = nlohmann::json::array();
-    for (const auto& v : *a) j.push_back(to_json(v));
-    return j;
-  }
-  if (auto v = node.value<bool>(); node.is_boolean()) return *v;
-  if (auto v = node.value<int64_t>(); node.is_integer()) return *v;
-  if (auto v = node.value<double>(); node.is_floating_point()) return *v;
-  if (auto v = node.value<std::string>()) return *v;
-  return nullptr;
-}
 
 }  // namespace
 
@@ -117,7 +102,7 @@ DaemonConfig load_config(const std::filesystem::path& file) {
         if (ic.id.empty() || ic.kind.empty() || ic.port.empty()) {
           bad(file, item.source(), "[[instrument]] needs id, kind and port");
         }
-        if (auto opts = (*t)["options"].as_table()) ic.options = to_json(*opts);
+        if (auto opts = (*t)["options"].as_table()) ic.options = toml_to_json(*opts);
         c.instruments.push_back(std::move(ic));
       }
     } else {

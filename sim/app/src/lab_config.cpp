@@ -4,6 +4,8 @@
 
 #include <toml++/toml.h>
 
+#include "colorlab/core/toml_json.hpp"
+
 #include "colorlab/core/error.hpp"
 
 namespace colorlab::sim {
@@ -15,23 +17,6 @@ namespace {
               "see docs/simulator.md");
 }
 
-nlohmann::json to_json(const toml::node& node) {
-  if (auto t = node.as_table()) {
-    nlohmann::json j = nlohmann::json::object();
-    for (const auto& [k, v] : *t) j[std::string(k.str())] = to_json(v);
-    return j;
-  }
-  if (auto a = node.as_array()) {
-    nlohmann::json j = nlohmann::json::array();
-    for (const auto& v : *a) j.push_back(to_json(v));
-    return j;
-  }
-  if (node.is_boolean()) return *node.value<bool>();
-  if (node.is_integer()) return *node.value<int64_t>();
-  if (node.is_floating_point()) return *node.value<double>();
-  if (auto v = node.value<std::string>()) return *v;
-  return nullptr;
-}
 
 }  // namespace
 
@@ -100,7 +85,7 @@ LabConfig load_lab_config(const std::filesystem::path& file) {
           c.ls110.aim_row = static_cast<int>((*a)[0].value_or(int64_t{0}));
           c.ls110.aim_col = static_cast<int>((*a)[1].value_or(int64_t{0}));
         } else if (s == "faults") {
-          c.ls110.faults = to_json(sn);
+          c.ls110.faults = toml_to_json(sn);
         } else {
           bad(file, sn, "unknown key ls110." + s);
         }
@@ -151,7 +136,7 @@ LabConfig load_lab_config(const std::filesystem::path& file) {
         } else if (s == "head") {
           sc.head_mm = pair("head");
         } else if (s == "faults") {
-          sc.faults = to_json(sn);
+          sc.faults = toml_to_json(sn);
         } else {
           bad(file, sn, "unknown key spectrolino." + s);
         }
@@ -185,7 +170,7 @@ LabConfig load_lab_config(const std::filesystem::path& file) {
             bad(file, sn, e.info().message);
           }
         } else if (s == "faults") {
-          dc.faults = to_json(sn);
+          dc.faults = toml_to_json(sn);
         } else {
           bad(file, sn, "unknown key dmx." + s);
         }
