@@ -25,7 +25,8 @@
 #include "colorlab/drivers/spectrolino.hpp"
 #include "colorlab/sim/scene.hpp"
 #include "run_support.hpp"   // tests/drivers/serial: runs a driver coroutine with a hard limit
-#include "sim_process.hpp"   // tests/sim/serial: colorlab-sim as a child process
+#include "sim_process.hpp"    // tests/sim/serial: colorlab-sim as a child process
+#include "colorlab/testing/process.hpp"
 
 namespace {
 
@@ -65,18 +66,8 @@ struct Run {
 Run g_argyll, g_colorlab;
 int g_patches = 0;
 
-bool on_path(const char* tool) {
-  return std::system((std::string("command -v ") + tool + " >/dev/null 2>&1").c_str()) == 0;
-}
-
-std::string shell(const std::string& cmd) {
-  std::string out;
-  std::unique_ptr<FILE, int (*)(FILE*)> p(::popen(cmd.c_str(), "r"), ::pclose);
-  if (!p) return out;
-  char buf[4096];
-  while (std::fgets(buf, sizeof buf, p.get())) out += buf;
-  return out;
-}
+using colorlab::testing::on_path;
+using colorlab::testing::shell_output;
 
 std::string sg_patch(int column) { return std::string(1, static_cast<char>('A' + column)) + std::to_string(kRow); }
 
@@ -133,7 +124,7 @@ void BM_ArgyllChartread(benchmark::State& state) {
                       " --workdir " + sim.dir().string() + " --patches " + std::to_string(patches) + " --first " +
                       coord(xy.front()) + " --last " + coord(xy.back()) + " --read-timeout 600 --log " +
                       log.string() + " --trace " + trace.string();
-    auto result = json::parse(shell(cmd), nullptr, false);
+    auto result = json::parse(shell_output(cmd), nullptr, false);
     for (const auto& f : {trace, log}) {
       std::error_code ec;
       std::filesystem::copy_file(f, keep_dir() / f.filename(), std::filesystem::copy_options::overwrite_existing, ec);
@@ -149,7 +140,7 @@ void BM_ArgyllChartread(benchmark::State& state) {
       state.SkipWithError(g_argyll.why.c_str());
       return;
     }
-    auto t = json::parse(shell("python3 " + src + "/bench/drivers/serial/serial_timeline.py " + trace.string() +
+    auto t = json::parse(shell_output("python3 " + src + "/bench/drivers/serial/serial_timeline.py " + trace.string() +
                                " --patches " + std::to_string(patches)),
                          nullptr, false);
     if (t.is_discarded()) {

@@ -15,23 +15,10 @@
 #include "../serial/sim_process.hpp"
 #include "colorlab/analysis/colorimetry.hpp"
 
-namespace {
+#include "colorlab/testing/process.hpp"
 
-bool on_path(const char* tool) {
-  std::string cmd = std::string("command -v ") + tool + " >/dev/null 2>&1";
-  return std::system(cmd.c_str()) == 0;
-}
-
-std::string run(const std::string& cmd) {
-  std::string out;
-  std::unique_ptr<FILE, int (*)(FILE*)> p(::popen(cmd.c_str(), "r"), ::pclose);
-  if (!p) return out;
-  char buf[4096];
-  while (std::fgets(buf, sizeof buf, p.get())) out += buf;
-  return out;
-}
-
-}  // namespace
+using colorlab::testing::on_path;
+using colorlab::testing::shell_output;
 
 // power_on_baud 19200 also exercises Argyll's speed scan and the 4D 27 switch back to 9600 (§5.4 d).
 class SimSpotread : public ::testing::TestWithParam<int> {};
@@ -58,7 +45,7 @@ enabled = false
   std::string cmd = "timeout 150 python3 " + driver + " spotread --port " + sim.port("spectrolino") + " --control " +
                     sim.announcement()["control"].get<std::string>() + " --patch D4 --workdir " + sim.dir().string() +
                     " --log " + log;
-  std::string out = run(cmd);
+  std::string out = shell_output(cmd);
   auto result = nlohmann::json::parse(out, nullptr, false);
   ASSERT_FALSE(result.is_discarded()) << "driver printed: " << out;
   ASSERT_TRUE(result.value("ok", false)) << result.dump() << "\n(see " << log << ")";
@@ -122,7 +109,7 @@ enabled = false
                     sim.announcement()["control"].get<std::string>() + " --workdir " + sim.dir().string() +
                     " --patches " + std::to_string(kPatches) + " --first " + xy(first) + " --last " + xy(last) +
                     " --log " + log;
-  std::string out = run(cmd);
+  std::string out = shell_output(cmd);
   auto result = nlohmann::json::parse(out, nullptr, false);
   ASSERT_FALSE(result.is_discarded()) << "driver printed: " << out;
   ASSERT_TRUE(result.value("ok", false)) << result.dump() << "\n(see " << log << ")";

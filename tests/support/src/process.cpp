@@ -7,7 +7,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <memory>
 #include <stdexcept>
 #include <thread>
 
@@ -18,6 +21,17 @@ namespace colorlab::testing {
 #endif
 
 std::string bin_path(const std::string& name) { return std::string(COLORLAB_BIN_DIR) + "/" + name; }
+
+bool on_path(const std::string& tool) { return std::system(("command -v " + tool + " >/dev/null 2>&1").c_str()) == 0; }
+
+std::string shell_output(const std::string& command) {
+  std::string out;
+  std::unique_ptr<FILE, int (*)(FILE*)> p(::popen(command.c_str(), "r"), ::pclose);
+  if (!p) return out;
+  char buf[4096];
+  while (std::fgets(buf, sizeof buf, p.get())) out += buf;
+  return out;
+}
 
 Process::Process(std::vector<std::string> argv, std::filesystem::path stderr_log,
                  std::optional<std::filesystem::path> working_dir) {

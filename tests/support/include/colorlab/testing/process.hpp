@@ -44,4 +44,9 @@ RunResult run_command(const std::vector<std::string>& argv, std::chrono::millise
 
 std::string bin_path(const std::string& name);  // COLORLAB_BIN_DIR/name
 
+// Whether an external tool (argyll, dcraw, unshare, ...) is installed, for skip-with-a-reason checks.
+bool on_path(const std::string& tool);
+// A shell command's standard output (empty if it could not start); its exit status is not reported.
+std::string shell_output(const std::string& command);
+
 }  // namespace colorlab::testing
