@@ -167,3 +167,27 @@ TEST(Store, ForeignCursorIsABadParameter) {
     }
   }
 }
+
+TEST(Store, ExecutionLifecycleKeepsRunExecutionAndEventLogInStep) {
+  TempDir dir;
+  Store store(dir / "colorlab.db");
+  auto e = store.create_execution(luminance_run()).execution;
+  store.start_execution(e);
+  EXPECT_EQ(store.run(e.run_id)->status, "running");
+  store.report_progress(e.id, 0.5, "reading/1");
+  EXPECT_DOUBLE_EQ(store.execution(e.id)->progress, 0.5);
+  EXPECT_EQ(store.execution(e.id)->step, "reading/1");
+  store.finish_execution(e, ExecutionStatus::finished_error, "reading/1", nullptr, {{"code", "misread"}});
+  auto run = store.run(e.run_id);
+  auto exec = store.execution(e.id);
+  EXPECT_EQ(run->status, "finished_error");
+  EXPECT_EQ(run->error["code"], "misread");
+  EXPECT_EQ(exec->status, ExecutionStatus::finished_error);
+  EXPECT_EQ(exec->error["code"], "misread");
+  auto events = store.events(0, 10, std::nullopt);
+  ASSERT_EQ(events.size(), 3u);  // created, progress, finished
+  EXPECT_EQ(events[0].topic, "execution");
+  EXPECT_EQ(events[1].topic, "progress");
+  EXPECT_EQ(events[1].payload["step"], "reading/1");
+  EXPECT_EQ(events[2].payload["status"], "finished_error");
+}

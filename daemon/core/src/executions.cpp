@@ -73,13 +73,9 @@ store::ExecutionRecord Executions::start(const std::string& campaign_name, const
         campaigns::CampaignContext ctx{instruments_, recorder, params,
                                        [&](double fraction, const std::string& step) {
                                          last_step = step;
-                                         store_.update_execution(record.id, ExecutionStatus::running, fraction, step);
-                                         store_.append_event("progress", {{"execution_id", record.id},
-                                                                          {"progress", fraction},
-                                                                          {"step", step}});
+                                         store_.report_progress(record.id, fraction, step);
                                        }};
-        store_.mark_run_started(record.run_id);
-        store_.update_execution(record.id, ExecutionStatus::running, 0, "starting");
+        store_.start_execution(record);
         nlohmann::json problem;
         nlohmann::json summary;
         ExecutionStatus status = ExecutionStatus::finished_ok;
@@ -97,10 +93,8 @@ store::ExecutionRecord Executions::start(const std::string& campaign_name, const
           log::error("executions", record.id + " failed: " + e.what());
         }
         try {
-          store_.finish_run(record.run_id, status, summary, problem);
-          store_.update_execution(record.id, status, status == ExecutionStatus::finished_ok ? 1.0 : 0.0,
-                                  status == ExecutionStatus::finished_ok ? "done" : last_step, problem);
-          store_.append_event("execution", {{"execution_id", record.id}, {"status", protocol::to_string(status)}});
+          store_.finish_execution(record, status, status == ExecutionStatus::finished_ok ? "done" : last_step, summary,
+                                  problem);
         } catch (const Error& e) {
           // The disk failed at the very end: what was committed stays committed; restart marks it interrupted.
           log::error("executions", record.id + ": cannot record the outcome: " + e.what());

@@ -133,8 +133,8 @@ Store::Created Store::create_execution(const NewRun& run) {
       .bind(4, run.idempotency_key)
       .bind(5, std::string_view(e.created_at))
       .run();
-  tx.commit();
   append_event("execution", e.to_json());
+  tx.commit();
   return {e, true};
 }
 
@@ -156,6 +156,29 @@ void Store::mark_run_started(const std::string& run_id) {
       .bind(1, std::string_view(run_id))
       .bind(2, std::string_view(now_iso8601()))
       .run();
+}
+
+void Store::start_execution(const ExecutionRecord& execution) {
+  Transaction tx(db_);
+  mark_run_started(execution.run_id);
+  update_execution(execution.id, ExecutionStatus::running, 0, "starting");
+  tx.commit();
+}
+
+void Store::report_progress(const std::string& execution_id, double progress, const std::string& step) {
+  Transaction tx(db_);
+  update_execution(execution_id, ExecutionStatus::running, progress, step);
+  append_event("progress", {{"execution_id", execution_id}, {"progress", progress}, {"step", step}});
+  tx.commit();
+}
+
+void Store::finish_execution(const ExecutionRecord& execution, ExecutionStatus status, const std::string& step,
+                             const nlohmann::json& summary, const nlohmann::json& error) {
+  Transaction tx(db_);
+  finish_run(execution.run_id, status, summary, error);
+  update_execution(execution.id, status, status == ExecutionStatus::finished_ok ? 1.0 : 0.0, step, error);
+  append_event("execution", {{"execution_id", execution.id}, {"status", protocol::to_string(status)}});
+  tx.commit();
 }
 
 void Store::finish_run(const std::string& run_id, ExecutionStatus status, const nlohmann::json& summary,

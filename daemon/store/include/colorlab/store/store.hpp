@@ -95,6 +95,13 @@ class Store {
                   const nlohmann::json& error);
   void mark_run_started(const std::string& run_id);
 
+  // The execution's state changes, each one transaction (one fsync) so that the run, the
+  // execution and the event log never disagree after a crash.
+  void start_execution(const ExecutionRecord& execution);
+  void report_progress(const std::string& execution_id, double progress, const std::string& step);
+  void finish_execution(const ExecutionRecord& execution, protocol::ExecutionStatus status, const std::string& step,
+                        const nlohmann::json& summary, const nlohmann::json& error);
+
   // Durable on return (synchronous=FULL). A repeated step is refused with Error{conflict}.
   void add_measurement(const std::string& run_id, const std::string& step, const std::string& instrument_id,
                        bool simulated, const std::string& quantity, std::optional<double> value,
