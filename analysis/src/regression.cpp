@@ -53,8 +53,9 @@ Solution solve(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y, double ridge,
 
 Eigen::MatrixXd target_of(const ChartData& d, FitTarget t) { return t == FitTarget::lab_direct ? d.lab : d.xyz; }
 
-// Row weights (square roots of the least-squares weights) for the target.
-Eigen::VectorXd row_weights(const ChartData& d, FitTarget t) {
+}  // namespace
+
+Eigen::VectorXd target_weights(const ChartData& d, FitTarget t) {
   Eigen::VectorXd w = Eigen::VectorXd::Ones(static_cast<Eigen::Index>(d.size()));
   if (t != FitTarget::xyz_lightness_weighted) return w;
   for (Eigen::Index i = 0; i < w.size(); ++i) {
@@ -64,6 +65,9 @@ Eigen::VectorXd row_weights(const ChartData& d, FitTarget t) {
   }
   return w;
 }
+
+namespace {
+Eigen::VectorXd row_weights(const ChartData& d, FitTarget t) { return target_weights(d, t); }
 
 double scale_for(const ChartData& d, const FitOptions& o) {
   if (o.input_scale > 0) return o.input_scale;
@@ -261,6 +265,7 @@ FitReport fit_report(const TermSet& terms, const ChartData& data, const FitOptio
   FitReport r;
   r.method = terms.name;
   r.terms = terms.size();
+  r.parameters = static_cast<double>(terms.size());
   r.target = o.target;
   r.cv_name = cv.name();
   try {
@@ -273,6 +278,26 @@ FitReport fit_report(const TermSet& terms, const ChartData& data, const FitOptio
   }
   r.cv = cross_validate(terms, data, o, cv);
   return r;
+}
+
+void choose_smallest_within_tolerance(Selection& s, const SelectionOptions& so, std::size_t patches) {
+  if (s.candidates.empty()) throw Error(ErrorClass::bad_parameter, "no candidate models to select from");
+  s.tolerance = so.tolerance_de00;
+  s.best = s.chosen = 0;
+  auto mean = [&](std::size_t i) { return s.candidates[i].cv.s00.mean; };
+  for (std::size_t i = 1; i < s.candidates.size(); ++i)
+    if (mean(i) < mean(s.best)) s.best = i;
+  if (!std::isfinite(mean(s.best)))
+    throw Error(ErrorClass::bad_data, "no candidate model could be cross-validated on " + std::to_string(patches) + " patches");
+  bool found = false;
+  for (std::size_t i = 0; i < s.candidates.size(); ++i) {
+    if (!(mean(i) <= mean(s.best) + so.tolerance_de00)) continue;
+    const double pi = s.candidates[i].parameters, pc = s.candidates[s.chosen].parameters;
+    if (!found || pi < pc || (pi == pc && mean(i) < mean(s.chosen))) {
+      s.chosen = i;
+      found = true;
+    }
+  }
 }
 
 Selection select_model(const std::vector<TermSet>& sets, const std::vector<FitTarget>& targets, const ChartData& data,
@@ -288,20 +313,7 @@ Selection select_model(const std::vector<TermSet>& sets, const std::vector<FitTa
       fo.target = t;
       s.candidates.push_back(fit_report(set, data, fo, cv));
     }
-  auto mean = [&](std::size_t i) { return s.candidates[i].cv.s00.mean; };
-  for (std::size_t i = 1; i < s.candidates.size(); ++i)
-    if (mean(i) < mean(s.best)) s.best = i;
-  if (!std::isfinite(mean(s.best)))
-    throw Error(ErrorClass::bad_data, "no candidate model could be cross-validated on " + std::to_string(data.size()) + " patches");
-  bool found = false;
-  for (std::size_t i = 0; i < s.candidates.size(); ++i) {
-    if (!(mean(i) <= mean(s.best) + so.tolerance_de00)) continue;
-    if (!found || s.candidates[i].terms < s.candidates[s.chosen].terms ||
-        (s.candidates[i].terms == s.candidates[s.chosen].terms && mean(i) < mean(s.chosen))) {
-      s.chosen = i;
-      found = true;
-    }
-  }
+  choose_smallest_within_tolerance(s, so, data.size());
   return s;
 }
 

@@ -10,6 +10,7 @@
 #include <regex>
 
 #include "colorlab/analysis/blackbox.hpp"
+#include "colorlab/analysis/characterization.hpp"
 #include "colorlab/analysis/chart_io.hpp"
 #include "colorlab/analysis/color_difference.hpp"
 #include "colorlab/analysis/colorimetry.hpp"
@@ -172,34 +173,95 @@ TEST(AnalysisArgyllComparison, LutFitVersusColprofLutOnTheSameChart) {
   auto r = ca::fit_report(ca::root_polynomial_set(2), c, o, ca::CvSpec::loo());
   std::cout << "CC24 self-check dE00 mean/max: colprof -ql -ax " << ax.avg << "/" << ax.peak << "; colorlab rootpoly:2 training "
             << r.training.s00.mean << "/" << r.training.s00.max << ", LOO " << r.cv.s00.mean << "/" << r.cv.s00.max << "\n";
-  // A 6-term root-polynomial fits the training chart as well as Argyll's cLUT does.
-  EXPECT_LE(r.training.s00.mean, ax.avg + 0.2);
+  // A 6-term root-polynomial fits the training chart at least as well as Argyll's cLUT does (no slack: measured 0.73 vs 1.17).
+  EXPECT_LE(r.training.s00.mean, ax.avg);
   // Its honest (held-out) error is reported beside it and is necessarily larger.
   EXPECT_GE(r.cv.s00.mean, r.training.s00.mean);
 }
 
-TEST(AnalysisGeneralisation, BestCrossValidatedModelTrainedOnSgBeatsColprofAxOnCc24) {
+// Issue 12's worst-patch target: trained on the SG, tested on the CC24, the model that cross-validated selection picks
+// among every family must beat ArgyllCMS colprof -ax (XYZ cLUT, -qm as in colorimetry-notes §6) on the mean AND on the
+// maximum ΔE00. colprof runs here, on the same two charts, so the reference is measured, not copied.
+TEST(AnalysisGeneralisation, SelectedModelTrainedOnSgBeatsColprofAxOnCc24MeanAndWorstPatch) {
   COLORLAB_REQUIRE_SHARED(sg, "testvec_sg140_canon20d_d50_argyll.csv");
   COLORLAB_REQUIRE_SHARED(cc24, "testvec_cc24_canon20d_d50_argyll.csv");
+  COLORLAB_REQUIRE_TOOL("colprof");
+  COLORLAB_REQUIRE_TOOL("profcheck");
   ca::ChartData train = ca::read_chart(sg), test = ca::read_chart(cc24);
+  auto dir = ca::testing::temp_dir("colprof-sg");
+  const ArgyllResult ax = argyll_profile_check(train, "x", dir, true, &test, "m");
+  ASSERT_TRUE(std::isfinite(ax.avg)) << "colprof/profcheck failed in " << dir;
+
   ca::FitOptions o;
   o.input_scale = 1.0;  // both charts are white-balanced to perfect white = 1
-  auto sel = ca::select_model(ca::all_term_sets(),
-                              {ca::FitTarget::xyz_then_lab, ca::FitTarget::xyz_lightness_weighted, ca::FitTarget::lab_direct}, train, o,
-                              ca::CvSpec::loo());
+  auto sel = ca::select_method(ca::all_methods(),
+                               {ca::FitTarget::xyz_then_lab, ca::FitTarget::xyz_lightness_weighted, ca::FitTarget::lab_direct}, train, o,
+                               ca::CvSpec::loo());
   const auto& ch = sel.candidates[sel.chosen];
   ca::FitOptions fo = o;
   fo.target = ch.target;
-  auto model = ca::fit(ca::term_set_by_name(ch.method), train, fo);
-  auto e = ca::evaluate(model.apply(test.rgb), test.lab);
-  std::cout << "chosen " << ch.method << " (" << ca::to_string(ch.target) << ", " << ch.terms << " terms; best "
-            << sel.candidates[sel.best].method << " LOO " << sel.candidates[sel.best].cv.s00.mean << ") on CC24: dE00 mean "
-            << e.s00.mean << " max " << e.s00.max << " (colprof -ax: 0.67 / 1.49)\n";
-  // Independent bar: Argyll's own SG-trained cLUT profile evaluated on CC24 (stored predictions, colorimetry-notes §6).
-  EXPECT_LE(e.s00.mean, 0.67);
-  // colprof -ax reaches max 1.49; no polynomial family here gets below about 1.9 on the worst CC24 patch (a
-  // saturated colour outside the SG's gamut). Shortfall recorded in the report; the bound below guards regressions.
-  EXPECT_LE(e.s00.max, 2.2);
+  auto e = ca::evaluate(ca::fit_method(ch.method, train, fo).apply(test.rgb), test.lab);
+
+  // The best polynomial under the same selection, for the record: the family the spline had to beat.
+  std::vector<std::string> polys;
+  for (const auto& s : ca::all_term_sets()) polys.push_back(s.name);
+  auto psel = ca::select_method(polys, {ca::FitTarget::xyz_then_lab, ca::FitTarget::xyz_lightness_weighted, ca::FitTarget::lab_direct},
+                                train, o, ca::CvSpec::loo());
+  ca::FitOptions po = o;
+  po.target = psel.candidates[psel.chosen].target;
+  auto pe = ca::evaluate(ca::fit_method(psel.candidates[psel.chosen].method, train, po).apply(test.rgb), test.lab);
+
+  std::cout << "chosen " << ch.method << " (" << ca::to_string(ch.target) << ", " << ch.parameters << " effective parameters, LOO "
+            << ch.cv.s00.mean << "; best " << sel.candidates[sel.best].method << " LOO " << sel.candidates[sel.best].cv.s00.mean
+            << ") on CC24: dE00 mean " << e.s00.mean << " max " << e.s00.max << "; colprof -qm -ax (this run): mean " << ax.avg
+            << " max " << ax.peak << "; best polynomial " << psel.candidates[psel.chosen].method << ": " << pe.s00.mean << " / "
+            << pe.s00.max << "\n";
+  EXPECT_TRUE(ca::is_spline_method(ch.method)) << "selection should prefer the spline here: its LOO is lower by more than the tolerance";
+  EXPECT_LT(e.s00.mean, ax.avg);
+  EXPECT_LT(e.s00.max, ax.peak);
+}
+
+// The spline's leave-one-out errors come from the leverage identity; they must equal explicit refits at the same λ,
+// else the selection above would compare the spline on a different footing from the polynomials.
+TEST(AnalysisSpline, LeaveOneOutMatchesExplicitRefitsAndInterpolatesWithoutSmoothing) {
+  ca::ChartData c = synthetic_chart(40, 11);
+  c.xyz.resize(40, 3);
+  for (Eigen::Index i = 0; i < 40; ++i) {
+    const double r = c.rgb(i, 0), g = c.rgb(i, 1), b = c.rgb(i, 2);
+    c.xyz.row(i) << 40 * r + 30 * g + 15 * b + 5 * std::sin(3 * r * g), 20 * r + 70 * g + 10 * b + 4 * std::cos(2 * b),
+        2 * r + 10 * g + 90 * b + 3 * r * b;
+  }
+  c.lab = ca::xyz_rows_to_lab(c.xyz, c.white);
+  ca::SplineOptions so;
+  so.input_scale = 1.0;
+  so.smoothing = 1e-4;
+  auto loo = ca::spline_report(c, so, ca::CvSpec::loo());
+  for (std::size_t i = 0; i < c.size(); i += 7) {
+    std::vector<std::size_t> rest;
+    for (std::size_t j = 0; j < c.size(); ++j)
+      if (j != i) rest.push_back(j);
+    auto m = ca::fit_spline(c.subset(rest), so);
+    Eigen::MatrixXd lab = m.apply(c.rgb.row(static_cast<Eigen::Index>(i)));
+    const auto ii = static_cast<Eigen::Index>(i);
+    EXPECT_NEAR(loo.cv.de76[i], ca::delta_e76({lab(0, 0), lab(0, 1), lab(0, 2)}, {c.lab(ii, 0), c.lab(ii, 1), c.lab(ii, 2)}), 1e-6)
+        << "patch " << i;
+  }
+  // Without smoothing the spline passes through every training patch, and has one parameter per patch.
+  so.smoothing = 0;
+  auto exact = ca::fit_spline(c, so);
+  EXPECT_LT(ca::evaluate(exact.apply(c.rgb), c.lab).s76.max, 1e-6);
+  EXPECT_NEAR(exact.effective_parameters(), 40, 1e-6);
+  // A pure 3×3 matrix is in the base, so heavy smoothing recovers it wherever the data are linear.
+  ca::ChartData lin = c;
+  Eigen::Matrix3d M;
+  M << 41, 35, 18, 21, 72, 7, 2, 12, 95;
+  lin.xyz = c.rgb * M.transpose();
+  lin.lab = ca::xyz_rows_to_lab(lin.xyz, lin.white);
+  so.smoothing.reset();
+  auto fitted = ca::fit_spline(lin, so);
+  Eigen::MatrixXd probe(1, 3);
+  probe << 0.9, 0.05, 0.3;  // outside the sampled cube's interior, still linear
+  EXPECT_NEAR((fitted.predict_target(probe) - probe * M.transpose()).cwiseAbs().maxCoeff(), 0, 1e-6);
 }
 
 // §7.4 on synthetic data: Canon 20D sensitivities × D65 × SG spectra, 0.5 % noise.

@@ -88,6 +88,9 @@ ErrorStats cross_validate(const TermSet& terms, const ChartData& data, const Fit
 struct FitReport {
   std::string method;
   std::size_t terms = 0;
+  // Effective number of parameters per channel: the term count for a polynomial, tr(H) for a smoothing spline.
+  // Selection compares models by this, so a spline with 140 centres but heavy smoothing counts as small.
+  double parameters = 0;
   FitTarget target = FitTarget::xyz_then_lab;
   ErrorStats training, cv;
   std::string cv_name;
@@ -109,6 +112,13 @@ struct Selection {
 Selection select_model(const std::vector<TermSet>& sets, const std::vector<FitTarget>& targets, const ChartData& data,
                        const FitOptions& options = {}, const CvSpec& cv = CvSpec::loo(),
                        const SelectionOptions& selection = {});
+
+// The rule shared by every selection: best = lowest mean CV ΔE00; chosen = fewest `parameters` among candidates within
+// the tolerance of the best (ties to the lower error). Throws Error(bad_data) if nothing could be cross-validated.
+void choose_smallest_within_tolerance(Selection& selection, const SelectionOptions& options, std::size_t patches);
+
+// Square roots of the least-squares row weights for a target (ones, or the slope of L* for xyz_lightness_weighted).
+Eigen::VectorXd target_weights(const ChartData& data, FitTarget target);
 
 // Row-wise conversions for n × 3 matrices.
 Eigen::MatrixXd xyz_rows_to_lab(const Eigen::MatrixXd& xyz, const Xyz& white);
