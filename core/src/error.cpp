@@ -19,6 +19,8 @@ std::string_view to_string(ErrorClass c) {
     case ErrorClass::io_error: return "io_error";
     case ErrorClass::not_found: return "not_found";
     case ErrorClass::conflict: return "conflict";
+    case ErrorClass::script_error: return "script_error";
+    case ErrorClass::aborted: return "aborted";
     case ErrorClass::internal: return "internal";
   }
   return "internal";

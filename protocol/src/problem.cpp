@@ -63,6 +63,16 @@ Problem problem_from_error(const Error& e) {
       p.category = ProblemCategory::undefined_execution;
       p.title = "Storage failure";
       break;
+    case ErrorClass::script_error:
+      p.status = 422;
+      p.category = ProblemCategory::defined_execution;
+      p.title = "Campaign script failed";
+      break;
+    case ErrorClass::aborted:
+      p.status = 409;
+      p.category = ProblemCategory::defined_execution;
+      p.title = "Aborted";
+      break;
     case ErrorClass::internal:
       p.status = 500;
       p.category = ProblemCategory::undefined_execution;

@@ -50,7 +50,8 @@ unsigned page_limit(const HttpRequest& req) {
 }
 
 HttpResponse get_root(ApiContext& ctx) {
-  json features = json::array({"instruments", "ports", "events", "campaigns", "executions", "runs", "problem+json",
+  json features = json::array({"instruments", "ports", "events", "campaigns", "lua-campaigns", "executions",
+                               "execution-control", "resume-after-restart", "runs", "run-script", "problem+json",
                                "cursor-paging", "idempotency-key"});
   return HttpResponse::json(200, {{"server", "colorlabd"},
                                   {"server_version", COLORLAB_VERSION},
@@ -70,11 +71,43 @@ HttpResponse get_instruments(ApiContext& ctx) {
 }
 
 HttpResponse get_campaigns(ApiContext& ctx) {
+  // Re-read on every request: a script dropped into the campaigns directory appears at once.
+  ctx.catalogue.refresh();
   json items = json::array();
-  for (const auto* c : ctx.campaigns.all()) {
-    items.push_back({{"name", c->name()}, {"description", c->description()}, {"parameters", c->parameters()}});
+  for (const auto& c : ctx.catalogue.all()) items.push_back(c->to_json());
+  json broken = json::array();
+  for (const auto& b : ctx.catalogue.broken()) broken.push_back({{"path", b.path.string()}, {"error", b.error}});
+  json dirs = json::array();
+  for (const auto& d : ctx.catalogue.directories()) dirs.push_back({{"path", d.path.string()}, {"origin", d.origin}});
+  return HttpResponse::json(200, {{"items", items}, {"broken", broken}, {"directories", dirs}});
+}
+
+HttpResponse post_execution_control(ApiContext& ctx, const std::string& id, const std::string& action) {
+  store::ExecutionRecord record;
+  if (action == "pause") {
+    record = ctx.executions.pause(id);
+  } else if (action == "resume") {
+    record = ctx.executions.resume(id);
+  } else {
+    record = ctx.executions.abort(id);
   }
-  return HttpResponse::json(200, {{"items", items}});
+  auto r = HttpResponse::json(202, record.to_json());
+  r.headers["Location"] = std::string(protocol::kPrefix) + "/executions/" + id;
+  return r;
+}
+
+HttpResponse get_run_script(ApiContext& ctx, const std::string& id) {
+  auto r = ctx.store.run(id);
+  if (!r) throw Error(ErrorClass::not_found, "no run with id '" + id + "'");
+  if (r->script_sha256.empty()) throw Error(ErrorClass::not_found, "run '" + id + "' predates stored scripts");
+  auto source = ctx.store.script_source(r->script_sha256);
+  if (!source) throw Error(ErrorClass::not_found, "the script of run '" + id + "' is missing");
+  HttpResponse resp;
+  resp.status = 200;
+  resp.content_type = "text/x-lua; charset=utf-8";
+  resp.body = *source;
+  resp.headers["ETag"] = "\"" + r->script_sha256 + "\"";
+  return resp;
 }
 
 HttpResponse post_execution(ApiContext& ctx, const HttpRequest& req) {
@@ -202,11 +235,27 @@ HttpResponse handle_api(ApiContext& ctx, const HttpRequest& req) {
       if (req.method != "GET") return method_not_allowed(req, "GET");
       return get_execution(ctx, p.substr(exec_prefix.size()));
     }
+    if (p.rfind(exec_prefix, 0) == 0) {
+      auto rest = p.substr(exec_prefix.size());
+      auto slash = rest.find('/');
+      if (slash != std::string::npos && slash > 0) {
+        std::string action = rest.substr(slash + 1);
+        if (action == "pause" || action == "resume" || action == "abort") {
+          if (req.method != "POST") return method_not_allowed(req, "POST");
+          return post_execution_control(ctx, rest.substr(0, slash), action);
+        }
+      }
+    }
     if (p == prefix + "/runs") {
       if (req.method != "GET") return method_not_allowed(req, "GET");
       return get_runs(ctx, req);
     }
     const std::string run_prefix = prefix + "/runs/";
+    if (p.rfind(run_prefix, 0) == 0 && p.size() > run_prefix.size() + 7 && p.ends_with("/script") &&
+        p.find('/', run_prefix.size()) == p.size() - 7) {
+      if (req.method != "GET") return method_not_allowed(req, "GET");
+      return get_run_script(ctx, p.substr(run_prefix.size(), p.size() - 7 - run_prefix.size()));
+    }
     if (p.rfind(run_prefix, 0) == 0 && p.size() > run_prefix.size() && p.find('/', run_prefix.size()) == std::string::npos) {
       if (req.method != "GET") return method_not_allowed(req, "GET");
       return get_run(ctx, p.substr(run_prefix.size()));

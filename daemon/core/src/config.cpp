@@ -15,6 +15,10 @@ std::filesystem::path DaemonConfig::socket_path() const {
   return unix_socket ? *unix_socket : state_dir / std::string(protocol::kSocketName);
 }
 
+std::filesystem::path DaemonConfig::campaign_dir() const {
+  return campaigns.directory ? *campaigns.directory : state_dir / "campaigns";
+}
+
 DaemonConfig embedded_default_config() {
   DaemonConfig c;
   c.simulator.enabled = true;
@@ -88,6 +92,46 @@ DaemonConfig load_config(const std::filesystem::path& file) {
       if (auto v = (*t)["config"].value<std::string>()) c.simulator.config = resolve(*v);
       if (auto v = (*t)["time_scale"].value<double>()) c.simulator.time_scale = *v;
       if (auto v = (*t)["seed"].value<int64_t>()) c.simulator.seed = static_cast<std::uint64_t>(*v);
+    } else if (k == "campaigns") {
+      auto t = node.as_table();
+      if (!t) bad(file, node.source(), "[campaigns] must be a table");
+      for (const auto& [ckey, cnode] : *t) {
+        std::string ck(ckey.str());
+        auto number = [&](double& out, double lo, double hi) {
+          auto v = cnode.value<double>();
+          if (!v || *v < lo || *v > hi) {
+            bad(file, cnode.source(), "campaigns." + ck + " must be a number from " + std::to_string(lo) + " to " + std::to_string(hi));
+          }
+          out = *v;
+        };
+        if (ck == "directory") {
+          auto v = cnode.value<std::string>();
+          if (!v) bad(file, cnode.source(), "campaigns.directory must be a path");
+          c.campaigns.directory = resolve(*v);
+        } else if (ck == "max_resume_attempts") {
+          double v = 0;
+          number(v, 1, 100);
+          c.campaigns.max_resume_attempts = static_cast<int>(v);
+        } else if (ck == "lamps_off_at_shutdown") {
+          auto v = cnode.value<bool>();
+          if (!v) bad(file, cnode.source(), "campaigns.lamps_off_at_shutdown must be true or false");
+          c.campaigns.lamps_off_at_shutdown = *v;
+        } else if (ck == "lamp_warmup_s") {
+          number(c.campaigns.lamp_warmup_s, 0, 86400);
+        } else if (ck == "stable_tolerance_pct") {
+          number(c.campaigns.stable_tolerance_pct, 1e-4, 100);
+        } else if (ck == "stable_window_s") {
+          number(c.campaigns.stable_window_s, 0, 86400);
+        } else if (ck == "stable_interval_s") {
+          number(c.campaigns.stable_interval_s, 0.01, 3600);
+        } else if (ck == "stable_timeout_s") {
+          number(c.campaigns.stable_timeout_s, 0, 7 * 86400);
+        } else if (ck == "time_scale") {
+          number(c.campaigns.time_scale, 1e-3, 1e6);
+        } else {
+          bad(file, cnode.source(), "unknown key 'campaigns." + ck + "'");
+        }
+      }
     } else if (k == "instrument") {
       auto arr = node.as_array();
       if (!arr) bad(file, node.source(), "instruments are [[instrument]] tables");

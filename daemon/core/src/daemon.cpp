@@ -8,11 +8,14 @@
 #include <boost/asio/detached.hpp>
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/signal_set.hpp>
+#include <boost/asio/steady_timer.hpp>
 #include <boost/asio/use_awaitable.hpp>
 
 #include "colorlab/core/error.hpp"
 #include "colorlab/core/ids.hpp"
 #include "colorlab/core/log.hpp"
+#include "colorlab/campaigns/catalogue.hpp"
+#include "colorlab/campaigns/lab.hpp"
 #include "colorlab/daemon/api.hpp"
 #include "colorlab/daemon/embedded_sim.hpp"
 #include "colorlab/daemon/executions.hpp"
@@ -30,7 +33,8 @@ struct Daemon::Impl {
   std::unique_ptr<EmbeddedSim> sim;
   std::unique_ptr<store::Store> store;
   campaigns::InstrumentSet instruments;
-  campaigns::CampaignRegistry campaigns = campaigns::CampaignRegistry::with_builtin_campaigns();
+  std::unique_ptr<campaigns::ScriptCatalogue> catalogue;
+  std::unique_ptr<campaigns::Lab> lab;
   std::unique_ptr<Executions> executions;
   std::unique_ptr<ApiContext> api;
   std::unique_ptr<http::Server> server;
@@ -108,8 +112,27 @@ Daemon::Daemon(DaemonConfig config) : impl_(std::make_unique<Impl>()) {
     }
   }
   d.discovery = std::make_unique<drivers::Discovery>(std::move(rules));
-  d.executions = std::make_unique<Executions>(d.io, *d.store, d.campaigns, d.instruments);
-  d.api = std::make_unique<ApiContext>(ApiContext{*d.store, d.instruments, d.campaigns, *d.executions,
+
+  std::error_code ec;
+  std::filesystem::create_directories(d.config.campaign_dir(), ec);
+  d.catalogue = std::make_unique<campaigns::ScriptCatalogue>(std::vector<campaigns::CampaignDirectory>{
+      {campaigns::shipped_campaign_dir(), "shipped"}, {d.config.campaign_dir(), "lab"}});
+  if (d.catalogue->all().empty()) {
+    log::warning("colorlabd", "no campaign scripts found in " + campaigns::shipped_campaign_dir().string() + " or " +
+                                  d.config.campaign_dir().string());
+  }
+  campaigns::LabOptions lab_options;
+  const auto& cc = d.config.campaigns;
+  lab_options.time_scale = cc.time_scale;
+  if (d.sim) lab_options.time_scale = d.sim->announcement().value("time_scale", 1.0);
+  lab_options.warmup = {cc.stable_tolerance_pct, cc.stable_window_s, cc.stable_interval_s, cc.stable_timeout_s};
+  lab_options.lamp_warmup_s = cc.lamp_warmup_s;
+  lab_options.lamps_off_at_shutdown = cc.lamps_off_at_shutdown;
+  d.lab = std::make_unique<campaigns::Lab>(d.io.get_executor(), d.instruments, lab_options);
+  d.executions = std::make_unique<Executions>(d.io, *d.store, *d.catalogue, d.instruments, *d.lab,
+                                              ExecutionOptions{cc.max_resume_attempts},
+                                              [&d](const std::string& text) { d.notifier.status(text); });
+  d.api = std::make_unique<ApiContext>(ApiContext{*d.store, d.instruments, *d.catalogue, *d.executions,
                                                   d.config.simulator.enabled, now_iso8601(), d.discovery.get(), ""});
 
   http::ServerOptions so;
@@ -157,14 +180,33 @@ int Daemon::run() {
   d.monitor->start();
   d.api->hotplug_status = d.monitor->hotplug_status();
 
+  // Executions left by a previous process (crash, power cut, shutdown) continue by themselves.
+  // After discovery's first scan, so instruments are already connecting when a resume needs them.
+  d.executions->resume_unfinished();
+
   asio::signal_set signals(d.io, SIGINT, SIGTERM);
   signals.async_wait([&](boost::system::error_code ec, int sig) {
     if (ec) return;
-    log::info("colorlabd", "signal " + std::to_string(sig) + ": stopping");
+    log::info("colorlabd", "signal " + std::to_string(sig) + ": stopping at the running steps' next safe point");
     d.notifier.stopping();
     d.server->stop();
     d.monitor->stop();
-    d.io.stop();
+    // Running steps finish (or their waits are cut short), then the instruments go to a safe state.
+    d.executions->shutdown([&d] {
+      asio::co_spawn(
+          d.io,
+          [&d]() -> asio::awaitable<void> {
+            co_await d.lab->safe_state();
+            d.io.stop();
+          },
+          asio::detached);
+    });
+    // A second signal, or an instrument that never answers, must not keep the daemon alive.
+    auto hard_stop = std::make_shared<asio::steady_timer>(d.io, std::chrono::seconds(20));
+    hard_stop->async_wait([&d, hard_stop](boost::system::error_code) { d.io.stop(); });
+    signals.async_wait([&d](boost::system::error_code e, int) {
+      if (!e) d.io.stop();
+    });
   });
 
   std::string where = d.config.listen_host + ":" + std::to_string(d.server->bound_port()) + " and " +

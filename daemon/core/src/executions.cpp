@@ -1,9 +1,13 @@
 #include "colorlab/daemon/executions.hpp"
 
+#include <cmath>
+#include <random>
+
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/detached.hpp>
 #include <boost/asio/use_awaitable.hpp>
 
+#include "colorlab/campaigns/engine.hpp"
 #include "colorlab/core/error.hpp"
 #include "colorlab/core/log.hpp"
 #include "colorlab/protocol/problem.hpp"
@@ -11,98 +15,308 @@
 namespace colorlab::daemon {
 
 namespace asio = boost::asio;
+using nlohmann::json;
 using protocol::ExecutionStatus;
+using Request = campaigns::ExecutionControl::Request;
+
+struct Executions::Active {
+  store::ExecutionRecord record;
+  campaigns::ExecutionControl control;
+};
 
 namespace {
 
-class StoreRecorder final : public campaigns::RunRecorder {
+// The engine's persistence, over the store: one step, one transaction.
+class StoreSink final : public campaigns::ExecutionSink {
  public:
-  StoreRecorder(store::Store& store, std::string run_id, const campaigns::InstrumentSet& instruments)
-      : store_(store), run_id_(std::move(run_id)), instruments_(instruments) {}
+  StoreSink(store::Store& store, const store::ExecutionRecord& record, const campaigns::InstrumentSet& instruments,
+            std::function<void(const std::string&)> status)
+      : store_(store), record_(record), instruments_(instruments), status_(std::move(status)) {}
 
-  void record(const campaigns::Measurement& m) override {
-    auto instrument = instruments_.find(m.instrument_id);
-    bool simulated = instrument ? instrument->identity().simulated : false;
-    std::optional<double> value;
-    if (!std::isnan(m.value)) value = m.value;
-    store_.add_measurement(run_id_, m.step, m.instrument_id, simulated, m.quantity, value, m.unit, m.data);
+  void commit(const campaigns::StepCommit& step) override {
+    store::StepRecord s;
+    s.progress = step.progress;
+    s.step = step.label;
+    for (const auto& j : step.journal) s.journal.push_back({j.seq, j.call, j.args, j.result});
+    for (const auto& m : step.measurements) {
+      auto instrument = instruments_.find(m.instrument_id);
+      s.measurements.push_back(
+          {m.step, m.instrument_id, instrument && instrument->identity().simulated, m.quantity, m.value, m.unit, m.data});
+    }
+    store_.commit_step(record_, s);
   }
-  bool has_step(const std::string& step) const override { return store_.has_measurement(run_id_, step); }
+  void restored(const json& actions) override {
+    store_.append_event("execution", {{"execution_id", record_.id}, {"run_id", record_.run_id}, {"restored", actions}});
+    log::info("executions", record_.id + ": lab restored: " + actions.dump());
+  }
+  void status_text(const std::string& text) override {
+    if (status_) status_(record_.campaign + " " + record_.id.substr(0, 8) + ": " + text);
+  }
 
  private:
   store::Store& store_;
-  std::string run_id_;
+  const store::ExecutionRecord& record_;
   const campaigns::InstrumentSet& instruments_;
+  std::function<void(const std::string&)> status_;
 };
+
+json problem_json(const Error& e, const json& location) {
+  json problem = protocol::problem_from_error(e).to_json();
+  if (!e.info().device_code.empty()) problem["device_code"] = e.info().device_code;
+  if (!e.info().transcript.empty()) problem["transcript"] = e.info().transcript;
+  if (location.is_object()) {
+    for (const char* key : {"script", "line", "step", "traceback"}) {
+      if (location.contains(key)) problem[key] = location[key];
+    }
+  }
+  return problem;
+}
+
+std::uint64_t new_seed() {
+  std::random_device rd;
+  return (static_cast<std::uint64_t>(rd()) << 32 | rd()) & 0x7fffffffffffffffULL;
+}
 
 }  // namespace
 
-Executions::Executions(asio::io_context& io, store::Store& store, const campaigns::CampaignRegistry& campaigns,
-                       const campaigns::InstrumentSet& instruments)
-    : io_(io), store_(store), campaigns_(campaigns), instruments_(instruments) {}
+Executions::Executions(asio::io_context& io, store::Store& store, campaigns::ScriptCatalogue& catalogue,
+                       const campaigns::InstrumentSet& instruments, campaigns::Lab& lab, ExecutionOptions options,
+                       std::function<void(const std::string&)> status_text)
+    : io_(io),
+      store_(store),
+      catalogue_(catalogue),
+      instruments_(instruments),
+      lab_(lab),
+      options_(options),
+      status_text_(std::move(status_text)) {}
 
-store::ExecutionRecord Executions::start(const std::string& campaign_name, const nlohmann::json& params,
+Executions::~Executions() = default;
+
+store::ExecutionRecord Executions::start(const std::string& campaign_name, const json& params,
                                          const std::optional<std::string>& idempotency_key) {
-  const campaigns::Campaign* campaign = campaigns_.find(campaign_name);
-  if (!campaign) {
+  if (shutting_down_) throw Error(ErrorClass::conflict, "colorlabd is shutting down", "start the campaign after it restarts");
+  catalogue_.refresh();
+  auto script = catalogue_.find(campaign_name);
+  if (!script) {
     std::string names;
-    for (auto* c : campaigns_.all()) names += (names.empty() ? "" : ", ") + c->name();
+    for (const auto& c : catalogue_.all()) names += (names.empty() ? "" : ", ") + c->name;
     throw Error(ErrorClass::not_found, "no campaign named '" + campaign_name + "'", "campaigns: " + names);
   }
-  campaign->validate(params);
+  json normalized = script->validate(params);
+  lab_.check_needs(script->needs);
 
   store::NewRun run;
   run.campaign = campaign_name;
-  run.params = params;
+  run.params = normalized;
   run.idempotency_key = idempotency_key;
-  run.instruments = nlohmann::json::array();
+  run.instruments = json::array();
   for (const auto& i : instruments_.all()) {
     run.instruments.push_back(drivers::describe(*i));
     if (i->identity().simulated) run.simulated = true;
   }
+  run.script_sha256 = script->sha256;
+  run.script_source = script->source;
+  run.random_seed = new_seed();
   auto created = store_.create_execution(run);
   if (!created.created) return created.execution;  // a retried POST with the same Idempotency-Key
-  store::ExecutionRecord record = created.execution;
+  launch(created.execution, script, normalized, false);
+  return created.execution;
+}
 
-  ++running_;
+void Executions::resume_unfinished() {
+  for (auto record : store_.unfinished_executions()) {
+    if (record.status == ExecutionStatus::paused) {
+      log::info("executions", record.id + " stays paused (" + record.reason + "); resume it with `colorlab resume`");
+      continue;
+    }
+    try {
+      // A clean shutdown suspended it; anything else means the process died during a step.
+      if (record.status != ExecutionStatus::suspended) {
+        int attempts = store_.begin_resume(record.id);
+        if (attempts > options_.max_resume_attempts) {
+          std::string why = "colorlabd stopped " + std::to_string(attempts) + " times in a row during step '" +
+                            record.step + "' without committing it; not resuming again";
+          Error e(ErrorClass::hardware_fail, why,
+                  "look at the daemon's log (journalctl -u colorlabd) for what killed it; start a new run when fixed");
+          store_.finish_execution(record, ExecutionStatus::finished_error, record.step, nullptr,
+                                  problem_json(e, json{{"step", record.step}}), why);
+          log::error("executions", record.id + ": " + why);
+          continue;
+        }
+      }
+      auto source = store_.script_source(record.script_sha256);
+      if (!source) throw Error(ErrorClass::not_found, "the run's script " + record.script_sha256 + " is missing from the store");
+      auto script = std::make_shared<campaigns::CampaignScript>(campaigns::parse_campaign_script(record.campaign, *source));
+      script->origin = "stored";
+      auto run = store_.run(record.run_id);
+      json params = run ? run->params : json::object();
+      log::info("executions", "resuming " + record.id + " (" + record.campaign + ") from step '" + record.step + "'");
+      launch(record, script, params, true);
+    } catch (const Error& e) {
+      log::error("executions", record.id + ": cannot resume: " + e.what());
+      store_.finish_execution(record, ExecutionStatus::finished_error, record.step, nullptr, problem_json(e, nullptr),
+                              std::string("cannot resume: ") + e.what());
+    }
+  }
+}
+
+void Executions::launch(store::ExecutionRecord record, std::shared_ptr<const campaigns::CampaignScript> script,
+                        json params, bool resumed) {
+  auto active = std::make_shared<Active>();
+  active->record = record;
+  active_[record.id] = active;
   asio::co_spawn(
       io_,
-      [this, campaign, params, record]() -> asio::awaitable<void> {
-        StoreRecorder recorder(store_, record.run_id, instruments_);
-        std::string last_step;
-        campaigns::CampaignContext ctx{instruments_, recorder, params,
-                                       [&](double fraction, const std::string& step) {
-                                         last_step = step;
-                                         store_.report_progress(record.id, fraction, step);
-                                       }};
-        store_.start_execution(record);
-        nlohmann::json problem;
-        nlohmann::json summary;
-        ExecutionStatus status = ExecutionStatus::finished_ok;
+      [this, active, script, params, resumed]() -> asio::awaitable<void> {
+        auto& record = active->record;
+        campaigns::RunOutcome outcome;
         try {
-          summary = co_await campaign->run(ctx);
+          store_.set_execution_status(record, ExecutionStatus::running, resumed ? "resumed from step '" + record.step + "'" : "",
+                                      resumed ? json{{"resumed", true}} : json(nullptr));
+          campaigns::ScriptRunSetup setup;
+          setup.script = script;
+          setup.params = params;
+          setup.random_seed = record.random_seed;
+          setup.initial_label = record.step;
+          setup.initial_progress = record.progress;
+          if (resumed) {
+            for (auto& j : store_.journal(record.id)) setup.journal.push_back({j.seq, j.call, j.args, j.result});
+            setup.stored_steps = store_.measurement_steps(record.run_id);
+          }
+          StoreSink sink(store_, record, instruments_, status_text_);
+          outcome = co_await campaigns::run_campaign_script(std::move(setup), lab_, sink, active->control);
         } catch (const Error& e) {
-          status = ExecutionStatus::finished_error;
-          problem = protocol::problem_from_error(e).to_json();
-          if (!e.info().device_code.empty()) problem["device_code"] = e.info().device_code;
-          if (!e.info().transcript.empty()) problem["transcript"] = e.info().transcript;
-          log::warning("executions", record.id + " failed: " + e.what());
+          outcome.kind = campaigns::RunOutcome::Kind::failed;
+          outcome.error = e;
+          if (e.cls() == ErrorClass::io_error) {
+            outcome.kind = campaigns::RunOutcome::Kind::suspended;
+            outcome.reason = std::string("storage: ") + e.what();
+          }
         } catch (const std::exception& e) {
-          status = ExecutionStatus::finished_error;
-          problem = protocol::problem_from_error(Error(ErrorClass::internal, e.what())).to_json();
-          log::error("executions", record.id + " failed: " + e.what());
+          outcome.kind = campaigns::RunOutcome::Kind::failed;
+          outcome.error = Error(ErrorClass::internal, e.what());
         }
         try {
-          store_.finish_execution(record, status, status == ExecutionStatus::finished_ok ? "done" : last_step, summary,
-                                  problem);
+          auto current = store_.execution(record.id);
+          std::string step = current ? current->step : record.step;
+          using Kind = campaigns::RunOutcome::Kind;
+          switch (outcome.kind) {
+            case Kind::finished: {
+              json summary = store_.measurement_summary(record.run_id);
+              summary = json{{"measurements", summary}, {"script", outcome.result}};
+              store_.finish_execution(record, ExecutionStatus::finished_ok, "done", summary, nullptr, "");
+              log::info("executions", record.id + " finished (" + std::to_string(outcome.calls) + " lab calls, " +
+                                          std::to_string(outcome.replayed) + " replayed)");
+              break;
+            }
+            case Kind::failed: {
+              json summary{{"measurements", store_.measurement_summary(record.run_id)}};
+              Error e = outcome.error ? *outcome.error : Error(ErrorClass::internal, "unknown failure");
+              store_.finish_execution(record, ExecutionStatus::finished_error, step, summary,
+                                      problem_json(e, outcome.script_location), e.what());
+              log::warning("executions", record.id + " failed: " + e.what());
+              break;
+            }
+            case Kind::aborted: {
+              json summary{{"measurements", store_.measurement_summary(record.run_id)}};
+              store_.finish_execution(record, ExecutionStatus::aborted, step, summary, nullptr, outcome.reason);
+              break;
+            }
+            case Kind::paused:
+              store_.set_execution_status(record, ExecutionStatus::paused, outcome.reason);
+              break;
+            case Kind::suspended:
+              store_.set_execution_status(record, ExecutionStatus::suspended, outcome.reason);
+              break;
+          }
         } catch (const Error& e) {
-          // The disk failed at the very end: what was committed stays committed; restart marks it interrupted.
+          // The disk failed at the very end: what was committed stays committed; a restart resumes it.
           log::error("executions", record.id + ": cannot record the outcome: " + e.what());
         }
-        --running_;
+        active_.erase(record.id);
+        maybe_done();
       },
       asio::detached);
+}
+
+store::ExecutionRecord Executions::require(const std::string& id) {
+  auto e = store_.execution(id);
+  if (!e) throw Error(ErrorClass::not_found, "no execution with id '" + id + "'");
+  return *e;
+}
+
+store::ExecutionRecord Executions::pause(const std::string& id) {
+  auto record = require(id);
+  auto it = active_.find(id);
+  if (it == active_.end()) {
+    if (record.status == ExecutionStatus::paused) return record;
+    throw Error(ErrorClass::conflict, "execution " + id + " is " + std::string(protocol::to_string(record.status)) +
+                                          ", not running", "only a running execution can be paused");
+  }
+  it->second->control.request = Request::pause;
+  it->second->control.reason = "paused by a client";
+  store_.append_event("execution", {{"execution_id", id}, {"requested", "pause"}});
   return record;
+}
+
+store::ExecutionRecord Executions::resume(const std::string& id) {
+  auto record = require(id);
+  auto it = active_.find(id);
+  if (it != active_.end()) {
+    // Still running towards its safe point: simply cancel the pause.
+    if (it->second->control.request == Request::pause) it->second->control = {};
+    return record;
+  }
+  if (record.status != ExecutionStatus::paused && record.status != ExecutionStatus::suspended) {
+    throw Error(ErrorClass::conflict, "execution " + id + " is " + std::string(protocol::to_string(record.status)) +
+                                          ", not paused", "only a paused or suspended execution can be resumed");
+  }
+  if (shutting_down_) throw Error(ErrorClass::conflict, "colorlabd is shutting down");
+  auto source = store_.script_source(record.script_sha256);
+  if (!source) throw Error(ErrorClass::not_found, "the run's script is missing from the store");
+  auto script = std::make_shared<campaigns::CampaignScript>(campaigns::parse_campaign_script(record.campaign, *source));
+  script->origin = "stored";
+  auto run = store_.run(record.run_id);
+  launch(record, script, run ? run->params : json::object(), true);
+  return require(id);
+}
+
+store::ExecutionRecord Executions::abort(const std::string& id) {
+  auto record = require(id);
+  auto it = active_.find(id);
+  if (it != active_.end()) {
+    it->second->control.request = Request::abort;
+    it->second->control.reason = "aborted by a client";
+    store_.append_event("execution", {{"execution_id", id}, {"requested", "abort"}});
+    return record;
+  }
+  if (protocol::is_terminal(record.status)) {
+    throw Error(ErrorClass::conflict, "execution " + id + " has already ended (" +
+                                          std::string(protocol::to_string(record.status)) + ")");
+  }
+  json summary{{"measurements", store_.measurement_summary(record.run_id)}};
+  store_.finish_execution(record, ExecutionStatus::aborted, record.step, summary, nullptr, "aborted by a client");
+  return require(id);
+}
+
+void Executions::shutdown(std::function<void()> done) {
+  shutting_down_ = true;
+  on_all_stopped_ = std::move(done);
+  for (auto& [id, active] : active_) {
+    if (active->control.request != Request::abort) {
+      active->control.request = Request::shutdown;
+      active->control.reason = "colorlabd stopped; it resumes when colorlabd starts again";
+    }
+  }
+  maybe_done();
+}
+
+void Executions::maybe_done() {
+  if (shutting_down_ && active_.empty() && on_all_stopped_) {
+    auto done = std::move(on_all_stopped_);
+    on_all_stopped_ = nullptr;
+    done();
+  }
 }
 
 }  // namespace colorlab::daemon

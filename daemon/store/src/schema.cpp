@@ -60,6 +60,32 @@ CREATE TABLE event_log (
   payload TEXT NOT NULL
 );
 )sql",
+    // 1 -> 2: campaign scripts stored with their runs, the journal of lab calls that makes an
+    // execution resumable by replay, and the execution's reason and resume attempts.
+    R"sql(
+CREATE TABLE scripts (
+  sha256      TEXT PRIMARY KEY,                    -- of the exact text that ran
+  name        TEXT NOT NULL,
+  source      TEXT NOT NULL,
+  first_seen  TEXT NOT NULL
+);
+ALTER TABLE runs ADD COLUMN script_sha256 TEXT REFERENCES scripts(sha256);
+ALTER TABLE executions ADD COLUMN script_sha256 TEXT REFERENCES scripts(sha256);
+ALTER TABLE executions ADD COLUMN random_seed INTEGER NOT NULL DEFAULT 0;
+ALTER TABLE executions ADD COLUMN reason TEXT NOT NULL DEFAULT '';
+ALTER TABLE executions ADD COLUMN resume_attempts INTEGER NOT NULL DEFAULT 0;
+ALTER TABLE executions ADD COLUMN steps_committed INTEGER NOT NULL DEFAULT 0;
+CREATE TABLE journal (
+  execution_id TEXT NOT NULL REFERENCES executions(id),
+  seq          INTEGER NOT NULL,                   -- position of the lab call in the script's run
+  call         TEXT NOT NULL,
+  args         TEXT NOT NULL,                      -- JSON
+  result       TEXT NOT NULL,                      -- JSON
+  at           TEXT NOT NULL,
+  PRIMARY KEY (execution_id, seq)
+) WITHOUT ROWID;
+CREATE INDEX executions_unfinished ON executions(status) WHERE status IN ('waiting', 'running', 'paused', 'suspended');
+)sql",
 };
 
 int read_pragma_int(Database& db, const char* pragma) {

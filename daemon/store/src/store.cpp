@@ -21,6 +21,10 @@ nlohmann::json parse_json_column(const std::string& text) {
 
 std::string dump_or_empty(const nlohmann::json& j) { return j.is_null() ? std::string() : j.dump(); }
 
+constexpr const char* kExecutionColumns =
+    "id, run_id, campaign, status, progress, step, created_at, updated_at, error, reason, resume_attempts, "
+    "steps_committed, script_sha256, random_seed";
+
 }  // namespace
 
 nlohmann::json ExecutionRecord::to_json() const {
@@ -28,6 +32,10 @@ nlohmann::json ExecutionRecord::to_json() const {
                    {"status", protocol::to_string(status)},       {"progress", progress},
                    {"step", step},     {"created_at", created_at}, {"updated_at", updated_at}};
   if (!error.is_null()) j["error"] = error;
+  j["reason"] = reason;
+  j["resume_attempts"] = resume_attempts;
+  j["steps_committed"] = steps_committed;
+  if (!script_sha256.empty()) j["script_sha256"] = script_sha256;
   return j;
 }
 
@@ -56,6 +64,7 @@ nlohmann::json RunRecord::to_json() const {
   j["finished_at"] = finished_at ? nlohmann::json(*finished_at) : nlohmann::json(nullptr);
   j["summary"] = summary;
   if (!error.is_null()) j["error"] = error;
+  if (!script_sha256.empty()) j["script"] = {{"sha256", script_sha256}, {"name", campaign + ".lua"}};
   return j;
 }
 
@@ -85,14 +94,20 @@ Store::Store(const fs::path& database_path) {
   }
   migrate(db_);
 
-  // A previous process died with these unfinished: finalise them so no tool waits for them forever.
+  // Executions from before scripts were stored cannot be replayed: finalise them so no tool waits
+  // for them forever. Every other unfinished execution is the daemon's to resume.
   Transaction tx(db_);
   std::string now = now_iso8601();
-  db_.prepare("UPDATE runs SET status = 'interrupted', finished_at = ?1 WHERE status IN ('waiting', 'running')")
+  db_.prepare(
+         "UPDATE runs SET status = 'interrupted', finished_at = ?1 WHERE status IN ('waiting', 'running') AND "
+         "script_sha256 IS NULL")
       .bind(1, std::string_view(now))
       .run();
   interrupted_at_open_ = db_.changes();
-  db_.prepare("UPDATE executions SET status = 'interrupted', updated_at = ?1 WHERE status IN ('waiting', 'running')")
+  db_.prepare(
+         "UPDATE executions SET status = 'interrupted', updated_at = ?1, reason = 'the process running it ended and "
+         "it has no stored script to resume from' WHERE status IN ('waiting', 'running', 'paused', 'suspended') AND "
+         "script_sha256 IS NULL")
       .bind(1, std::string_view(now))
       .run();
   tx.commit();
@@ -113,25 +128,41 @@ Store::Created Store::create_execution(const NewRun& run) {
   e.campaign = run.campaign;
   e.created_at = e.updated_at = now_iso8601();
 
+  e.script_sha256 = run.script_sha256;
+  e.random_seed = run.random_seed;
+
   Transaction tx(db_);
+  std::optional<std::string> sha;
+  if (!run.script_sha256.empty()) {
+    sha = run.script_sha256;
+    db_.prepare("INSERT OR IGNORE INTO scripts (sha256, name, source, first_seen) VALUES (?1, ?2, ?3, ?4)")
+        .bind(1, std::string_view(run.script_sha256))
+        .bind(2, std::string_view(run.campaign))
+        .bind(3, std::string_view(run.script_source))
+        .bind(4, std::string_view(e.created_at))
+        .run();
+  }
   db_.prepare(
-         "INSERT INTO runs (id, campaign, params, status, simulated, instruments, created_at) "
-         "VALUES (?1, ?2, ?3, 'waiting', ?4, ?5, ?6)")
+         "INSERT INTO runs (id, campaign, params, status, simulated, instruments, created_at, script_sha256) "
+         "VALUES (?1, ?2, ?3, 'waiting', ?4, ?5, ?6, ?7)")
       .bind(1, std::string_view(e.run_id))
       .bind(2, std::string_view(run.campaign))
       .bind(3, std::string_view(run.params.dump()))
       .bind(4, static_cast<std::int64_t>(run.simulated))
       .bind(5, std::string_view(run.instruments.dump()))
       .bind(6, std::string_view(e.created_at))
+      .bind(7, sha)
       .run();
   db_.prepare(
-         "INSERT INTO executions (id, run_id, campaign, status, idempotency_key, created_at, updated_at) "
-         "VALUES (?1, ?2, ?3, 'waiting', ?4, ?5, ?5)")
+         "INSERT INTO executions (id, run_id, campaign, status, idempotency_key, created_at, updated_at, script_sha256, "
+         "random_seed) VALUES (?1, ?2, ?3, 'waiting', ?4, ?5, ?5, ?6, ?7)")
       .bind(1, std::string_view(e.id))
       .bind(2, std::string_view(e.run_id))
       .bind(3, std::string_view(run.campaign))
       .bind(4, run.idempotency_key)
       .bind(5, std::string_view(e.created_at))
+      .bind(6, sha)
+      .bind(7, static_cast<std::int64_t>(run.random_seed & 0x7fffffffffffffffULL))
       .run();
   append_event("execution", e.to_json());
   tx.commit();
@@ -173,12 +204,191 @@ void Store::report_progress(const std::string& execution_id, double progress, co
 }
 
 void Store::finish_execution(const ExecutionRecord& execution, ExecutionStatus status, const std::string& step,
-                             const nlohmann::json& summary, const nlohmann::json& error) {
+                             const nlohmann::json& summary, const nlohmann::json& error, const std::string& reason) {
   Transaction tx(db_);
   finish_run(execution.run_id, status, summary, error);
-  update_execution(execution.id, status, status == ExecutionStatus::finished_ok ? 1.0 : 0.0, step, error);
-  append_event("execution", {{"execution_id", execution.id}, {"status", protocol::to_string(status)}});
+  double progress = execution.progress;
+  if (auto current = this->execution(execution.id)) progress = current->progress;
+  update_execution(execution.id, status, status == ExecutionStatus::finished_ok ? 1.0 : progress, step, error);
+  db_.prepare("UPDATE executions SET reason = ?2 WHERE id = ?1")
+      .bind(1, std::string_view(execution.id))
+      .bind(2, std::string_view(reason))
+      .run();
+  append_event("execution", {{"execution_id", execution.id},
+                             {"run_id", execution.run_id},
+                             {"status", protocol::to_string(status)},
+                             {"reason", reason}});
   tx.commit();
+}
+
+void Store::set_execution_status(const ExecutionRecord& execution, ExecutionStatus status, const std::string& reason,
+                                 const nlohmann::json& event_extra) {
+  Transaction tx(db_);
+  std::string now = now_iso8601();
+  db_.prepare("UPDATE executions SET status = ?2, reason = ?3, updated_at = ?4 WHERE id = ?1")
+      .bind(1, std::string_view(execution.id))
+      .bind(2, protocol::to_string(status))
+      .bind(3, std::string_view(reason))
+      .bind(4, std::string_view(now))
+      .run();
+  db_.prepare("UPDATE runs SET status = ?2, started_at = COALESCE(started_at, ?3) WHERE id = ?1")
+      .bind(1, std::string_view(execution.run_id))
+      .bind(2, protocol::to_string(status))
+      .bind(3, std::string_view(now))
+      .run();
+  nlohmann::json event{{"execution_id", execution.id},
+                       {"run_id", execution.run_id},
+                       {"status", protocol::to_string(status)},
+                       {"reason", reason}};
+  if (event_extra.is_object()) event.update(event_extra);
+  append_event("execution", event);
+  tx.commit();
+}
+
+int Store::begin_resume(const std::string& execution_id) {
+  Transaction tx(db_);
+  db_.prepare("UPDATE executions SET resume_attempts = resume_attempts + 1 WHERE id = ?1")
+      .bind(1, std::string_view(execution_id))
+      .run();
+  auto st = db_.prepare("SELECT resume_attempts FROM executions WHERE id = ?1");
+  st.bind(1, std::string_view(execution_id));
+  int attempts = st.step() ? static_cast<int>(st.int64(0)) : 0;
+  tx.commit();
+  return attempts;
+}
+
+void Store::commit_step(const ExecutionRecord& execution, const StepRecord& step) {
+  Transaction tx(db_);
+  std::string now = now_iso8601();
+  if (!step.journal.empty()) {
+    auto ins = db_.prepare("INSERT INTO journal (execution_id, seq, call, args, result, at) VALUES (?1, ?2, ?3, ?4, ?5, ?6)");
+    for (const auto& j : step.journal) {
+      ins.bind(1, std::string_view(execution.id))
+          .bind(2, j.seq)
+          .bind(3, std::string_view(j.call))
+          .bind(4, std::string_view(j.args.dump()))
+          .bind(5, std::string_view(j.result.dump()))
+          .bind(6, std::string_view(now));
+      ins.run();
+      ins.reset();
+    }
+  }
+  if (!step.measurements.empty()) {
+    std::int64_t seq = 0;
+    {
+      auto st = db_.prepare("SELECT COALESCE(MAX(seq), 0) FROM measurements WHERE run_id = ?1");
+      st.bind(1, std::string_view(execution.run_id));
+      if (st.step()) seq = st.int64(0);
+    }
+    auto ins = db_.prepare(
+        "INSERT INTO measurements (run_id, seq, step, instrument_id, simulated, quantity, value, unit, data, measured_at) "
+        "VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10)");
+    for (const auto& m : step.measurements) {
+      ins.bind(1, std::string_view(execution.run_id))
+          .bind(2, ++seq)
+          .bind(3, std::string_view(m.step))
+          .bind(4, std::string_view(m.instrument_id))
+          .bind(5, static_cast<std::int64_t>(m.simulated))
+          .bind(6, std::string_view(m.quantity));
+      if (m.value && std::isfinite(*m.value)) {
+        ins.bind(7, *m.value);
+      } else {
+        ins.bind_null(7);
+      }
+      ins.bind(8, std::string_view(m.unit)).bind(9, std::string_view(dump_or_empty(m.data))).bind(10, std::string_view(now));
+      ins.run();
+      ins.reset();
+    }
+  }
+  db_.prepare(
+         "UPDATE executions SET progress = ?2, step = ?3, updated_at = ?4, steps_committed = steps_committed + 1, "
+         "resume_attempts = 0 WHERE id = ?1")
+      .bind(1, std::string_view(execution.id))
+      .bind(2, step.progress)
+      .bind(3, std::string_view(step.step))
+      .bind(4, std::string_view(now))
+      .run();
+  append_event("progress", {{"execution_id", execution.id},
+                            {"run_id", execution.run_id},
+                            {"progress", step.progress},
+                            {"step", step.step},
+                            {"measurements", step.measurements.size()}});
+  tx.commit();
+}
+
+std::vector<JournalRow> Store::journal(const std::string& execution_id) {
+  auto st = db_.prepare("SELECT seq, call, args, result FROM journal WHERE execution_id = ?1 ORDER BY seq");
+  st.bind(1, std::string_view(execution_id));
+  std::vector<JournalRow> out;
+  while (st.step()) {
+    out.push_back(JournalRow{st.int64(0), st.text(1), parse_json_column(st.text(2)), parse_json_column(st.text(3))});
+  }
+  return out;
+}
+
+std::set<std::string> Store::measurement_steps(const std::string& run_id) {
+  auto st = db_.prepare("SELECT step FROM measurements WHERE run_id = ?1");
+  st.bind(1, std::string_view(run_id));
+  std::set<std::string> out;
+  while (st.step()) out.insert(st.text(0));
+  return out;
+}
+
+std::optional<std::string> Store::script_source(const std::string& sha256) {
+  auto st = db_.prepare("SELECT source FROM scripts WHERE sha256 = ?1");
+  st.bind(1, std::string_view(sha256));
+  if (!st.step()) return std::nullopt;
+  return st.text(0);
+}
+
+ExecutionRecord Store::read_execution(Statement& st) {
+  ExecutionRecord e;
+  e.id = st.text(0);
+  e.run_id = st.text(1);
+  e.campaign = st.text(2);
+  e.status = protocol::execution_status_from_string(st.text(3)).value_or(ExecutionStatus::finished_error);
+  e.progress = st.real(4);
+  e.step = st.text(5);
+  e.created_at = st.text(6);
+  e.updated_at = st.text(7);
+  e.error = parse_json_column(st.text(8));
+  e.reason = st.text(9);
+  e.resume_attempts = static_cast<int>(st.int64(10));
+  e.steps_committed = st.int64(11);
+  if (!st.is_null(12)) e.script_sha256 = st.text(12);
+  e.random_seed = static_cast<std::uint64_t>(st.int64(13));
+  return e;
+}
+
+std::vector<ExecutionRecord> Store::unfinished_executions() {
+  auto st = db_.prepare(std::string("SELECT ") + kExecutionColumns +
+                        " FROM executions WHERE status IN ('waiting', 'running', 'paused', 'suspended') ORDER BY created_at, id");
+  std::vector<ExecutionRecord> out;
+  while (st.step()) out.push_back(read_execution(st));
+  return out;
+}
+
+nlohmann::json Store::measurement_summary(const std::string& run_id) {
+  auto st = db_.prepare(
+      "SELECT quantity, unit, COUNT(*), COUNT(value), AVG(value), MIN(value), MAX(value), "
+      "SUM(value * value), SUM(value) FROM measurements WHERE run_id = ?1 GROUP BY quantity, unit ORDER BY quantity, unit");
+  st.bind(1, std::string_view(run_id));
+  nlohmann::json out = nlohmann::json::object();
+  while (st.step()) {
+    nlohmann::json q{{"unit", st.text(1)}, {"count", st.int64(2)}};
+    std::int64_t n = st.int64(3);
+    if (n > 0) {
+      double mean = st.real(4), sum_sq = st.real(7), sum = st.real(8);
+      q["mean"] = mean;
+      q["min"] = st.real(5);
+      q["max"] = st.real(6);
+      q["stdev"] = n > 1 ? std::sqrt(std::max(0.0, (sum_sq - sum * mean) / static_cast<double>(n - 1))) : 0.0;
+    }
+    std::string key = st.text(0);
+    if (out.contains(key)) key += " [" + st.text(1) + "]";
+    out[key] = q;
+  }
+  return out;
 }
 
 void Store::finish_run(const std::string& run_id, ExecutionStatus status, const nlohmann::json& summary,
@@ -228,21 +438,10 @@ bool Store::has_measurement(const std::string& run_id, const std::string& step) 
 }
 
 std::optional<ExecutionRecord> Store::execution(const std::string& id) {
-  auto st = db_.prepare(
-      "SELECT id, run_id, campaign, status, progress, step, created_at, updated_at, error FROM executions WHERE id = ?1");
+  auto st = db_.prepare(std::string("SELECT ") + kExecutionColumns + " FROM executions WHERE id = ?1");
   st.bind(1, std::string_view(id));
   if (!st.step()) return std::nullopt;
-  ExecutionRecord e;
-  e.id = st.text(0);
-  e.run_id = st.text(1);
-  e.campaign = st.text(2);
-  e.status = protocol::execution_status_from_string(st.text(3)).value_or(ExecutionStatus::finished_error);
-  e.progress = st.real(4);
-  e.step = st.text(5);
-  e.created_at = st.text(6);
-  e.updated_at = st.text(7);
-  e.error = parse_json_column(st.text(8));
-  return e;
+  return read_execution(st);
 }
 
 RunRecord Store::read_run(Statement& st) {
@@ -259,11 +458,13 @@ RunRecord Store::read_run(Statement& st) {
   if (!st.is_null(9)) r.finished_at = st.text(9);
   r.summary = parse_json_column(st.text(10));
   r.error = parse_json_column(st.text(11));
+  if (!st.is_null(12)) r.script_sha256 = st.text(12);
   return r;
 }
 
 static constexpr const char* kRunColumns =
-    "seq, id, campaign, params, status, simulated, instruments, created_at, started_at, finished_at, summary, error";
+    "seq, id, campaign, params, status, simulated, instruments, created_at, started_at, finished_at, summary, error, "
+    "script_sha256";
 
 std::optional<RunRecord> Store::run(const std::string& id) {
   auto st = db_.prepare(std::string("SELECT ") + kRunColumns + " FROM runs WHERE id = ?1");

@@ -25,6 +25,8 @@ enum class ErrorClass {
   io_error,           // disk, database
   not_found,
   conflict,
+  script_error,       // a campaign script failed: syntax, runtime error, budget, forbidden call
+  aborted,            // a person or the daemon's shutdown stopped the work on purpose
   internal,
 };
 

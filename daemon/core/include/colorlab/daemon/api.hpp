@@ -3,7 +3,7 @@
 // executions. Every error leaves as RFC 9457 problem+json.
 #include <string>
 
-#include "colorlab/campaigns/campaign.hpp"
+#include "colorlab/campaigns/catalogue.hpp"
 #include "colorlab/daemon/executions.hpp"
 #include "colorlab/drivers/discovery.hpp"
 #include "colorlab/http/message.hpp"
@@ -14,7 +14,7 @@ namespace colorlab::daemon {
 struct ApiContext {
   store::Store& store;
   const campaigns::InstrumentSet& instruments;
-  const campaigns::CampaignRegistry& campaigns;
+  campaigns::ScriptCatalogue& catalogue;
   Executions& executions;
   bool simulated_lab = false;
   std::string started_at;

@@ -17,6 +17,19 @@ struct SimulatorConfig {
   std::optional<std::uint64_t> seed;
 };
 
+// [campaigns]: where the lab's own scripts live, and how executions survive restarts.
+struct CampaignConfig {
+  std::optional<std::filesystem::path> directory;  // default: <state_dir>/campaigns
+  int max_resume_attempts = 3;       // restarts in a row without a committed step before giving up
+  bool lamps_off_at_shutdown = false;
+  double lamp_warmup_s = 900;        // after relighting on resume, when there is no luminance meter
+  double stable_tolerance_pct = 0.5; // lamp stability on resume: drift over the window (LS-110)
+  double stable_window_s = 60;
+  double stable_interval_s = 5;
+  double stable_timeout_s = 1800;
+  double time_scale = 1;             // lab seconds per wall second for an external simulated lab
+};
+
 struct DaemonConfig {
   std::filesystem::path state_dir = "./colorlab-state";
   std::string listen_host = "127.0.0.1";
@@ -24,9 +37,11 @@ struct DaemonConfig {
   std::optional<std::filesystem::path> unix_socket;  // default: <state_dir>/colorlabd.sock
   std::vector<drivers::InstrumentConfig> instruments;
   SimulatorConfig simulator;
+  CampaignConfig campaigns;
 
   std::filesystem::path database_path() const;
   std::filesystem::path socket_path() const;
+  std::filesystem::path campaign_dir() const;
 };
 
 // The configuration colorlabd uses without --config: the simulated lab, state under ./colorlab-state.

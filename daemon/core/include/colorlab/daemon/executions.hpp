@@ -1,7 +1,12 @@
 #pragma once
-// Starts campaigns as observable executions (SiLA): a POST creates the run and its execution in
-// one transaction and returns at once; the campaign runs as a coroutine on the daemon's
-// executor, recording each measurement durably and updating progress as it goes.
+// Campaign executions (SiLA's observable commands): a POST validates the parameters against the
+// script's declaration, stores the run with the script's exact text, and returns at once; the
+// script runs as a coroutine on the daemon's executor through the campaign engine. Executions
+// left unfinished by a crash, a power cut or a shutdown are resumed at start-up by replay, up to
+// a bounded number of attempts in a row without progress. Pause, resume and abort land at the
+// engine's next safe point.
+#include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -9,27 +14,55 @@
 #include <boost/asio/io_context.hpp>
 #include <nlohmann/json.hpp>
 
-#include "colorlab/campaigns/campaign.hpp"
+#include "colorlab/campaigns/catalogue.hpp"
+#include "colorlab/campaigns/control.hpp"
+#include "colorlab/campaigns/lab.hpp"
 #include "colorlab/store/store.hpp"
 
 namespace colorlab::daemon {
 
+struct ExecutionOptions {
+  int max_resume_attempts = 3;
+};
+
 class Executions {
  public:
-  Executions(boost::asio::io_context& io, store::Store& store, const campaigns::CampaignRegistry& campaigns,
-             const campaigns::InstrumentSet& instruments);
+  Executions(boost::asio::io_context& io, store::Store& store, campaigns::ScriptCatalogue& catalogue,
+             const campaigns::InstrumentSet& instruments, campaigns::Lab& lab, ExecutionOptions options,
+             std::function<void(const std::string&)> status_text = {});
+  ~Executions();
 
   // Validates, records and launches. Throws Error{bad_parameter|not_found} before anything starts.
   store::ExecutionRecord start(const std::string& campaign, const nlohmann::json& params,
                                const std::optional<std::string>& idempotency_key);
-  std::size_t running() const { return running_; }
+  // At start-up: every execution a previous process left running or suspended continues.
+  void resume_unfinished();
+  store::ExecutionRecord pause(const std::string& id);
+  store::ExecutionRecord resume(const std::string& id);
+  store::ExecutionRecord abort(const std::string& id);
+  // SIGTERM: running executions stop at their next safe point as `suspended` (resumed at the next
+  // start); `done` runs when all have stopped.
+  void shutdown(std::function<void()> done);
+
+  std::size_t running() const { return active_.size(); }
 
  private:
+  struct Active;
+  void launch(store::ExecutionRecord record, std::shared_ptr<const campaigns::CampaignScript> script,
+              nlohmann::json params, bool resumed);
+  store::ExecutionRecord require(const std::string& id);
+  void maybe_done();
+
   boost::asio::io_context& io_;
   store::Store& store_;
-  const campaigns::CampaignRegistry& campaigns_;
+  campaigns::ScriptCatalogue& catalogue_;
   const campaigns::InstrumentSet& instruments_;
-  std::size_t running_ = 0;
+  campaigns::Lab& lab_;
+  ExecutionOptions options_;
+  std::function<void(const std::string&)> status_text_;
+  std::map<std::string, std::shared_ptr<Active>> active_;
+  std::function<void()> on_all_stopped_;
+  bool shutting_down_ = false;
 };
 
 }  // namespace colorlab::daemon

@@ -53,6 +53,8 @@ class Statement {
   // True while a row is available.
   bool step();
   void run() { while (step()) {} }
+  // Ready to run again with new bindings (one prepared statement for many rows).
+  void reset();
 
   std::int64_t int64(int col) const;
   double real(int col) const;

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,10 @@ struct NewRun {
   bool simulated = false;
   nlohmann::json instruments;  // snapshot
   std::optional<std::string> idempotency_key;
+  // The exact script text that runs (stored once per hash) and the seed its math.random draws from.
+  std::string script_sha256;
+  std::string script_source;
+  std::uint64_t random_seed = 0;
 };
 
 struct ExecutionRecord {
@@ -33,7 +38,37 @@ struct ExecutionRecord {
   std::string created_at;
   std::string updated_at;
   nlohmann::json error;  // problem, or null
+  std::string reason;    // why it is paused, suspended, aborted or ended
+  int resume_attempts = 0;
+  std::int64_t steps_committed = 0;
+  std::string script_sha256;
+  std::uint64_t random_seed = 0;
   nlohmann::json to_json() const;
+};
+
+struct JournalRow {
+  std::int64_t seq = 0;
+  std::string call;
+  nlohmann::json args;
+  nlohmann::json result;
+};
+
+struct MeasurementRow {
+  std::string step;
+  std::string instrument_id;
+  bool simulated = false;
+  std::string quantity;
+  std::optional<double> value;
+  std::string unit;
+  nlohmann::json data;
+};
+
+// One committed step of a campaign: its journal entries, its measurements and its progress.
+struct StepRecord {
+  std::vector<JournalRow> journal;
+  std::vector<MeasurementRow> measurements;
+  double progress = 0;
+  std::string step;
 };
 
 struct MeasurementRecord {
@@ -61,6 +96,7 @@ struct RunRecord {
   std::optional<std::string> started_at, finished_at;
   nlohmann::json summary;
   nlohmann::json error;
+  std::string script_sha256;
   nlohmann::json to_json() const;  // without measurements
 };
 
@@ -78,8 +114,9 @@ struct RunPage {
 
 class Store {
  public:
-  // Creates the directory and database as needed, migrates, checks integrity, and marks runs and
-  // executions that a previous process left unfinished as `interrupted`.
+  // Creates the directory and database as needed, migrates and checks integrity. Executions a
+  // previous process left unfinished stay as they were, for the daemon to resume; only those
+  // without a stored script (made before scripts were stored) are marked `interrupted`.
   explicit Store(const std::filesystem::path& database_path);
 
   // Creates a run and its execution in one transaction. With an idempotency key already used,
@@ -100,7 +137,22 @@ class Store {
   void start_execution(const ExecutionRecord& execution);
   void report_progress(const std::string& execution_id, double progress, const std::string& step);
   void finish_execution(const ExecutionRecord& execution, protocol::ExecutionStatus status, const std::string& step,
-                        const nlohmann::json& summary, const nlohmann::json& error);
+                        const nlohmann::json& summary, const nlohmann::json& error, const std::string& reason = {});
+  // paused / suspended / running again, with the run's status and an event, in one transaction.
+  void set_execution_status(const ExecutionRecord& execution, protocol::ExecutionStatus status, const std::string& reason,
+                            const nlohmann::json& event_extra = nullptr);
+  // A restart is about to resume this execution: counts the attempt (reset by the next committed
+  // step) and returns how many resumes in a row have not committed a step.
+  int begin_resume(const std::string& execution_id);
+  // One campaign step in one transaction (one fsync): journal, measurements, progress and event.
+  void commit_step(const ExecutionRecord& execution, const StepRecord& step);
+  std::vector<JournalRow> journal(const std::string& execution_id);
+  std::set<std::string> measurement_steps(const std::string& run_id);
+  std::optional<std::string> script_source(const std::string& sha256);
+  // waiting, running, paused or suspended, oldest first.
+  std::vector<ExecutionRecord> unfinished_executions();
+  // Per quantity: count, unit, mean, stdev, min, max — computed by SQL from the stored rows.
+  nlohmann::json measurement_summary(const std::string& run_id);
 
   // Durable on return (synchronous=FULL). A repeated step is refused with Error{conflict}.
   void add_measurement(const std::string& run_id, const std::string& step, const std::string& instrument_id,
@@ -121,6 +173,7 @@ class Store {
 
  private:
   RunRecord read_run(Statement& st);
+  ExecutionRecord read_execution(Statement& st);
 
   Database db_;
   int interrupted_at_open_ = 0;

@@ -1,4 +1,4 @@
-#include "colorlab/campaigns/image_averaging.hpp"
+#include "colorlab/campaigns/frame_statistics.hpp"
 
 #include <algorithm>
 #include <memory>
@@ -14,39 +14,6 @@ namespace colorlab::campaigns {
 
 using nlohmann::json;
 namespace cam = drivers::camera;
-
-nlohmann::json ImageAveraging::parameters() const {
-  return {{"frames", {{"type", "integer"}, {"default", 25}, {"minimum", 2}, {"maximum", 256}}},
-          {"region", {{"type", "array"}, {"default", json::array()},
-                      {"description", "[x, y, width, height] in visible pixels; empty = the most uniform mid-level 32×32 window"}}},
-          {"exposure_us", {{"type", "number"}, {"default", nullptr}}},
-          {"instrument", {{"type", "string"}, {"default", ""}}}};
-}
-
-void ImageAveraging::validate(const nlohmann::json& params) const {
-  if (!params.is_object()) throw Error(ErrorClass::bad_parameter, "params must be a JSON object");
-  for (const auto& [key, value] : params.items()) {
-    if (key == "frames") {
-      if (!value.is_number_integer() || value.get<long long>() < 2 || value.get<long long>() > 256) {
-        throw Error(ErrorClass::bad_parameter, "params.frames must be an integer from 2 to 256");
-      }
-    } else if (key == "region") {
-      bool ok = value.is_array() && (value.empty() || value.size() == 4);
-      for (const auto& v : value) ok = ok && v.is_number_integer() && v.get<long long>() >= 0;
-      if (ok && value.size() == 4) ok = value[2].get<long long>() >= 4 && value[3].get<long long>() >= 4;
-      if (!ok) throw Error(ErrorClass::bad_parameter, "params.region must be [x, y, width, height] with width, height ≥ 4");
-    } else if (key == "exposure_us") {
-      if (!value.is_null() && (!value.is_number() || value.get<double>() <= 0)) {
-        throw Error(ErrorClass::bad_parameter, "params.exposure_us must be a positive number");
-      }
-    } else if (key == "instrument") {
-      if (!value.is_string()) throw Error(ErrorClass::bad_parameter, "params.instrument must be a string");
-    } else {
-      throw Error(ErrorClass::bad_parameter, "unknown parameter params." + key + " for image-averaging",
-                  "parameters: frames, region, exposure_us, instrument");
-    }
-  }
-}
 
 namespace {
 
@@ -98,44 +65,34 @@ void choose_uniform_region(const cam::RawImage& image, RegionFrames& g) {
 
 }  // namespace
 
-boost::asio::awaitable<nlohmann::json> ImageAveraging::run(CampaignContext& ctx) const {
-  int frames = ctx.params.value("frames", 25);
-  std::string wanted = ctx.params.value("instrument", std::string());
-  std::shared_ptr<cam::CameraInstrument> instrument;
-  if (wanted.empty()) {
-    instrument = ctx.instruments.first_with<cam::CameraInstrument>(drivers::Capability::camera);
-  } else {
-    instrument = std::dynamic_pointer_cast<cam::CameraInstrument>(ctx.instruments.find(wanted));
-    if (!instrument) throw Error(ErrorClass::not_found, "no camera with id '" + wanted + "'");
-  }
-  if (instrument->state() == drivers::InstrumentState::disconnected) co_await instrument->connect();
-  auto& camera = instrument->camera();
-  cam::CameraSettings settings;
-  if (ctx.params.contains("exposure_us") && !ctx.params["exposure_us"].is_null()) {
-    settings.exposure_us = ctx.params["exposure_us"].get<double>();
-  }
+boost::asio::awaitable<json> capture_noise_table(cam::CameraInstrument& instrument, const json& options) {
+  const int frames = options.value("frames", 25);
+  if (frames < 1 || frames > 256) throw Error(ErrorClass::bad_parameter, "camera.capture: frames must be from 1 to 256");
+  auto& camera = instrument.camera();
   // Averaging needs the sensor's counts: ask a GenICam camera for its raw Bayer (or mono) format.
   const auto formats = camera.limits().pixel_formats;
   if (!formats.empty() && !camera.settings().pixel_format) {
+    cam::CameraSettings settings;
     settings.pixel_format = formats.front();
     for (auto preferred : {cam::PixelFormat::bayer_rg16, cam::PixelFormat::bayer_rg12}) {
       if (std::find(formats.begin(), formats.end(), preferred) != formats.end()) settings.pixel_format = preferred;
     }
-  }
-  if (settings.exposure_us || settings.pixel_format) {
     auto error = co_await cam::async_configure(camera, settings, boost::asio::use_awaitable);
     if (error) throw *error;
   }
 
   auto region = std::make_shared<RegionFrames>();
-  if (ctx.params.contains("region") && ctx.params["region"].size() == 4) {
-    const auto& r = ctx.params["region"];
+  if (options.contains("region") && options["region"].is_array() && options["region"].size() == 4) {
+    const auto& r = options["region"];
+    for (const auto& v : r) {
+      if (!v.is_number_integer() || v.get<long long>() < 0) throw Error(ErrorClass::bad_parameter, "camera.capture: region must be {x, y, w, h} in pixels");
+    }
     region->x = r[0];
     region->y = r[1];
     region->width = r[2];
     region->height = r[3];
+    if (region->width < 4 || region->height < 4) throw Error(ErrorClass::bad_parameter, "camera.capture: region width and height must be ≥ 4");
   }
-  ctx.progress(0.0, "capturing");
   // Runs on the camera's decode thread; the campaign reads `region` only after the series ends.
   auto sink = [region](const cam::RawImage& image) {
     auto& g = *region;
@@ -175,36 +132,28 @@ boost::asio::awaitable<nlohmann::json> ImageAveraging::run(CampaignContext& ctx)
     throw Error(ErrorClass::hardware_fail, "the camera delivered " + std::to_string(report.delivered) + " of " +
                                                std::to_string(report.requested) + " frames");
   }
-  ctx.progress(0.9, "analysing");
 
   std::vector<std::size_t> subsets;
   for (std::size_t n : analysis::kTable2Subsets) {
     if (n <= static_cast<std::size_t>(frames)) subsets.push_back(n);
   }
-  if (subsets.back() != static_cast<std::size_t>(frames)) subsets.push_back(static_cast<std::size_t>(frames));
+  if (subsets.empty() || subsets.back() != static_cast<std::size_t>(frames)) subsets.push_back(static_cast<std::size_t>(frames));
   std::size_t pw = region->width / 2, ph = region->height / 2;
   analysis::Rect whole{0, 0, pw, ph};
-  json table = json::object();
+  json rows = json::array();
   for (int c = 0; c < 3; ++c) {
     if (region->planes[c].empty()) continue;
     std::vector<analysis::ImageView> views;
     for (const auto& p : region->planes[c]) views.push_back(analysis::ImageView{p.data(), pw, ph, pw});
-    auto rows = analysis::noise_vs_averaging(views, std::span<const analysis::Rect>(&whole, 1), subsets);
-    for (const auto& row : rows) {
-      std::string step = "noise/N" + std::to_string(row.frames) + "/" + kChannelNames[c];
-      if (!ctx.recorder.has_step(step)) {
-        ctx.recorder.record(Measurement{step, instrument->id(), "pixel_stdev", row.summary.median, "DN",
-                                        {{"frames_averaged", row.frames},
-                                         {"channel", kChannelNames[c]},
-                                         {"region", {region->x, region->y, region->width, region->height}}}});
-      }
-      table[std::to_string(row.frames)][kChannelNames[c]] = row.summary.median;
+    auto table = analysis::noise_vs_averaging(views, std::span<const analysis::Rect>(&whole, 1), subsets);
+    for (const auto& row : table) {
+      rows.push_back({{"frames", row.frames}, {"channel", kChannelNames[c]}, {"stdev", row.summary.median}});
     }
   }
-  ctx.progress(1.0, "done");
   co_return json{{"frames", frames},
                  {"region", {region->x, region->y, region->width, region->height}},
-                 {"stdev_by_frames_averaged", table},
+                 {"rows", rows},
+                 {"instrument", instrument.id()},
                  {"unit", "DN above black"}};
 }
 

@@ -1,0 +1,87 @@
+#pragma once
+// The campaign engine: runs a Lua campaign script as a coroutine on the daemon's executor, and
+// makes it durable by deterministic replay. Every lab call's result is journaled; the journal,
+// the measurements recorded since the last commit and the progress are committed in ONE
+// transaction just before the next live lab call (so a committed step is always whole). After a
+// crash the script is run again from the start with the stored text, parameters and random seed:
+// calls already in the journal are answered from it (no instrument moves), recorded steps already
+// stored are skipped, and at the first call past the journal the lab is restored to the state the
+// replay says it should be in; from there the script runs live. docs/ARCHITECTURE.md says why.
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <boost/asio/awaitable.hpp>
+#include <nlohmann/json.hpp>
+
+#include "colorlab/campaigns/control.hpp"
+#include "colorlab/campaigns/lab.hpp"
+#include "colorlab/campaigns/script.hpp"
+#include "colorlab/core/error.hpp"
+
+namespace colorlab::campaigns {
+
+struct JournalEntry {
+  std::int64_t seq = 0;  // 0-based position of the call in the script's run
+  std::string call;      // "meter.measure", "lamps.select", ...
+  nlohmann::json args;   // the call's arguments as given
+  nlohmann::json result;
+};
+
+struct RecordedMeasurement {
+  std::string step;  // unique within the run
+  std::string instrument_id;
+  std::string quantity;
+  std::optional<double> value;
+  std::string unit;
+  nlohmann::json data;
+};
+
+// One committed step: everything since the previous commit, stored in one transaction.
+struct StepCommit {
+  std::vector<JournalEntry> journal;
+  std::vector<RecordedMeasurement> measurements;
+  double progress = 0;
+  std::string label;
+};
+
+// The daemon's side of one execution.
+class ExecutionSink {
+ public:
+  virtual ~ExecutionSink() = default;
+  // Durable on return; throws Error{io_error} if the disk refused it (nothing is half-stored).
+  virtual void commit(const StepCommit& step) = 0;
+  // The lab was brought back after a resume (for the event log).
+  virtual void restored(const nlohmann::json& actions) = 0;
+  // What the execution is doing now, for logs and systemd's STATUS=.
+  virtual void status_text(const std::string& text) = 0;
+};
+
+struct RunOutcome {
+  enum class Kind { finished, paused, aborted, suspended, failed };
+  Kind kind = Kind::failed;
+  nlohmann::json result;             // the run function's return value (finished)
+  std::optional<Error> error;        // failed
+  nlohmann::json script_location;    // failed in the script: {script, line, step, traceback}
+  std::string reason;                // paused, aborted, suspended
+  std::int64_t calls = 0;            // lab calls made, replayed included
+  std::int64_t replayed = 0;         // of which answered from the journal
+};
+
+struct ScriptRunSetup {
+  std::shared_ptr<const CampaignScript> script;
+  nlohmann::json params;                   // validated, defaults filled in
+  std::vector<JournalEntry> journal;       // committed calls of a previous attempt, in order
+  std::set<std::string> stored_steps;      // recorded steps already stored
+  std::uint64_t random_seed = 0;
+  std::string initial_label;               // progress label to start from
+  double initial_progress = 0;
+};
+
+boost::asio::awaitable<RunOutcome> run_campaign_script(ScriptRunSetup setup, Lab& lab, ExecutionSink& sink,
+                                                       ExecutionControl& control);
+
+}  // namespace colorlab::campaigns

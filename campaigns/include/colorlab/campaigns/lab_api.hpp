@@ -1,0 +1,36 @@
+#pragma once
+// The `lab` table a campaign script sees: instruments in lab terms, plus record, progress, log,
+// checkpoint and the analysis library. Calls that touch an instrument or take time yield the
+// script's coroutine with a request the engine carries out (or answers from the journal on
+// replay); the rest run at once. Arguments are checked here so an error names the script line.
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+struct lua_State;
+
+namespace colorlab::campaigns {
+
+// What the engine offers the Lua side. Implementations must not throw through Lua: the closures
+// catch and turn exceptions into Lua errors.
+class LabCallSink {
+ public:
+  virtual ~LabCallSink() = default;
+  virtual bool is_campaign_thread(lua_State* L) const = 0;
+  // A call the engine performs between two resumes of the script (it yields right after).
+  virtual void request(std::string call, nlohmann::json args) = 0;
+  virtual void record(const std::string& step, const nlohmann::json& fields) = 0;
+  virtual void progress(double fraction, const std::string& label) = 0;
+  virtual void log(const std::string& text) = 0;
+};
+
+// Kinds of yielding calls: an effect changes the lab (and is replayed into the desired state), a
+// reading returns a value (replayed from the journal), control only marks a safe point.
+enum class CallKind { effect, reading, control };
+CallKind kind_of(const std::string& call);
+
+// Sets the global `lab` in L. With sink == nullptr (reading a script's declaration) every call
+// raises "only inside run()".
+void install_lab_api(lua_State* L, LabCallSink* sink);
+
+}  // namespace colorlab::campaigns

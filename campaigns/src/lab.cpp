@@ -1,0 +1,440 @@
+#include "colorlab/campaigns/lab.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+
+#include <boost/asio/steady_timer.hpp>
+#include <boost/asio/use_awaitable.hpp>
+
+#include "colorlab/analysis/colorimetry.hpp"
+#include "colorlab/campaigns/frame_statistics.hpp"
+#include "colorlab/core/error.hpp"
+#include "colorlab/core/ids.hpp"
+#include "colorlab/core/log.hpp"
+#include "colorlab/drivers/camera/asio_camera.hpp"
+#include "colorlab/drivers/camera/camera_instrument.hpp"
+#include "colorlab/drivers/lab_capabilities.hpp"
+
+namespace colorlab::campaigns {
+
+namespace asio = boost::asio;
+using nlohmann::json;
+using drivers::Capability;
+namespace cam = drivers::camera;
+
+namespace {
+
+Capability capability_of(const std::string& role) {
+  if (role == "luminance_meter") return Capability::luminance;
+  if (role == "spectrophotometer") return Capability::reflectance_spectrum;
+  if (role == "table") return Capability::xy_table;
+  if (role == "lamps") return Capability::lamp_switching;
+  if (role == "dimmer") return Capability::dimmer;
+  if (role == "camera") return Capability::camera;
+  throw Error(ErrorClass::internal, "unknown role " + role);
+}
+
+std::string role_words(const std::string& role) {
+  if (role == "luminance_meter") return "a luminance meter (LS-110)";
+  if (role == "spectrophotometer") return "a spectrophotometer (Spectrolino)";
+  if (role == "table") return "an XY table (SpectroScan T)";
+  if (role == "lamps") return "lamp switching (DMX widget or relay board)";
+  if (role == "dimmer") return "a dimmer (DMX widget)";
+  return "a camera";
+}
+
+drivers::SpectralMode mode_from(const std::string& m) {
+  if (m == "reflectance") return drivers::SpectralMode::reflectance;
+  if (m == "emission") return drivers::SpectralMode::emission;
+  if (m == "transmission") return drivers::SpectralMode::transmission;
+  throw Error(ErrorClass::script_error, "lab.spectro.mode: '" + m + "' is not reflectance, emission or transmission");
+}
+
+json spectrum_json(const drivers::SpectralReading& r, const std::string& instrument) {
+  json j{{"mode", std::string(drivers::to_string(r.mode))},
+         {"first_nm", r.first_nm},
+         {"step_nm", r.step_nm},
+         {"values", r.values},
+         {"attempts", r.attempts},
+         {"instrument", instrument}};
+  if (r.xyz) {
+    const auto& x = *r.xyz;
+    j["XYZ"] = {x[0], x[1], x[2]};
+    if (r.mode != drivers::SpectralMode::emission) {
+      auto lab = analysis::xyz_to_lab({x[0], x[1], x[2]}, analysis::kIccD50White);
+      j["Lab"] = {lab.L, lab.a, lab.b};
+    }
+  }
+  return j;
+}
+
+}  // namespace
+
+StabilityCriterion StabilityCriterion::from_json(const json& j, const StabilityCriterion& d) {
+  StabilityCriterion c = d;
+  if (!j.is_object()) return c;
+  auto number = [&](const char* key, double& out, double lo, double hi) {
+    if (!j.contains(key)) return;
+    if (!j[key].is_number() || !(j[key].get<double>() >= lo && j[key].get<double>() <= hi)) {
+      throw Error(ErrorClass::script_error, std::string("lab.wait_stable: ") + key + " must be a number from " +
+                                                std::to_string(lo) + " to " + std::to_string(hi));
+    }
+    out = j[key].get<double>();
+  };
+  number("tolerance_pct", c.tolerance_pct, 1e-4, 100);
+  number("window_s", c.window_s, 0, 86400);
+  number("interval_s", c.interval_s, 0.01, 3600);
+  number("timeout_s", c.timeout_s, 0, 7 * 86400);
+  return c;
+}
+
+Lab::Lab(asio::any_io_executor executor, const InstrumentSet& instruments, LabOptions options)
+    : executor_(std::move(executor)), instruments_(instruments), options_(options) {
+  if (!(options_.time_scale > 0)) options_.time_scale = 1;
+}
+
+template <class T>
+std::shared_ptr<T> Lab::find_role(const std::string& name) const {
+  auto capability = capability_of(name);
+  for (const auto& i : instruments_.all()) {
+    for (auto c : i->capabilities()) {
+      if (c == capability) {
+        if (auto t = std::dynamic_pointer_cast<T>(i)) return t;
+      }
+    }
+  }
+  return nullptr;
+}
+
+template <class T>
+std::shared_ptr<T> Lab::role(const std::string& name) const {
+  if (auto t = find_role<T>(name)) return t;
+  throw Error(ErrorClass::not_found, "this campaign needs " + role_words(name) + ", and none is configured",
+              "add one to colorlabd's configuration, or run the simulated lab");
+}
+
+void Lab::check_needs(const std::vector<std::string>& roles) const {
+  for (const auto& r : roles) {
+    if (r == "luminance_meter") role<drivers::LuminanceMeter>(r);
+    else if (r == "spectrophotometer") role<drivers::Spectrometer>(r);
+    else if (r == "table") role<drivers::XyTable>(r);
+    else if (r == "lamps") role<drivers::LampController>(r);
+    else if (r == "dimmer") role<drivers::Dimmer>(r);
+    else if (r == "camera") role<cam::CameraInstrument>(r);
+  }
+}
+
+json Lab::roles() const {
+  json j = json::object();
+  for (const char* r : {"luminance_meter", "spectrophotometer", "table", "lamps", "dimmer", "camera"}) {
+    auto capability = capability_of(r);
+    for (const auto& i : instruments_.all()) {
+      auto caps = i->capabilities();
+      if (std::find(caps.begin(), caps.end(), capability) != caps.end()) {
+        auto id = i->identity();
+        j[r] = {{"id", i->id()}, {"serial", id.serial}, {"model", id.model}, {"simulated", id.simulated}};
+        break;
+      }
+    }
+  }
+  return j;
+}
+
+asio::awaitable<void> Lab::ready(drivers::Instrument& instrument) {
+  using drivers::InstrumentState;
+  auto deadline = std::chrono::steady_clock::now() + options_.connect_timeout;
+  for (;;) {
+    auto s = instrument.state();
+    if (s == InstrumentState::disconnected || s == InstrumentState::fault) {
+      co_await instrument.connect();
+      co_return;
+    }
+    if (s != InstrumentState::initialising) co_return;
+    // Connecting at daemon start (discovery got there first): wait for it rather than interleave.
+    if (std::chrono::steady_clock::now() > deadline) {
+      throw Error(ErrorClass::timeout, instrument.id() + " is still connecting after " +
+                                           std::to_string(options_.connect_timeout.count()) + " s");
+    }
+    asio::steady_timer t(executor_, std::chrono::milliseconds(20));
+    co_await t.async_wait(asio::use_awaitable);
+  }
+}
+
+asio::awaitable<void> Lab::sleep_lab_seconds(double seconds, const ExecutionControl& control) {
+  auto end = std::chrono::steady_clock::now() +
+             std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(seconds / options_.time_scale));
+  for (;;) {
+    if (control.requested()) throw Error(ErrorClass::aborted, "wait interrupted: " + control.reason);
+    auto now = std::chrono::steady_clock::now();
+    if (now >= end) co_return;
+    asio::steady_timer t(executor_, std::min<std::chrono::steady_clock::duration>(end - now, std::chrono::milliseconds(100)));
+    co_await t.async_wait(asio::use_awaitable);
+  }
+}
+
+asio::awaitable<json> Lab::wait_stable(const StabilityCriterion& c, const ExecutionControl& control) {
+  auto meter = role<drivers::LuminanceMeter>("luminance_meter");
+  co_await ready(*meter);
+  auto start = std::chrono::steady_clock::now();
+  auto lab_seconds = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() * options_.time_scale;
+  };
+  std::deque<std::pair<double, double>> window;  // (lab time, luminance)
+  int readings = 0;
+  double drift_pct = 100;
+  for (;;) {
+    if (control.requested()) throw Error(ErrorClass::aborted, "wait_stable interrupted: " + control.reason);
+    auto r = co_await meter->measure_luminance();
+    ++readings;
+    double t = lab_seconds();
+    window.emplace_back(t, r.luminance);
+    while (window.size() > 3 && t - window.front().first > c.window_s) window.pop_front();
+    if (window.size() >= 3 && t - window.front().first >= c.window_s * 0.999) {
+      // Drift from a straight-line fit, not max − min: the meter's noise must not read as drift.
+      double n = static_cast<double>(window.size()), st = 0, sl = 0, stt = 0, stl = 0;
+      for (auto [ti, li] : window) {
+        st += ti;
+        sl += li;
+        stt += ti * ti;
+        stl += ti * li;
+      }
+      double denom = n * stt - st * st;
+      double slope = denom > 0 ? (n * stl - st * sl) / denom : 0;
+      double mean = sl / n;
+      drift_pct = mean > 0 ? std::abs(slope) * c.window_s / mean * 100 : 100;
+      if (drift_pct <= c.tolerance_pct) {
+        co_return json{{"luminance", r.luminance}, {"unit", r.unit},          {"instrument", meter->id()},
+                       {"drift_pct", drift_pct},   {"readings", readings},    {"waited_s", t}};
+      }
+    }
+    if (t >= c.timeout_s) {
+      throw Error(ErrorClass::needs_operator,
+                  "the light did not settle within " + std::to_string(static_cast<int>(c.timeout_s)) + " s (drift " +
+                      std::to_string(drift_pct) + " % over " + std::to_string(static_cast<int>(c.window_s)) + " s)",
+                  "check the lamp; a failing tube flickers and drifts");
+    }
+    co_await sleep_lab_seconds(c.interval_s, control);
+  }
+}
+
+asio::awaitable<void> Lab::switch_lamps(std::vector<std::string> on) {
+  auto lamps = role<drivers::LampController>("lamps");
+  co_await ready(*lamps);
+  auto before = lamps->lamps_on();
+  co_await lamps->set_lamps(on);
+  for (const auto& l : on) {
+    if (std::find(before.begin(), before.end(), l) == before.end()) known_warm_.erase(l);
+  }
+  for (const auto& l : before) {
+    if (std::find(on.begin(), on.end(), l) == on.end()) known_warm_.erase(l);
+  }
+}
+
+asio::awaitable<json> Lab::perform(const std::string& call, const json& args, const ExecutionControl& control) {
+  if (call == "meter.measure") {
+    auto meter = role<drivers::LuminanceMeter>("luminance_meter");
+    co_await ready(*meter);
+    auto r = co_await meter->measure_luminance();
+    co_return json{{"luminance", r.luminance}, {"unit", r.unit}, {"instrument", meter->id()}, {"raw", r.raw_reply}};
+  }
+  if (call == "wait_stable") {
+    auto c = StabilityCriterion::from_json(args.empty() ? json::object() : args[0], options_.warmup);
+    json r = co_await wait_stable(c, control);
+    if (auto lamps = find_role<drivers::LampController>("lamps")) {
+      for (const auto& l : lamps->lamps_on()) known_warm_.insert(l);
+    }
+    co_return r;
+  }
+  if (call == "lamps.select") {
+    std::vector<std::string> on{args[0].get<std::string>()};
+    co_await switch_lamps(on);
+    json result = json::object();
+    result["lamps_on"] = on;
+    co_return result;
+  }
+  if (call == "lamps.set") {
+    std::vector<std::string> on;
+    for (const auto& l : args[0]) {
+      if (!l.is_string()) throw Error(ErrorClass::script_error, "lab.lamps.set takes a list of lamp names");
+      on.push_back(l.get<std::string>());
+    }
+    co_await switch_lamps(on);
+    co_return json{{"lamps_on", on}};
+  }
+  if (call == "lamps.off") {
+    std::vector<std::string> none;
+    co_await switch_lamps(none);
+    json result = json::object();
+    result["lamps_on"] = json::array();
+    co_return result;
+  }
+  if (call == "lamps.names") {
+    auto lamps = role<drivers::LampController>("lamps");
+    co_return json(lamps->lamp_names());
+  }
+  if (call == "dimmer.set") {
+    auto dimmer = role<drivers::Dimmer>("dimmer");
+    co_await ready(*dimmer);
+    const std::string channel = "dimmer";
+    co_await dimmer->set_level(channel, args[0].get<double>() / 100.0);
+    co_return json{{"dimmer_percent", args[0]}};
+  }
+  if (call.rfind("table.", 0) == 0) {
+    auto table = role<drivers::XyTable>("table");
+    co_await ready(*table);
+    if (call == "table.move") {
+      co_await table->move_to(args[0].get<double>(), args[1].get<double>());
+    } else if (call == "table.home") {
+      co_await table->home();
+    } else if (call == "table.head_up") {
+      co_await table->head_up();
+    } else if (call == "table.head_down") {
+      co_await table->head_down();
+    } else if (call == "table.hold_paper") {
+      co_await table->hold_paper(args[0].get<bool>());
+    } else if (call == "table.measure_at") {
+      auto r = co_await table->move_and_measure(args[0].get<double>(), args[1].get<double>());
+      co_return spectrum_json(r, table->id());
+    }
+    co_return json(nullptr);
+  }
+  if (call.rfind("spectro.", 0) == 0) {
+    auto spectro = role<drivers::Spectrometer>("spectrophotometer");
+    co_await ready(*spectro);
+    if (call == "spectro.mode") {
+      co_await spectro->set_mode(mode_from(args[0].get<std::string>()));
+    } else if (call == "spectro.calibrate") {
+      co_await spectro->calibrate();
+    } else if (call == "spectro.measure") {
+      auto r = co_await spectro->measure();
+      co_return spectrum_json(r, spectro->id());
+    }
+    co_return json(nullptr);
+  }
+  if (call == "camera.configure" || call == "camera.capture") {
+    auto camera = role<cam::CameraInstrument>("camera");
+    co_await ready(*camera);
+    if (call == "camera.capture") {
+      // Named, not a temporary in the co_await: GCC 12 destroys such temporaries twice.
+      json options = args.empty() ? json::object() : args[0];
+      json table = co_await capture_noise_table(*camera, options);
+      co_return table;
+    }
+    cam::CameraSettings s;
+    const json& o = args[0];
+    for (const auto& [key, value] : o.items()) {
+      if (!value.is_number()) throw Error(ErrorClass::script_error, "lab.camera.configure: " + key + " must be a number");
+      if (key == "iso") s.iso = value.get<int>();
+      else if (key == "shutter_s") s.shutter_s = value.get<double>();
+      else if (key == "aperture_f") s.aperture_f = value.get<double>();
+      else if (key == "exposure_us") s.exposure_us = value.get<double>();
+      else if (key == "gain") s.gain = value.get<double>();
+      else throw Error(ErrorClass::script_error, "lab.camera.configure: unknown setting '" + key + "' (iso, shutter_s, aperture_f, exposure_us, gain)");
+    }
+    auto error = co_await cam::async_configure(camera->camera(), s, asio::use_awaitable);
+    if (error) throw *error;
+    co_return json(nullptr);
+  }
+  if (call == "wait") {
+    co_await sleep_lab_seconds(args[0].get<double>(), control);
+    co_return json(nullptr);
+  }
+  if (call == "now") {
+    auto now = std::chrono::system_clock::now();
+    co_return json{{"utc", now_iso8601()},
+                   {"unix", std::chrono::duration<double>(now.time_since_epoch()).count()}};
+  }
+  throw Error(ErrorClass::internal, "the lab has no call " + call);
+}
+
+asio::awaitable<json> Lab::restore(const LabState& desired, const ExecutionControl& control) {
+  json done = json::array();
+  std::shared_ptr<drivers::XyTable> table;
+  if (desired.table_used) {
+    table = role<drivers::XyTable>("table");
+    co_await ready(*table);
+    // A process killed mid-move may have left the head down: never drag it across the chart.
+    co_await table->head_up();
+    done.push_back("head up");
+  }
+  if (desired.spectro_mode || desired.spectro_calibrated) {
+    auto spectro = role<drivers::Spectrometer>("spectrophotometer");
+    co_await ready(*spectro);
+    if (desired.spectro_mode) co_await spectro->set_mode(mode_from(*desired.spectro_mode));
+    if (desired.spectro_calibrated) {
+      bool valid = false;
+      for (const auto& c : spectro->calibration()) valid = valid || c.valid;
+      // The calibration lived in the previous process's driver (and the instrument may have been
+      // power-cycled): calibrate again rather than trust it.
+      if (!valid) {
+        co_await spectro->calibrate();
+        done.push_back("white calibration");
+      }
+    }
+  }
+  if (desired.lamps_on) {
+    // A fresh driver does not know what the widget last sent: send the whole state again.
+    co_await switch_lamps(*desired.lamps_on);
+    done.push_back(json{{"lamps_on", *desired.lamps_on}});
+  }
+  if (desired.dimmer_percent) {
+    auto dimmer = role<drivers::Dimmer>("dimmer");
+    co_await ready(*dimmer);
+    const std::string channel = "dimmer";
+    co_await dimmer->set_level(channel, *desired.dimmer_percent / 100.0);
+    done.push_back(json{{"dimmer_percent", *desired.dimmer_percent}});
+  }
+  if (desired.any_lamp_on()) {
+    bool warm = std::all_of(desired.lamps_on->begin(), desired.lamps_on->end(),
+                            [&](const std::string& l) { return known_warm_.count(l) > 0; });
+    if (!warm) {
+      if (find_role<drivers::LuminanceMeter>("luminance_meter")) {
+        json r = co_await wait_stable(options_.warmup, control);
+        done.push_back(json{{"lamps_stable", r}});
+      } else {
+        co_await sleep_lab_seconds(options_.lamp_warmup_s, control);
+        done.push_back(json{{"lamp_warmup_s", options_.lamp_warmup_s}});
+      }
+      for (const auto& l : *desired.lamps_on) known_warm_.insert(l);
+    }
+  }
+  if (table) {
+    if (desired.table_xy) {
+      co_await table->move_to(desired.table_xy->first, desired.table_xy->second);
+      done.push_back(json{{"table_mm", {desired.table_xy->first, desired.table_xy->second}}});
+    }
+    if (desired.head_down) co_await table->head_down();
+    if (desired.paper_held) co_await table->hold_paper(*desired.paper_held);
+  }
+  if (!desired.camera_settings.is_null()) {
+    const std::string configure = "camera.configure";
+    json args = json::array();
+    args.push_back(desired.camera_settings);
+    co_await perform(configure, args, control);
+    done.push_back(json{{"camera", desired.camera_settings}});
+  }
+  co_return done;
+}
+
+asio::awaitable<void> Lab::safe_state() {
+  for (const auto& i : instruments_.all()) {
+    if (i->state() == drivers::InstrumentState::disconnected) continue;
+    try {
+      if (auto table = std::dynamic_pointer_cast<drivers::XyTable>(i)) {
+        co_await table->head_up();
+        co_await table->home();
+      }
+      if (options_.lamps_off_at_shutdown) {
+        if (auto lamps = std::dynamic_pointer_cast<drivers::LampController>(i)) {
+          std::vector<std::string> none;
+          co_await lamps->set_lamps(none);
+        }
+      }
+    } catch (const Error& e) {
+      log::warning("lab", i->id() + ": cannot reach the safe state: " + e.what());
+    }
+  }
+}
+
+}  // namespace colorlab::campaigns

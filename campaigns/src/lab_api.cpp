@@ -1,0 +1,278 @@
+#include "colorlab/campaigns/lab_api.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <vector>
+
+#include <lua5.4/lua.hpp>
+
+#include "colorlab/analysis/statistics.hpp"
+#include "colorlab/campaigns/lua_value.hpp"
+#include "colorlab/core/error.hpp"
+
+namespace colorlab::campaigns {
+
+using nlohmann::json;
+
+namespace {
+
+struct CallSpec {
+  CallKind kind;
+  std::vector<std::string> args;  // json types: "string", "number", "boolean", "list", "table"; "?" suffix = optional
+};
+
+const std::map<std::string, CallSpec>& call_specs() {
+  static const std::map<std::string, CallSpec> specs = {
+      {"lamps.select", {CallKind::effect, {"string"}}},
+      {"lamps.set", {CallKind::effect, {"list"}}},
+      {"lamps.off", {CallKind::effect, {}}},
+      {"lamps.names", {CallKind::reading, {}}},
+      {"dimmer.set", {CallKind::effect, {"number"}}},
+      {"table.move", {CallKind::effect, {"number", "number"}}},
+      {"table.home", {CallKind::effect, {}}},
+      {"table.head_up", {CallKind::effect, {}}},
+      {"table.head_down", {CallKind::effect, {}}},
+      {"table.hold_paper", {CallKind::effect, {"boolean"}}},
+      {"table.measure_at", {CallKind::reading, {"number", "number"}}},
+      {"spectro.mode", {CallKind::effect, {"string"}}},
+      {"spectro.calibrate", {CallKind::effect, {}}},
+      {"spectro.measure", {CallKind::reading, {}}},
+      {"meter.measure", {CallKind::reading, {}}},
+      {"camera.configure", {CallKind::effect, {"table"}}},
+      {"camera.capture", {CallKind::reading, {"table?"}}},
+      {"wait", {CallKind::effect, {"number"}}},
+      {"wait_stable", {CallKind::reading, {"table?"}}},
+      {"now", {CallKind::reading, {}}},
+      {"checkpoint", {CallKind::control, {}}},
+  };
+  return specs;
+}
+
+std::string json_kind(const json& v) {
+  if (v.is_null()) return "nil";
+  if (v.is_string()) return "string";
+  if (v.is_number()) return "number";
+  if (v.is_boolean()) return "boolean";
+  if (v.is_array()) return "list";
+  return "table";
+}
+
+// Empty string = fine; otherwise what is wrong, in the script author's terms.
+std::string check_args(const std::string& call, const json& args) {
+  const auto& spec = call_specs().at(call).args;
+  if (args.size() > spec.size()) {
+    return "lab." + call + " takes " + std::to_string(spec.size()) + " argument(s), got " + std::to_string(args.size());
+  }
+  for (std::size_t i = 0; i < spec.size(); ++i) {
+    std::string want = spec[i];
+    bool optional = !want.empty() && want.back() == '?';
+    if (optional) want.pop_back();
+    json v = i < args.size() ? args[i] : json(nullptr);
+    std::string got = json_kind(v);
+    if (got == "nil" && optional) continue;
+    bool ok = got == want || (want == "list" && got == "table" && v.empty()) || (want == "table" && got == "list" && v.empty());
+    if (!ok) return "bad argument #" + std::to_string(i + 1) + " to lab." + call + " (" + want + " expected, got " + got + ")";
+  }
+  if (call == "dimmer.set" && !(args[0].get<double>() >= 0 && args[0].get<double>() <= 100)) {
+    return "lab.dimmer.set takes a level in percent from 0 to 100, got " + args[0].dump();
+  }
+  if (call == "wait" && !(args[0].get<double>() >= 0 && args[0].get<double>() <= 86400)) {
+    return "lab.wait takes seconds from 0 to 86400, got " + args[0].dump();
+  }
+  return {};
+}
+
+LabCallSink* sink_of(lua_State* L) { return static_cast<LabCallSink*>(lua_touserdata(L, lua_upvalueindex(1))); }
+
+// Raises the message on top of the stack as a Lua error with the calling line in front. Only call
+// it once every C++ object of the caller is destroyed: lua_error longjmps.
+int raise_top(lua_State* L) {
+  luaL_where(L, 1);
+  lua_insert(L, -2);
+  lua_concat(L, 2);
+  return lua_error(L);
+}
+
+int yielding_call(lua_State* L) {
+  LabCallSink* sink = sink_of(L);
+  const char* call = lua_tostring(L, lua_upvalueindex(2));
+  if (!sink) return luaL_error(L, "lab.%s can only be called while the campaign runs (inside run)", call);
+  if (!sink->is_campaign_thread(L) || !lua_isyieldable(L)) {
+    return luaL_error(L, "lab.%s cannot be called from a coroutine or a callback (table.sort, string.gsub); call it from run", call);
+  }
+  bool failed = false;
+  {
+    try {
+      json args = json::array();
+      int n = lua_gettop(L);
+      for (int i = 1; i <= n; ++i) args.push_back(to_json(L, i, "argument #" + std::to_string(i) + " to lab." + call));
+      while (!args.empty() && args.back().is_null()) args.erase(args.end() - 1);
+      std::string problem = check_args(call, args);
+      if (!problem.empty()) throw Error(ErrorClass::script_error, problem);
+      sink->request(call, std::move(args));
+    } catch (const Error& e) {
+      lua_pushstring(L, e.info().message.c_str());
+      failed = true;
+    } catch (const std::exception& e) {
+      lua_pushstring(L, e.what());
+      failed = true;
+    }
+  }
+  if (failed) return raise_top(L);
+  lua_settop(L, 0);
+  return lua_yield(L, 0);
+}
+
+int lab_record(lua_State* L) {
+  LabCallSink* sink = sink_of(L);
+  if (!sink) return luaL_error(L, "lab.record can only be called while the campaign runs (inside run)");
+  bool failed = false;
+  {
+    try {
+      if (lua_type(L, 1) != LUA_TSTRING) throw Error(ErrorClass::script_error, "bad argument #1 to lab.record (step key string expected)");
+      if (lua_type(L, 2) != LUA_TTABLE) {
+        throw Error(ErrorClass::script_error, "bad argument #2 to lab.record (table {quantity=, value=, unit=, instrument=, data=} expected)");
+      }
+      std::string step = lua_tostring(L, 1);
+      json fields = to_json(L, 2, "lab.record's fields");
+      if (step.empty() || step.size() > 256) throw Error(ErrorClass::script_error, "lab.record: the step key must be 1 to 256 characters");
+      if (!fields.is_object() || !fields.contains("quantity") || !fields["quantity"].is_string()) {
+        throw Error(ErrorClass::script_error, "lab.record: fields.quantity (a string) is required");
+      }
+      if (fields.contains("value") && !fields["value"].is_number() && !fields["value"].is_null()) {
+        throw Error(ErrorClass::script_error, "lab.record: fields.value must be a number (put other payloads in fields.data)");
+      }
+      sink->record(step, fields);
+    } catch (const Error& e) {
+      lua_pushstring(L, e.info().message.c_str());
+      failed = true;
+    } catch (const std::exception& e) {
+      lua_pushstring(L, e.what());
+      failed = true;
+    }
+  }
+  if (failed) return raise_top(L);
+  return 0;
+}
+
+int lab_progress(lua_State* L) {
+  LabCallSink* sink = sink_of(L);
+  if (!sink) return luaL_error(L, "lab.progress can only be called while the campaign runs (inside run)");
+  double fraction = luaL_checknumber(L, 1);
+  if (!(fraction >= 0 && fraction <= 1)) return luaL_error(L, "lab.progress takes a fraction from 0 to 1");
+  std::size_t n = 0;
+  const char* label = luaL_optlstring(L, 2, "", &n);
+  bool failed = false;
+  {
+    try {
+      sink->progress(fraction, std::string(label, n));
+    } catch (const std::exception& e) {
+      lua_pushstring(L, e.what());
+      failed = true;
+    }
+  }
+  if (failed) return raise_top(L);
+  return 0;
+}
+
+int lab_log(lua_State* L) {
+  LabCallSink* sink = sink_of(L);
+  int n = lua_gettop(L);
+  luaL_Buffer b;
+  luaL_buffinit(L, &b);
+  for (int i = 1; i <= n; ++i) {
+    if (i > 1) luaL_addchar(&b, ' ');
+    luaL_tolstring(L, i, nullptr);
+    luaL_addvalue(&b);
+  }
+  luaL_pushresult(&b);
+  if (sink) {
+    bool failed = false;
+    {
+      try {
+        sink->log(lua_tostring(L, -1));
+      } catch (const std::exception& e) {
+        lua_pushstring(L, e.what());
+        failed = true;
+      }
+    }
+    if (failed) return raise_top(L);
+  }
+  return 0;
+}
+
+// lab.analysis.summarize({...}) → {count, mean, stdev, median, min, max}: the one summary used everywhere.
+int analysis_summarize(lua_State* L) {
+  luaL_checktype(L, 1, LUA_TTABLE);
+  lua_Integer n = luaL_len(L, 1);
+  std::vector<double> values;
+  values.reserve(static_cast<std::size_t>(std::max<lua_Integer>(n, 0)));
+  for (lua_Integer i = 1; i <= n; ++i) {
+    lua_rawgeti(L, 1, i);
+    int isnum = 0;
+    double v = lua_tonumberx(L, -1, &isnum);
+    lua_pop(L, 1);
+    if (!isnum) return luaL_error(L, "lab.analysis.summarize: element %d is not a number", static_cast<int>(i));
+    values.push_back(v);
+  }
+  if (values.empty()) return luaL_error(L, "lab.analysis.summarize: no values");
+  analysis::Summary s = analysis::summarize(values);
+  lua_createtable(L, 0, 6);
+  lua_pushinteger(L, static_cast<lua_Integer>(s.count));
+  lua_setfield(L, -2, "count");
+  const std::pair<const char*, double> fields[] = {
+      {"mean", s.mean}, {"stdev", s.stdev}, {"median", s.median}, {"min", s.min}, {"max", s.max}};
+  for (const auto& [k, v] : fields) {
+    lua_pushnumber(L, v);
+    lua_setfield(L, -2, k);
+  }
+  return 1;
+}
+
+void set_function(lua_State* L, const char* field, lua_CFunction f, LabCallSink* sink, const char* call = nullptr) {
+  lua_pushlightuserdata(L, sink);
+  if (call) {
+    lua_pushstring(L, call);
+    lua_pushcclosure(L, f, 2);
+  } else {
+    lua_pushcclosure(L, f, 1);
+  }
+  lua_setfield(L, -2, field);
+}
+
+}  // namespace
+
+CallKind kind_of(const std::string& call) {
+  auto it = call_specs().find(call);
+  if (it == call_specs().end()) throw Error(ErrorClass::internal, "unknown lab call " + call);
+  return it->second.kind;
+}
+
+void install_lab_api(lua_State* L, LabCallSink* sink) {
+  lua_newtable(L);  // lab
+  std::map<std::string, std::vector<std::string>> groups;
+  for (const auto& [call, spec] : call_specs()) {
+    auto dot = call.find('.');
+    if (dot == std::string::npos) {
+      set_function(L, call.c_str(), yielding_call, sink, call.c_str());
+    } else {
+      groups[call.substr(0, dot)].push_back(call);
+    }
+  }
+  for (const auto& [group, calls] : groups) {
+    lua_newtable(L);
+    for (const auto& call : calls) set_function(L, call.substr(call.find('.') + 1).c_str(), yielding_call, sink, call.c_str());
+    lua_setfield(L, -2, group.c_str());
+  }
+  set_function(L, "record", lab_record, sink);
+  set_function(L, "progress", lab_progress, sink);
+  set_function(L, "log", lab_log, sink);
+  lua_newtable(L);
+  lua_pushcfunction(L, analysis_summarize);
+  lua_setfield(L, -2, "summarize");
+  lua_setfield(L, -2, "analysis");
+  lua_setglobal(L, "lab");
+}
+
+}  // namespace colorlab::campaigns
