@@ -12,11 +12,12 @@ packages=(
   # libraries
   libboost-dev libsqlite3-dev libserialport-dev libhidapi-dev libusb-1.0-0-dev libraw-dev libaravis-dev
   libgphoto2-dev liblcms2-dev libeigen3-dev nlohmann-json3-dev libtomlplusplus-dev libcli11-dev liblua5.4-dev
-  libtiff-dev libjpeg-dev libsystemd-dev libssl-dev libgtest-dev libgmock-dev libbenchmark-dev
+  libtiff-dev libjpeg-dev libsystemd-dev libssl-dev libgtest-dev libgmock-dev libbenchmark-dev libopencv-dev
   # standard CIE data at run time
   colord-data
   # independent references and test tools
   argyll aravis-tools aravis-tools-cli libraw-bin dcraw python3-numpy hyperfine sqlite3 curl util-linux procps strace
+  imagemagick
 )
 
 missing=()
