@@ -19,6 +19,8 @@
 
 namespace colorlab::analysis::testing {
 
+using Quad4 = std::array<std::array<double, 2>, 4>;
+
 struct FlatChart {
   int width = 0, height = 0;
   int margin = 20, pitch = 38, size = 30;  // pixels; size / pitch ≈ the layout's patch size

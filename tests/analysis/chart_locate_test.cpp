@@ -16,7 +16,8 @@ namespace {
 
 using testing::FlatChart;
 using testing::Posed;
-using Quad4 = std::array<std::array<double, 2>, 4>;
+using testing::Quad4;
+
 
 constexpr double kCentreBound = 2.0;  // px, the goal
 

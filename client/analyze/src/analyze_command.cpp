@@ -16,6 +16,7 @@
 #include "colorlab/analysis/regression.hpp"
 #include "colorlab/analysis/uniformity.hpp"
 #include "colorlab/core/error.hpp"
+#include "locate_chart_command.hpp"
 #include "pgm_reader.hpp"
 
 namespace colorlab::cli {
@@ -386,6 +387,7 @@ void add_analyze_command(CLI::App& app) {
     c->add_flag("--json", o->json, "JSON instead of CSV");
     c->callback([o] { run_averaging(*o); });
   }
+  detail::add_locate_chart_command(*analyze);
 }
 
 }  // namespace colorlab::cli
