@@ -10,6 +10,7 @@
 
 #include "colorlab/analysis/colorimetry.hpp"
 #include "colorlab/core/error.hpp"
+#include "chart_pose.hpp"
 #include "fast_random.hpp"
 #include "sensitivities.hpp"
 
@@ -61,6 +62,7 @@ struct CameraModel::Impl {
   std::uint64_t seed = 0;
   detail::Sensitivities sens;
   double px_per_mm = 0, origin_x = 0, origin_y = 0;  // chart top-left in pixels
+  std::optional<detail::PoseGeometry> pose;            // set: the chart at a pose instead
   std::vector<Spectrum> material_reflectance;          // material_count
   // response[lamp][material][channel]: green-normalised exposure per cd/m² of floor luminance.
   std::array<std::vector<std::array<double, 3>>, 5> response;
@@ -95,15 +97,27 @@ struct CameraModel::Impl {
   std::shared_ptr<const Moments> moments_for(const std::shared_ptr<const Precomputed>& pre,
                                              const std::array<float, 5>& warm) const;
 
+  // Chart millimetres of a continuous image position (pixel x covers [x, x+1)).
+  std::pair<double, double> chart_mm(double u, double v) const {
+    if (pose) return pose->chart_of(u, v);
+    return {(u - origin_x) / px_per_mm, (v - origin_y) / px_per_mm};
+  }
+  // Continuous image position of a chart point.
+  std::pair<double, double> image_of(double X, double Y) const {
+    if (pose) return pose->image_of(X, Y);
+    return {origin_x + X * px_per_mm, origin_y + Y * px_per_mm};
+  }
+
   int material_at(int x, int y) const {
-    const double cx = (x + 0.5 - origin_x) / px_per_mm, cy = (y + 0.5 - origin_y) / px_per_mm;
+    const auto [cx, cy] = chart_mm(x + 0.5, y + 0.5);
     if (cx < 0 || cy < 0 || cx >= chart_width_mm || cy >= chart_height_mm) return floor_material;
     const auto p = scene->chart().patch_at(cx, cy);
     return p ? *p : surround_material;
   }
 
   std::pair<double, double> floor_mm(double x, double y) const {
-    return scene->chart_to_floor_mm((x - origin_x) / px_per_mm, (y - origin_y) / px_per_mm);
+    const auto [cx, cy] = chart_mm(x, y);
+    return scene->chart_to_floor_mm(cx, cy);
   }
 
   double vignetting(int x, int y, double f_number) const {
@@ -327,7 +341,25 @@ CameraModel::CameraModel(std::shared_ptr<const Scene> scene, CameraConfig config
       }
     }
   }
+  if (m.config.pose) m.pose.emplace(*m.config.pose, m.config.width, m.config.height, m.config.chart_height_fraction);
   for (const auto& p : m.scene->chart().patches) {
+    if (m.pose) {
+      // The largest axis-aligned rectangle centred on the patch inside its image (pixel centres at +0.5).
+      const auto c = m.image_of(p.x_mm + p.size_mm / 2, p.y_mm + p.size_mm / 2);
+      const double corners[4][2] = {{p.x_mm, p.y_mm}, {p.x_mm + p.size_mm, p.y_mm}, {p.x_mm + p.size_mm, p.y_mm + p.size_mm}, {p.x_mm, p.y_mm + p.size_mm}};
+      double h = 1e300;
+      for (int i = 0; i < 4; ++i) {
+        const auto a = m.image_of(corners[i][0], corners[i][1]), b = m.image_of(corners[(i + 1) % 4][0], corners[(i + 1) % 4][1]);
+        const double ex = b.first - a.first, ey = b.second - a.second, len = std::hypot(ex, ey);
+        const double nx = -ey / len, ny = ex / len;
+        h = std::min(h, std::abs(nx * (c.first - a.first) + ny * (c.second - a.second)) / (std::abs(nx) + std::abs(ny)));
+      }
+      h *= 0.95;  // the distorted edges bow a little
+      const int x0 = static_cast<int>(std::ceil(c.first - h - 0.5)), x1 = static_cast<int>(std::floor(c.first + h - 0.5));
+      const int y0 = static_cast<int>(std::ceil(c.second - h - 0.5)), y1 = static_cast<int>(std::floor(c.second + h - 0.5));
+      m.regions.push_back({x0, y0, std::max(1, x1 - x0 + 1), std::max(1, y1 - y0 + 1)});
+      continue;
+    }
     // Pixels whose centres lie inside the patch square.
     const int x0 = static_cast<int>(std::ceil(m.origin_x + p.x_mm * m.px_per_mm - 0.5));
     const int x1 = static_cast<int>(std::ceil(m.origin_x + (p.x_mm + p.size_mm) * m.px_per_mm - 0.5));
@@ -398,6 +430,34 @@ PatchRegion CameraModel::patch_region(int patch_index) const {
   if (patch_index < 0 || patch_index >= chart_patch_count)
     throw Error(ErrorClass::bad_parameter, "patch index " + std::to_string(patch_index) + " is outside 0..139");
   return impl_->regions[static_cast<std::size_t>(patch_index)];
+}
+
+std::array<double, 2> CameraModel::patch_centre_px(int patch_index) const {
+  if (patch_index < 0 || patch_index >= chart_patch_count)
+    throw Error(ErrorClass::bad_parameter, "patch index " + std::to_string(patch_index) + " is outside 0..139");
+  const auto& p = impl_->scene->chart().patches[static_cast<std::size_t>(patch_index)];
+  const auto c = impl_->image_of(p.x_mm + p.size_mm / 2, p.y_mm + p.size_mm / 2);
+  return {c.first - 0.5, c.second - 0.5};
+}
+
+std::array<std::array<double, 2>, 4> CameraModel::patch_grid_corners_px() const {
+  const auto& ps = impl_->scene->chart().patches;
+  const auto& a1 = ps.front();
+  const auto& n10 = ps.back();
+  const double x0 = a1.x_mm, y0 = a1.y_mm, x1 = n10.x_mm + n10.size_mm, y1 = n10.y_mm + n10.size_mm;
+  std::array<std::array<double, 2>, 4> out{};
+  const double pts[4][2] = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
+  for (std::size_t i = 0; i < 4; ++i) {
+    const auto c = impl_->image_of(pts[i][0], pts[i][1]);
+    out[i] = {c.first - 0.5, c.second - 0.5};
+  }
+  return out;
+}
+
+LensIntrinsics CameraModel::lens() const {
+  if (impl_->pose) return impl_->pose->intrinsics();
+  const double f = impl_->px_per_mm * 1200.0;  // nominal: the chart 1.2 m away
+  return {f, f, impl_->config.width / 2.0 - 0.5, impl_->config.height / 2.0 - 0.5, 0, 0};
 }
 
 std::array<double, 3> CameraModel::ground_truth(int patch_index, const CameraSettings& settings) const {

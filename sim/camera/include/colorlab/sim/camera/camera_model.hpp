@@ -20,6 +20,24 @@
 
 namespace colorlab::sim::camera {
 
+// Where the chart sits in front of the camera (issue 14). Unset in CameraConfig: the chart square to the sensor,
+// centred, filling chart_height_fraction of the frame height, no lens distortion (the original behaviour).
+struct ChartPose {
+  double rotation_deg = 0;   // in the image plane, clockwise
+  double tilt_deg = 0;       // about the chart's horizontal axis (positive: its top edge leans away)
+  double swing_deg = 0;      // about its vertical axis (positive: its right edge leans away)
+  double distance_mm = 1200; // camera to chart centre; the focal length keeps the chart at chart_height_fraction
+  double shift_x = 0, shift_y = 0;  // chart centre offset as a fraction of the frame width / height
+  double k1 = 0, k2 = 0;     // radial lens distortion (OpenCV's model, coordinates normalised by the focal length)
+};
+// A plausible bench pose for a seed: a few degrees of rotation and tilt, some shift, mild barrel distortion.
+ChartPose random_chart_pose(std::uint64_t seed);
+
+// The pinhole camera of a posed chart, in OpenCV's conventions (pixel centres at integers).
+struct LensIntrinsics {
+  double fx = 0, fy = 0, cx = 0, cy = 0, k1 = 0, k2 = 0;
+};
+
 struct CameraConfig {
   int width = 3504;    // even
   int height = 2336;   // even
@@ -28,6 +46,7 @@ struct CameraConfig {
   std::optional<std::filesystem::path> sensitivity_file;
   bool force_parametric_sensitivities = false;
   double chart_height_fraction = 0.8;  // of the frame height the chart fills
+  std::optional<ChartPose> pose;       // unset: square to the sensor, centred, no distortion
   // Sensor (EOS-20D-like): DN per electron at ISO 100, full well, read noise, dark current.
   double gain_dn_per_e_iso100 = 0.09;
   double read_noise_e = 9.0;
@@ -77,8 +96,15 @@ class CameraModel {
   // Same, reusing `out`'s buffer.
   void render_into(RawFrame& out, const CameraSettings& settings, std::uint64_t frame_index) const;
 
-  // Pixel rectangle of patch 0..139 (Chart order: A1, A2, ..., N10).
+  // Pixel rectangle of patch 0..139 (Chart order: A1, A2, ..., N10). With a pose: the largest axis-aligned
+  // rectangle centred on the patch inside its (tilted) image.
   PatchRegion patch_region(int patch_index) const;
+  // Ground truth of the geometry, pixel centres at integers (OpenCV's convention): a patch's centre, and the outer
+  // corners of the patch grid (A1's, N1's, N10's, A10's outer corner) in that order.
+  std::array<double, 2> patch_centre_px(int patch_index) const;
+  std::array<std::array<double, 2>, 4> patch_grid_corners_px() const;
+  // The lens of a posed chart (zero distortion and a nominal focal length without a pose).
+  LensIntrinsics lens() const;
   // Ground truth: noiseless mean counts (including the black level) of R, G, B pixels over the patch region,
   // without PRNU, dust and defective pixels, for the scene's current state.
   std::array<double, 3> ground_truth(int patch_index, const CameraSettings& settings) const;
