@@ -120,10 +120,12 @@ BlackBoxModel fit_blackbox(const Eigen::MatrixXd& spectra, const Eigen::MatrixXd
       throw Error(ErrorClass::bad_data, "black box: prior has " + std::to_string(o.prior->wavelengths.size()) +
                                             " bands, spectra " + std::to_string(m));
     model.with_prior = true;
+    model.sensitivity_sdev.resize(3, m);
     for (int c = 0; c < 3; ++c) {
       PriorFit fit = fit_with_prior(o.prior->channels[static_cast<std::size_t>(c)], X, raw.col(c));
       model.lambda[static_cast<std::size_t>(c)] = fit.lambda;
       model.sensitivities.row(c) = fit.curve.transpose() / xscale;
+      model.sensitivity_sdev.row(c) = fit.sdev.transpose() / xscale;
     }
     return model;
   }

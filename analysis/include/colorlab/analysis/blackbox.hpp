@@ -29,6 +29,9 @@ struct BlackBoxModel {
   Eigen::MatrixXd sensitivities;  // 3 × bands (R, G, B)
   std::array<double, 3> lambda{};  // penalty weights used: relative smoothness weight, or the prior's λ
   bool with_prior = false;
+  // With a prior: 3 × bands posterior standard deviations of `sensitivities` (see PriorFit::sdev); credible_band()
+  // turns a row into a band. Empty without a prior: the smoothness penalty has no calibrated posterior.
+  Eigen::MatrixXd sensitivity_sdev;
   Eigen::MatrixXd predict(const Eigen::MatrixXd& spectra) const;  // n × bands → n × 3 RAW
 };
 

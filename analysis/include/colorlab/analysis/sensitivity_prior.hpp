@@ -42,11 +42,23 @@ std::vector<std::string> camera_names(const SpectralSet& curves);
 struct PriorFit {
   Eigen::VectorXd curve;  // bands, ≥ 0, in the units that make X · curve ≈ y
   double lambda = 0;      // prior weight chosen (noise variance / prior variance)
+  // Posterior standard deviation of the curve at each band (same units as `curve`): the Gaussian posterior of
+  // (amplitude, components) given y, with the noise variance at its REML estimate. A point estimate can be far off
+  // where the chart does not see the curve (the SG under one lamp pins ~8 of 33 directions); this says where.
+  Eigen::VectorXd sdev;
+  double noise_sdev = 0;  // REML estimate of the RAW noise σ, in y's units
 };
 
 // argmin ‖X s − y‖² + λ Σ c_i²/sdev_i² over s = a·mean + directions·c, subject to s ≥ 0 at every band.
 // λ maximises the restricted (REML) marginal likelihood of y under the Gaussian prior; the constrained problem is
 // solved exactly (Lawson & Hanson's LSI → LDP → NNLS).
 PriorFit fit_with_prior(const ChannelPrior& prior, const Eigen::MatrixXd& X, const Eigen::VectorXd& y);
+
+// Credible band curve ± z·sdev, clipped at 0 below (a sensitivity is never negative). z = 1.96 is the pointwise 95 %
+// interval of the Gaussian posterior.
+struct CurveBand {
+  Eigen::VectorXd lower, upper;
+};
+CurveBand credible_band(const Eigen::VectorXd& curve, const Eigen::VectorXd& sdev, double z = 1.96);
 
 }  // namespace colorlab::analysis
