@@ -17,6 +17,7 @@
 #include "colorlab/analysis/regression.hpp"
 #include "colorlab/analysis/standard_data.hpp"
 #include "colorlab/core/error.hpp"
+#include "argyll_reference.hpp"
 #include "test_support.hpp"
 
 namespace ca = colorlab::analysis;
@@ -107,35 +108,8 @@ TEST(AnalysisRegression, RecoversAGeneratingPolynomialAndLooMatchesExplicitRefit
   EXPECT_TRUE(std::isfinite(k5.s76.mean));
 }
 
-struct ArgyllResult {
-  double avg = NAN, peak = NAN;
-};
-
-// Builds an Argyll profile from the chart and checks it against the same chart, as the notes' recipe does.
-ArgyllResult argyll_profile_check(const ca::ChartData& chart, const std::string& algo, const std::filesystem::path& dir,
-                                  bool de2000, const ca::ChartData* test = nullptr, const std::string& quality = "m") {
-  ca::write_argyll_ti3(dir / "train.ti3", chart);
-  const std::string base = (dir / ("p_" + algo)).string();
-  std::string cmd = "cd '" + dir.string() + "' && colprof -q" + quality + " -a" + algo + " -ua -O '" + base + ".icc' train";
-  if (ca::testing::run(cmd) != 0) return {};
-  std::string check_ti3 = (dir / "train.ti3").string();
-  if (test) {
-    ca::write_argyll_ti3(dir / "test.ti3", *test);
-    check_ti3 = (dir / "test.ti3").string();
-  }
-  const std::string out = (dir / "profcheck.txt").string();
-  cmd = std::string("profcheck ") + (de2000 ? "-k " : "") + "'" + check_ti3 + "' '" + base + ".icc' > '" + out + "' 2>&1";
-  if (std::system(cmd.c_str()) != 0) return {};
-  std::ifstream f(out);
-  std::string text((std::istreambuf_iterator<char>(f)), {});
-  std::smatch m;
-  ArgyllResult r;
-  if (std::regex_search(text, m, std::regex(R"(max\. = ([0-9.]+), avg\. = ([0-9.]+))"))) {
-    r.peak = std::stod(m[1]);
-    r.avg = std::stod(m[2]);
-  }
-  return r;
-}
+using ca::testing::argyll_profile_check;
+using ca::testing::ArgyllResult;
 
 TEST(AnalysisArgyllComparison, MatrixFitMatchesColprofMatrixOnTheSameChart) {
   COLORLAB_REQUIRE_SHARED(cc24, "testvec_cc24_canon20d_d50_argyll.csv");

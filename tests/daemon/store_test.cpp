@@ -1,5 +1,5 @@
 // The store's promises: forward-only migrations, refusal of newer or foreign files, durable
-// measurements, interrupted runs finalised at open, idempotent execution creation, keyset paging.
+// measurements, unfinished scripted runs kept for resume (legacy ones finalised) at open, whole steps, idempotent execution creation, keyset paging.
 #include <gtest/gtest.h>
 #include <sqlite3.h>
 
@@ -12,6 +12,8 @@ using colorlab::Error;
 using colorlab::ErrorClass;
 using colorlab::protocol::ExecutionStatus;
 using colorlab::store::NewRun;
+using colorlab::store::StepRecord;
+using nlohmann::json;
 using colorlab::store::Store;
 using colorlab::testing::TempDir;
 
@@ -79,32 +81,86 @@ TEST(Store, RejectsGarbageFileWithTypedError) {
   }
 }
 
-TEST(Store, MeasurementsSurviveReopenAndUnfinishedRunsBecomeInterrupted) {
+TEST(Store, MeasurementsSurviveReopenAndUnfinishedRunsAwaitResume) {
   TempDir dir;
-  std::string run_id, exec_id;
+  std::string run_id, exec_id, legacy_run, legacy_exec;
   {
     Store store(dir / "colorlab.db");
-    auto created = store.create_execution(luminance_run());
+    auto run = luminance_run();
+    run.script_sha256 = "abc";
+    run.script_source = "return {run = function() end}";
+    run.random_seed = 42;
+    auto created = store.create_execution(run);
     ASSERT_TRUE(created.created);
     run_id = created.execution.run_id;
     exec_id = created.execution.id;
     store.mark_run_started(run_id);
     store.update_execution(exec_id, ExecutionStatus::running, 0.5, "reading/1");
     store.add_measurement(run_id, "reading/0", "ls110", true, "luminance", 245.5, "cd/m2", {{"raw", "OK00,   245.50"}});
+    // One made before scripts were stored cannot be replayed.
+    auto legacy = store.create_execution(luminance_run());
+    legacy_run = legacy.execution.run_id;
+    legacy_exec = legacy.execution.id;
+    store.update_execution(legacy_exec, ExecutionStatus::running, 0.1, "reading/0");
     // The process "dies" here: no finish_run.
   }
   Store reopened(dir / "colorlab.db");
+  // The scripted execution is left for the daemon to resume, exactly as it was.
+  auto unfinished = reopened.unfinished_executions();
+  ASSERT_EQ(unfinished.size(), 1u);
+  EXPECT_EQ(unfinished[0].id, exec_id);
+  EXPECT_EQ(unfinished[0].status, ExecutionStatus::running);
+  EXPECT_EQ(unfinished[0].step, "reading/1");
+  EXPECT_EQ(unfinished[0].random_seed, 42u);
+  EXPECT_EQ(*reopened.script_source("abc"), "return {run = function() end}");
   EXPECT_EQ(reopened.interrupted_at_open(), 1);
-  auto run = reopened.run(run_id);
-  ASSERT_TRUE(run);
-  EXPECT_EQ(run->status, "interrupted");
-  EXPECT_TRUE(run->finished_at.has_value());
-  EXPECT_EQ(reopened.execution(exec_id)->status, ExecutionStatus::interrupted);
+  EXPECT_EQ(reopened.run(legacy_run)->status, "interrupted");
+  EXPECT_EQ(reopened.execution(legacy_exec)->status, ExecutionStatus::interrupted);
   auto ms = reopened.measurements(run_id);
   ASSERT_EQ(ms.size(), 1u);
   EXPECT_DOUBLE_EQ(*ms[0].value, 245.5);
   EXPECT_TRUE(ms[0].simulated);
   EXPECT_EQ(ms[0].data["raw"], "OK00,   245.50");
+}
+
+// A campaign step is one transaction: journal, measurements, progress and event together, or none.
+TEST(Store, CommittedStepIsWholeAndAStepStoredTwiceLeavesNothingHalfDone) {
+  TempDir dir;
+  Store store(dir / "colorlab.db");
+  auto run = luminance_run();
+  run.script_sha256 = "s1";
+  run.script_source = "x";
+  auto e = store.create_execution(run).execution;
+  StepRecord step;
+  step.journal.push_back({0, "meter.measure", json::array(), {{"luminance", 245.5}}});
+  step.measurements.push_back({"reading/0", "ls110", true, "luminance", 245.5, "cd/m2", nullptr});
+  step.progress = 0.5;
+  step.step = "reading/0";
+  store.commit_step(e, step);
+  EXPECT_EQ(store.journal(e.id).size(), 1u);
+  EXPECT_EQ(store.measurement_steps(e.run_id), std::set<std::string>{"reading/0"});
+  EXPECT_EQ(store.execution(e.id)->steps_committed, 1);
+  auto events_before = store.events(0, 1000, std::nullopt).size();
+
+  // The same measurement again (and a new journal entry) must fail whole.
+  StepRecord again = step;
+  again.journal[0].seq = 1;
+  EXPECT_THROW(store.commit_step(e, again), colorlab::Error);
+  EXPECT_EQ(store.journal(e.id).size(), 1u);
+  EXPECT_EQ(store.measurements(e.run_id).size(), 1u);
+  EXPECT_EQ(store.events(0, 1000, std::nullopt).size(), events_before);
+
+  // Resume attempts count up and a committed step resets them.
+  EXPECT_EQ(store.begin_resume(e.id), 1);
+  EXPECT_EQ(store.begin_resume(e.id), 2);
+  StepRecord next;
+  next.journal.push_back({1, "meter.measure", json::array(), {{"luminance", 246.0}}});
+  next.step = "reading/1";
+  store.commit_step(e, next);
+  EXPECT_EQ(store.execution(e.id)->resume_attempts, 0);
+  auto summary = store.measurement_summary(e.run_id);
+  EXPECT_EQ(summary["luminance"]["count"], 1);
+  EXPECT_DOUBLE_EQ(summary["luminance"]["mean"].get<double>(), 245.5);
 }
 
 TEST(Store, RepeatedStepIsAConflictNotADuplicate) {

@@ -61,18 +61,18 @@ TEST(EmbeddedDefault, DaemonWithoutConfigStartsTheSimulatedLab) {
 // §6.1.3 / Table 2 through the whole stack: GigE Vision over loopback, the camera driver, the
 // analysis code, the store. Truth is the shape physics demands: the spread of an averaged uniform
 // region falls with N, roughly as 1/√N at first, then levels off at the fixed-pattern floor.
-TEST(EmbeddedDefault, ImageAveragingReproducesTable2Shape) {
+TEST(EmbeddedDefault, FrameAverageReproducesTable2Shape) {
   EmbeddedDaemon daemon;
   json instruments = json::parse(daemon.cli({"instruments"}).out);
   bool have_camera = false;
   for (const auto& i : instruments["items"]) have_camera = have_camera || i["kind"] == "genicam";
   if (!have_camera) GTEST_SKIP() << "the simulated lab could not start its GigE Vision camera on 127.0.0.1";
 
-  auto r = daemon.cli({"run", "image-averaging", "--param", "frames=16"});
+  auto r = daemon.cli({"run", "frame-average", "--param", "frames=16"});
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
   json run = json::parse(r.out);
   ASSERT_EQ(run["status"], "finished_ok");
-  const json& table = run["summary"]["stdev_by_frames_averaged"];
+  const json& table = run["summary"]["script"]["stdev_by_frames_averaged"];
   for (const char* channel : {"R", "G", "B"}) {
     double s1 = table["1"][channel], s2 = table["2"][channel], s4 = table["4"][channel], s16 = table["16"][channel];
     EXPECT_GT(s1, s2) << channel;

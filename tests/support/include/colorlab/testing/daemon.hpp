@@ -1,0 +1,44 @@
+#pragma once
+// colorlabd as a real process for integration tests: started on a state directory (and a
+// configuration file, if any) with port 0, found through the endpoint file it writes once it
+// serves, killed with SIGKILL or stopped with SIGTERM, and started again on the same state.
+#include <chrono>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "colorlab/testing/process.hpp"
+
+namespace colorlab::testing {
+
+// Waits until <state_dir>/colorlabd.endpoint names process `pid` (a file left by a killed
+// predecessor names another pid) and returns its JSON; throws std::runtime_error on timeout.
+nlohmann::json wait_for_endpoint(const std::filesystem::path& state_dir, pid_t pid,
+                                 std::chrono::milliseconds timeout = std::chrono::seconds(20));
+
+class DaemonProcess {
+ public:
+  // `config`: a TOML file for --config; without it colorlabd starts its embedded simulated lab.
+  explicit DaemonProcess(std::filesystem::path state_dir, std::optional<std::filesystem::path> config = std::nullopt,
+                         std::filesystem::path log = {});
+  void start();
+  void kill9();       // no cleanup: the embedded simulated lab dies with it
+  int terminate();    // SIGTERM and wait; returns the exit code
+  bool running();
+  const std::string& url() const { return url_; }
+  Process& process() { return *process_; }
+  const std::filesystem::path& state_dir() const { return state_dir_; }
+
+ private:
+  std::filesystem::path state_dir_;
+  std::optional<std::filesystem::path> config_;
+  std::filesystem::path log_;
+  std::unique_ptr<Process> process_;
+  std::string url_;
+};
+
+}  // namespace colorlab::testing
