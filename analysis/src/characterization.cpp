@@ -17,6 +17,15 @@ std::string Characterization::method() const {
   return std::get<PolynomialModel>(model_).terms().name;
 }
 
+std::string Characterization::describe() const {
+  if (const auto* s = spline()) return s->describe();
+  return std::get<PolynomialModel>(model_).terms().describe();
+}
+
+double Characterization::input_scale() const {
+  return std::visit([](const auto& m) { return m.input_scale(); }, model_);
+}
+
 Characterization fit_method(const std::string& method, const ChartData& train, const FitOptions& o) {
   if (is_spline_method(method)) return Characterization(fit_spline(train, spline_options(method, o)));
   return Characterization(fit(method, train, o));

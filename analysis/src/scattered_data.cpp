@@ -1,5 +1,6 @@
 #include "colorlab/analysis/scattered_data.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -153,6 +154,11 @@ SplineModel fit_spline(const ChartData& train, const SplineOptions& o) {
 Eigen::MatrixXd SplineModel::predict_target(const Eigen::MatrixXd& rgb) const {
   const Eigen::MatrixXd u = cube_root_coordinates(rgb, input_scale_);
   return cubic_kernel(u, centres_) * kernel_ + polynomial_part(base_, rgb / input_scale_, u) * poly_;
+}
+
+std::string SplineModel::describe() const {
+  return "r^3 spline on cube-root RGB over " + base_.name + " + 1 + cube-root terms (lambda " + std::to_string(smoothing_) + ", " +
+         std::to_string(dof_) + " effective parameters per channel, " + std::to_string(centres_.rows()) + " centres)";
 }
 
 Eigen::MatrixXd SplineModel::apply(const Eigen::MatrixXd& rgb) const {

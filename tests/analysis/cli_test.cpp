@@ -60,6 +60,9 @@ TEST(AnalysisCli, FitWithCrossValidationAndTestChart) {
   EXPECT_NE(out.find("# test_summary"), std::string::npos) << out;
   out = run_cli({"analyze", "fit", "--train", sg.string(), "--json"});
   EXPECT_NE(out.find("\"model\""), std::string::npos);
+  EXPECT_NE(out.find("\"rbf:ccm\""), std::string::npos) << "auto must try the spline family too";
+  out = run_cli({"analyze", "fit", "--method", "rbf:ccm", "--train", sg.string(), "--cv", "loo"});
+  EXPECT_NE(out.find("\nrbf:ccm,7,xyz,"), std::string::npos) << out;
   EXPECT_THROW(run_cli({"analyze", "fit", "--method", "poly:12", "--train", sg.string()}), colorlab::Error);
 }
 

@@ -1,5 +1,6 @@
 #include "colorlab/cli/analyze_command.hpp"
 
+#include <array>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -7,6 +8,7 @@
 
 #include "analyze_output.hpp"
 #include "colorlab/analysis/blackbox.hpp"
+#include "colorlab/analysis/characterization.hpp"
 #include "colorlab/analysis/chart_io.hpp"
 #include "colorlab/analysis/color_difference.hpp"
 #include "colorlab/analysis/colorimetry.hpp"
@@ -146,17 +148,29 @@ void run_blackbox(const FitCliOptions& o) {
     const auto& p = res.percent[static_cast<std::size_t>(c)];
     t13.rows.push_back({std::string(1, "RGB"[c]), a.min, a.max, a.median, a.mean, a.stdev, p.min, p.max, p.median, p.mean, p.stdev});
   }
+  // With a prior each curve carries its 95 % credible band (docs/ACCURACY.md: how often it holds the truth).
   Table curves{"sensitivities", {"wavelength_nm", "R", "G", "B"}, {}};
+  std::array<ca::CurveBand, 3> bands;
+  if (model.with_prior) {
+    for (const char* col : {"R_low", "R_high", "G_low", "G_high", "B_low", "B_high"}) curves.columns.push_back(col);
+    for (int c = 0; c < 3; ++c)
+      bands[static_cast<std::size_t>(c)] = ca::credible_band(model.sensitivities.row(c).transpose(), model.sensitivity_sdev.row(c).transpose());
+  }
   for (std::size_t k = 0; k < spectra.bands(); ++k) {
     auto kk = static_cast<Eigen::Index>(k);
     curves.rows.push_back({spectra.wavelengths[k], model.sensitivities(0, kk), model.sensitivities(1, kk), model.sensitivities(2, kk)});
+    if (model.with_prior)
+      for (const auto& b : bands) {
+        curves.rows.back().push_back(b.lower(kk));
+        curves.rows.back().push_back(b.upper(kk));
+      }
   }
   detail::print_tables(std::cout, {t13, curves}, o.json);
 }
 
 void add_report_rows(Table& t, const ca::FitReport& r, const std::string& cv) {
   t.rows.push_back({r.method, double(r.terms), ca::to_string(r.target), r.training.s76.mean, r.training.s00.mean,
-                    r.training.s00.max, r.cv.s76.mean, r.cv.s00.mean, r.cv.s00.max, cv});
+                    r.training.s00.max, r.cv.s76.mean, r.cv.s00.mean, r.cv.s00.max, cv, r.parameters});
 }
 
 void run_fit(const FitCliOptions& o) {
@@ -168,21 +182,22 @@ void run_fit(const FitCliOptions& o) {
   fo.target = parse_target(o.target);
   const ca::CvSpec cv = ca::CvSpec::parse(o.cv);
   Table fits{"fits", {"method", "terms", "target", "train_dE76_mean", "train_dE00_mean", "train_dE00_max", "cv_dE76_mean",
-                      "cv_dE00_mean", "cv_dE00_max", "cv"}, {}};
-  ca::TermSet chosen;
+                      "cv_dE00_mean", "cv_dE00_max", "cv", "parameters"}, {}};
+  // Splines (rbf:<term set>) are candidates of `auto` beside every polynomial; selection compares effective parameters.
+  std::string chosen = o.method;
   if (o.method == "auto") {
     ca::SelectionOptions so;
     so.tolerance_de00 = o.tolerance;
-    auto sel = ca::select_model(ca::all_term_sets(), {fo.target}, train, fo, cv, so);
+    auto sel = ca::select_method(ca::all_methods(), {fo.target}, train, fo, cv, so);
     for (const auto& r : sel.candidates) add_report_rows(fits, r, cv.name());
-    chosen = ca::term_set_by_name(sel.candidates[sel.chosen].method);
+    chosen = sel.candidates[sel.chosen].method;
   } else {
-    chosen = ca::term_set_by_name(o.method);
-    add_report_rows(fits, ca::fit_report(chosen, train, fo, cv), cv.name());
+    add_report_rows(fits, ca::report_method(o.method, train, fo, cv), cv.name());
   }
-  auto model = ca::fit(chosen, train, fo);
+  const auto model = ca::fit_method(chosen, train, fo);
+  const double terms = model.spline() ? double(model.spline()->base_terms()) : double(ca::term_set_by_name(chosen).size());
   Table model_t{"model", {"method", "terms", "target", "input_scale", "description"},
-                {{chosen.name, double(chosen.size()), ca::to_string(fo.target), model.input_scale(), chosen.describe()}}};
+                {{chosen, terms, ca::to_string(fo.target), model.input_scale(), model.describe()}}};
   std::vector<Table> out{fits, model_t};
   if (!o.test.empty()) {
     ca::ChartData test = ca::read_chart(o.test);
@@ -348,7 +363,8 @@ void add_analyze_command(CLI::App& app) {
     auto* c = analyze->add_subcommand("fit", "Fit a camera characterization with cross-validated errors beside training errors");
     c->add_option("--method", o->method,
                   "poly:1..11 (dissertation §7.3), hong:N (3,5,7,8,10,11,14,16,17,19,20), rootpoly:1..4, ccm, "
-                  "auto (smallest model within --tolerance of the best CV error), blackbox (§7.4, needs --spectra)")
+                  "rbf:<any of those> (r³ spline over that base, smoothing by LOO), "
+                  "auto (every family: smallest model within --tolerance of the best CV error), blackbox (§7.4, needs --spectra)")
         ->capture_default_str();
     c->add_option("--train", o->train, "Training chart: CSV (id,R,G,B,X,Y,Z and/or L,a,b) or Argyll .ti3; blackbox: id,R,G,B RAW")->required();
     c->add_option("--test", o->test, "Independent test chart (same format)");

@@ -21,6 +21,8 @@ class Characterization {
   Eigen::MatrixXd apply(const Eigen::MatrixXd& rgb) const;           // → L*a*b*
   Eigen::MatrixXd predict_target(const Eigen::MatrixXd& rgb) const;  // → XYZ or L*a*b*, as fitted
   std::string method() const;
+  std::string describe() const;  // the term labels, or the spline's base, λ and effective parameters
+  double input_scale() const;
   const SplineModel* spline() const { return std::get_if<SplineModel>(&model_); }
 
  private:

@@ -38,7 +38,9 @@ class SplineModel {
   FitTarget target() const { return target_; }
   double smoothing() const { return smoothing_; }                    // λ used
   double effective_parameters() const { return dof_; }               // tr(H)
-  std::size_t base_terms() const { return poly_.rows(); }
+  std::size_t base_terms() const { return static_cast<std::size_t>(poly_.rows()); }  // incl. the added 1 and ∛rgb
+  double input_scale() const { return input_scale_; }
+  std::string describe() const;  // "r³ spline over ccm (λ …, … effective parameters)"
 
  private:
   friend SplineModel fit_spline(const ChartData&, const SplineOptions&);
