@@ -47,7 +47,8 @@ class Engine final : public LabCallSink {
   void progress(double fraction, const std::string& label) override {
     progress_ = fraction;
     if (!label.empty()) label_ = label;
-    progress_changed_ = true;
+    // Replayed progress is already stored; only live progress makes a step worth committing.
+    if (live_) progress_changed_ = true;
   }
   void log(const std::string& text) override { log::info(setup_.script->name, text); }
 
@@ -61,6 +62,7 @@ class Engine final : public LabCallSink {
   std::string label_;
   double progress_ = 0;
   bool progress_changed_ = false;
+  bool live_ = false;
 };
 
 // "name.lua:12: message" → 12 (0 if the message has no position).
@@ -94,6 +96,7 @@ asio::awaitable<RunOutcome> run_campaign_script(ScriptRunSetup setup, Lab& lab, 
   LabState state;
   std::size_t replay_index = 0;
   bool live = setup.journal.empty();
+  engine.live_ = live;
   bool restore_pending = false;
 
   auto flush = [&] {
@@ -178,6 +181,7 @@ asio::awaitable<RunOutcome> run_campaign_script(ScriptRunSetup setup, Lab& lab, 
             answered = true;
           } else {
             live = true;
+            engine.live_ = true;
             restore_pending = true;
           }
         }

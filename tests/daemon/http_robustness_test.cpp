@@ -157,21 +157,20 @@ TEST_F(DaemonHttp, KeepAliveServesSeveralRequestsOnOneConnection) {
   EXPECT_NE(all.find("\"items\":[]"), std::string::npos) << all;
 }
 
-TEST_F(DaemonHttp, CampaignWithoutItsInstrumentFailsWithAHint) {
+TEST_F(DaemonHttp, CampaignWithoutItsInstrumentIsRefusedBeforeAnythingIsStored) {
   colorlab::client::Endpoint ep;
   ep.unix_socket = socket_path;  // the Unix socket serves the same API
   colorlab::client::ApiClient api(ep);
-  auto e = api.post("/v1/executions", {{"campaign", "luminance-spot"}});
-  json status;
-  for (int i = 0; i < 200; ++i) {
-    status = api.get("/v1/executions/" + e["id"].get<std::string>());
-    if (status["status"] != "waiting" && status["status"] != "running") break;
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  auto runs_before = api.get("/v1/runs")["items"].size();
+  try {
+    api.post("/v1/executions", {{"campaign", "luminance-spot"}});
+    FAIL() << "a campaign whose instrument is missing was started";
+  } catch (const colorlab::client::ApiError& e) {
+    EXPECT_EQ(e.problem().status, 404);
+    EXPECT_EQ(e.problem().code, "not_found");
+    EXPECT_NE(e.problem().detail.find("luminance meter"), std::string::npos) << e.problem().detail;
+    EXPECT_FALSE(e.problem().hint.empty());
   }
-  EXPECT_EQ(status["status"], "finished_error");
-  EXPECT_EQ(status["error"]["code"], "not_found");
-  EXPECT_FALSE(status["error"]["hint"].get<std::string>().empty());
-  auto run = api.get("/v1/runs/" + e["run_id"].get<std::string>());
-  EXPECT_EQ(run["status"], "finished_error");
+  EXPECT_EQ(api.get("/v1/runs")["items"].size(), runs_before);
   expect_still_serving();
 }

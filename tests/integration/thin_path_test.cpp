@@ -48,7 +48,8 @@ TEST(ThinPath, StoredLuminanceEqualsTheScenesValueWithinNoise) {
     sum += v;
   }
   EXPECT_NEAR(sum / 5, expected, 5 * sigma / std::sqrt(5.0) + 0.01);
-  EXPECT_NEAR(run["summary"]["mean"].get<double>(), sum / 5, 1e-9);
+  EXPECT_NEAR(run["summary"]["script"]["mean"].get<double>(), sum / 5, 1e-9);
+  EXPECT_NEAR(run["summary"]["measurements"]["luminance"]["mean"].get<double>(), sum / 5, 1e-9);
 
   // The same run through the list and the Unix socket.
   json runs = lab.cli_json({"runs"});

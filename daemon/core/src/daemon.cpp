@@ -159,6 +159,7 @@ void Daemon::write_endpoint_file() {
                    {"url", "http://" + d.config.listen_host + ":" + std::to_string(d.server->bound_port())},
                    {"port", d.server->bound_port()},
                    {"unix_socket", d.config.socket_path().string()}};
+  if (d.sim) j["simulator_pid"] = d.sim->pid();
   auto path = endpoint_file_path(d.config);
   auto tmp = path;
   tmp += ".tmp";

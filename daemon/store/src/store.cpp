@@ -300,13 +300,17 @@ void Store::commit_step(const ExecutionRecord& execution, const StepRecord& step
       ins.reset();
     }
   }
+  // Only a step that did something (a lab call or a measurement) proves a resume got past the
+  // point that killed the previous process.
+  bool progressed = !step.journal.empty() || !step.measurements.empty();
   db_.prepare(
          "UPDATE executions SET progress = ?2, step = ?3, updated_at = ?4, steps_committed = steps_committed + 1, "
-         "resume_attempts = 0 WHERE id = ?1")
+         "resume_attempts = CASE WHEN ?5 THEN 0 ELSE resume_attempts END WHERE id = ?1")
       .bind(1, std::string_view(execution.id))
       .bind(2, step.progress)
       .bind(3, std::string_view(step.step))
       .bind(4, std::string_view(now))
+      .bind(5, static_cast<std::int64_t>(progressed))
       .run();
   append_event("progress", {{"execution_id", execution.id},
                             {"run_id", execution.run_id},

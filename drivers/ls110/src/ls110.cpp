@@ -65,12 +65,28 @@ asio::awaitable<std::string> Ls110::transact(const std::string& command) {
   throw Error(std::move(info));
 }
 
+asio::awaitable<std::string> Ls110::transact_expecting(const std::string& command, bool with_value) {
+  std::string line = co_await transact(command);
+  for (int late = 0; late < 2; ++late) {
+    ls110::Reply reply;
+    try {
+      reply = ls110::parse_reply(line);
+    } catch (const Error&) {
+      co_return line;  // garbled: the caller decides
+    }
+    if (!reply.ok || reply.value.has_value() == with_value) co_return line;
+    log::debug("ls110", "discarding a late reply to an earlier command: " + line.substr(0, line.size() - 2));
+    line = co_await link_.read_until(ls110::kTerminator, options_.reply_timeout);
+  }
+  co_return line;
+}
+
 asio::awaitable<void> Ls110::connect() {
   state_ = InstrumentState::initialising;
   try {
     link_.open(serial_settings());
     // Absolute mode; any OK proves the meter is there and in remote mode.
-    std::string line = co_await transact(ls110::command_set_mode(4));
+    std::string line = co_await transact_expecting(ls110::command_set_mode(4), false);
     auto reply = ls110::parse_reply(line);
     if (!reply.ok) {
       auto code = ls110::lookup_error(reply.error_code);
@@ -103,7 +119,7 @@ asio::awaitable<LuminanceReading> Ls110::measure_luminance() {
   state_ = InstrumentState::busy;
   try {
     for (int attempt = 1;; ++attempt) {
-      std::string line = co_await transact(ls110::command_measure());
+      std::string line = co_await transact_expecting(ls110::command_measure(), true);
       ls110::Reply reply;
       try {
         reply = ls110::parse_reply(line);

@@ -40,16 +40,37 @@ void DaemonProcess::start() {
   process_ = std::make_unique<Process>(argv, log_);
   auto endpoint = wait_for_endpoint(state_dir_, process_->pid());
   url_ = endpoint["url"];
+  simulator_pid_ = endpoint.value("simulator_pid", -1);
+}
+
+DaemonProcess::~DaemonProcess() {
+  if (process_ && process_->running()) kill9();
+  wait_for_simulator_exit();
+}
+
+void DaemonProcess::wait_for_simulator_exit() {
+  if (simulator_pid_ <= 0) return;
+  for (int i = 0; i < 500 && ::kill(simulator_pid_, 0) == 0; ++i) {
+    // A zombie (not yet reaped by init) no longer holds anything.
+    std::ifstream stat("/proc/" + std::to_string(simulator_pid_) + "/stat");
+    std::string pid, comm, state;
+    if (stat >> pid >> comm >> state && state == "Z") break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  simulator_pid_ = -1;
 }
 
 void DaemonProcess::kill9() {
   process_->signal(SIGKILL);
   process_->wait(std::chrono::seconds(10));
+  wait_for_simulator_exit();
 }
 
 int DaemonProcess::terminate() {
   process_->signal(SIGTERM);
-  return process_->wait(std::chrono::seconds(30)).value_or(-1);
+  int code = process_->wait(std::chrono::seconds(30)).value_or(-1);
+  wait_for_simulator_exit();
+  return code;
 }
 
 bool DaemonProcess::running() { return process_ && process_->running(); }

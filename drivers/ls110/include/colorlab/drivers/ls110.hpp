@@ -41,6 +41,10 @@ class Ls110 final : public LuminanceMeter {
 
  private:
   boost::asio::awaitable<std::string> transact(const std::string& command);
+  // After a restart the meter may still owe the killed process an answer (a measurement takes
+  // ~0.5 s): a reply of the wrong shape — a value to MDS, none to MES — is that late answer, so
+  // read the next line instead of taking it for ours.
+  boost::asio::awaitable<std::string> transact_expecting(const std::string& command, bool with_value);
   [[noreturn]] void fail(const Error& e);
 
   Ls110Options options_;

@@ -25,8 +25,11 @@ class DaemonProcess {
   // `config`: a TOML file for --config; without it colorlabd starts its embedded simulated lab.
   explicit DaemonProcess(std::filesystem::path state_dir, std::optional<std::filesystem::path> config = std::nullopt,
                          std::filesystem::path log = {});
+  // Kills the daemon and waits for its embedded simulated lab to go too (it holds the GigE
+  // Vision port on 127.0.0.1 a moment longer than its parent lives).
+  ~DaemonProcess();
   void start();
-  void kill9();       // no cleanup: the embedded simulated lab dies with it
+  void kill9();       // no cleanup: the embedded simulated lab dies with it (waited for)
   int terminate();    // SIGTERM and wait; returns the exit code
   bool running();
   const std::string& url() const { return url_; }
@@ -37,8 +40,11 @@ class DaemonProcess {
   std::filesystem::path state_dir_;
   std::optional<std::filesystem::path> config_;
   std::filesystem::path log_;
+  void wait_for_simulator_exit();
+
   std::unique_ptr<Process> process_;
   std::string url_;
+  pid_t simulator_pid_ = -1;
 };
 
 }  // namespace colorlab::testing

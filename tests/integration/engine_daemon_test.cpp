@@ -1,0 +1,254 @@
+// The campaign engine inside colorlabd, as a lab uses it: scripts dropped into the campaigns
+// directory, scripts that misbehave, pause/resume/abort from the API, SIGTERM in the middle of a
+// run, and a step that kills the daemon every time (a bounded number of resumes, then a reason).
+#include <stdlib.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#include <csignal>
+#include <cstring>
+#include <fstream>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "colorlab/client/api_client.hpp"
+#include "resume_support.hpp"
+
+using namespace colorlab::testing;
+using colorlab::client::ApiClient;
+using nlohmann::json;
+
+namespace {
+
+json start(const ApiClient& api, const std::string& campaign, const json& params) {
+  return api.post("/v1/executions", {{"campaign", campaign}, {"params", params}});
+}
+
+json wait_status(const ApiClient& api, const std::string& id, const std::string& status,
+                 std::chrono::seconds timeout = std::chrono::seconds(30)) {
+  auto deadline = std::chrono::steady_clock::now() + timeout;
+  json e;
+  while (std::chrono::steady_clock::now() < deadline) {
+    e = api.get("/v1/executions/" + id);
+    if (e["status"] == status) return e;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return e;
+}
+
+std::size_t measurement_count(const ApiClient& api, const json& execution) {
+  return api.get("/v1/runs/" + execution["run_id"].get<std::string>())["measurements"].size();
+}
+
+void wait_measurements(const ApiClient& api, const json& execution, std::size_t n) {
+  for (int i = 0; i < 600 && measurement_count(api, execution) < n; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+}
+
+}  // namespace
+
+TEST(EngineInDaemon, AScriptDroppedIntoTheCampaignsDirectoryAppearsAndRunsWithoutRestart) {
+  TempDir dir;
+  DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), 20, 1));
+  auto api = api_for(daemon);
+  auto names = [&] {
+    std::set<std::string> out;
+    json campaigns = api.get("/v1/campaigns");  // a temporary's member would dangle in the loop
+    for (const auto& c : campaigns["items"]) out.insert(c["name"].get<std::string>());
+    return out;
+  };
+  EXPECT_EQ(names().count("twice"), 0u);
+  std::ofstream(dir / "state" / "campaigns" / "twice.lua") << R"lua(
+return {
+  description = "two readings, their difference",
+  needs = { "luminance_meter" },
+  parameters = { label = { type = "string", default = "spot", description = "a name" } },
+  run = function(p)
+    local a = lab.meter.measure()
+    lab.record(p.label .. "/a", { quantity = "luminance", value = a.luminance, unit = a.unit, instrument = a.instrument })
+    local b = lab.meter.measure()
+    lab.record(p.label .. "/b", { quantity = "luminance", value = b.luminance, unit = b.unit, instrument = b.instrument })
+    return { difference = b.luminance - a.luminance }
+  end,
+}
+)lua";
+  ASSERT_TRUE(std::filesystem::exists(dir / "state" / "campaigns" / "twice.lua"));
+  auto listed = names();
+  ASSERT_EQ(listed.count("twice"), 1u) << api.get("/v1/campaigns")["broken"].dump() << " " << listed.size();
+  auto e = start(api, "twice", {{"label", "centre"}});
+  auto done = wait_terminal(api, e["id"]);
+  ASSERT_EQ(done["status"], "finished_ok") << done.dump();
+  json run = api.get("/v1/runs/" + e["run_id"].get<std::string>());
+  ASSERT_EQ(run["measurements"].size(), 2u);
+  EXPECT_EQ(run["measurements"][0]["step"], "centre/a");
+  EXPECT_EQ(run["measurements"][0]["instrument_id"], "ls110");
+  EXPECT_NEAR(run["summary"]["script"]["difference"].get<double>(),
+              run["measurements"][1]["value"].get<double>() - run["measurements"][0]["value"].get<double>(), 1e-9);
+  // The run describes itself: the exact script text it ran, by hash.
+  auto script = api.request("GET", "/v1/runs/" + e["run_id"].get<std::string>() + "/script");
+  EXPECT_EQ(script.status, 200);
+  EXPECT_NE(script.body.find("two readings, their difference"), std::string::npos);
+  EXPECT_EQ(run["script"]["sha256"].get<std::string>().size(), 64u);
+  // Parameters are validated before anything moves.
+  try {
+    start(api, "twice", {{"label", 3}});
+    FAIL() << "a bad parameter was accepted";
+  } catch (const colorlab::client::ApiError& err) {
+    EXPECT_EQ(err.problem().status, 400);
+    EXPECT_NE(err.problem().detail.find("params.label"), std::string::npos);
+  }
+}
+
+// Each misbehaving script ends in a typed error naming it and the line; meanwhile the event loop
+// goes on feeding systemd's watchdog and serving the API.
+TEST(EngineInDaemon, MisbehavingScriptsEndInTypedErrorsWhileTheDaemonKeepsServing) {
+  TempDir dir;
+  std::string sock_path = (dir / "notify.sock").string();
+  int fd = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+  sockaddr_un addr{};
+  addr.sun_family = AF_UNIX;
+  std::strncpy(addr.sun_path, sock_path.c_str(), sizeof addr.sun_path - 1);
+  ASSERT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+  timeval tv{0, 20000};
+  ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+  std::filesystem::create_directories(dir / "state" / "campaigns");
+  struct Case {
+    const char* name;
+    const char* body;
+    const char* words;
+    int line;
+  };
+  const Case cases[] = {
+      {"spin", "local n = 0\nwhile true do n = n + 1 end", "instruction budget", 5},
+      {"hoard", "local t = {}\nwhile true do t[#t + 1] = string.rep('x', 65536) .. #t end", "memory limit", 0},
+      {"escape", "lab.progress(0.1, 'before escaping')\nlocal f = io.open('/etc/shadow')", "io.open is forbidden", 5},
+      {"fails", "lab.progress(0.2, 'spot/r1c2')\n\nerror('the tile is dirty')", "the tile is dirty", 6},
+  };
+  for (const auto& c : cases) {
+    std::ofstream(dir / "state" / "campaigns" / (std::string(c.name) + ".lua"))
+        << "return {\n  limits = { memory_mib = 16 },\n  run = function(p)\n" << c.body << "\n  end,\n}\n";
+  }
+  ::setenv("NOTIFY_SOCKET", sock_path.c_str(), 1);
+  ::setenv("WATCHDOG_USEC", "400000", 1);
+  DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), 20, 1));
+  ::unsetenv("NOTIFY_SOCKET");
+  ::unsetenv("WATCHDOG_USEC");
+  auto api = api_for(daemon);
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.name);
+    auto started = std::chrono::steady_clock::now();
+    auto e = start(api, c.name, json::object());
+    int pings = 0;
+    json done;
+    for (;;) {
+      char buf[256];
+      ssize_t n = ::recv(fd, buf, sizeof buf, 0);
+      if (n > 0 && std::string(buf, static_cast<std::size_t>(n)).find("WATCHDOG=1") != std::string::npos) ++pings;
+      done = api.get("/v1/executions/" + e["id"].get<std::string>());  // the API answers meanwhile
+      if (done["status"] != "running" && done["status"] != "waiting") break;
+      ASSERT_LT(std::chrono::steady_clock::now() - started, std::chrono::seconds(60));
+    }
+    double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    ASSERT_EQ(done["status"], "finished_error") << done.dump();
+    EXPECT_EQ(done["error"]["code"], "script_error");
+    EXPECT_NE(done["error"]["detail"].get<std::string>().find(c.words), std::string::npos) << done["error"].dump();
+    EXPECT_EQ(done["error"]["script"], std::string(c.name) + ".lua");
+    if (c.line > 0) {
+      EXPECT_EQ(done["error"]["line"], c.line) << done["error"].dump();
+    }
+    // WatchdogSec 0.4 s → a ping every 0.2 s; the loop must not have starved it.
+    if (seconds > 1.0) {
+      EXPECT_GE(pings, static_cast<int>(seconds / 0.2 / 2)) << seconds << " s";
+    }
+  }
+  EXPECT_EQ(api.get("/v1")["server"], "colorlabd");
+  ::close(fd);
+}
+
+TEST(EngineInDaemon, PauseResumeAndAbortLandAtSafePoints) {
+  TempDir dir;
+  DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), 4, 1));
+  auto api = api_for(daemon);
+  auto e = start(api, "luminance-spot", {{"readings", 200}});
+  std::string id = e["id"];
+  wait_measurements(api, e, 2);
+  api.post("/v1/executions/" + id + "/pause", json::object());
+  auto paused = wait_status(api, id, "paused");
+  ASSERT_EQ(paused["status"], "paused") << paused.dump();
+  EXPECT_EQ(paused["reason"], "paused by a client");
+  auto held = measurement_count(api, e);
+  std::this_thread::sleep_for(std::chrono::milliseconds(600));
+  EXPECT_EQ(measurement_count(api, e), held) << "a paused execution must not measure";
+  // A paused execution stays paused across a restart, and resumes on request.
+  daemon.kill9();
+  daemon.start();
+  api = api_for(daemon);
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  EXPECT_EQ(api.get("/v1/executions/" + id)["status"], "paused");
+  api.post("/v1/executions/" + id + "/resume", json::object());
+  wait_measurements(api, e, held + 2);
+  EXPECT_GE(measurement_count(api, e), held + 2);
+  api.post("/v1/executions/" + id + "/abort", json::object());
+  auto aborted = wait_terminal(api, id);
+  EXPECT_EQ(aborted["status"], "aborted");
+  EXPECT_EQ(aborted["reason"], "aborted by a client");
+  json run = api.get("/v1/runs/" + e["run_id"].get<std::string>());
+  EXPECT_EQ(run["status"], "aborted");
+  EXPECT_LT(run["measurements"].size(), 200u);
+  // Nothing to pause or abort any more: a conflict, as problem+json.
+  try {
+    api.post("/v1/executions/" + id + "/abort", json::object());
+    FAIL();
+  } catch (const colorlab::client::ApiError& err) {
+    EXPECT_EQ(err.problem().status, 409);
+  }
+}
+
+TEST(EngineInDaemon, SigtermSuspendsTheRunningStepAndTheNextStartResumesIt) {
+  TempDir dir;
+  DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), 4, 1));
+  auto api = api_for(daemon);
+  auto e = start(api, "luminance-spot", {{"readings", 20}});
+  std::string id = e["id"];
+  wait_measurements(api, e, 3);
+  EXPECT_EQ(daemon.terminate(), 0) << "colorlabd must stop cleanly on SIGTERM";
+  daemon.start();
+  api = api_for(daemon);
+  bool suspended = false;
+  json events = api.get("/v1/events?topic=execution&limit=300");
+  for (const auto& ev : events["items"]) {
+    if (ev["payload"].value("execution_id", "") == id && ev["payload"].value("status", "") == "suspended") suspended = true;
+  }
+  EXPECT_TRUE(suspended) << "SIGTERM must leave the execution suspended with its reason";
+  auto done = wait_terminal(api, id);
+  EXPECT_EQ(done["status"], "finished_ok") << done.dump();
+  json run = api.get("/v1/runs/" + e["run_id"].get<std::string>());
+  ASSERT_EQ(run["measurements"].size(), 20u);
+  for (int i = 0; i < 20; ++i) EXPECT_EQ(run["measurements"][i]["step"], "reading/" + std::to_string(i));
+}
+
+TEST(EngineInDaemon, AStepThatKillsTheDaemonEveryTimeEndsAfterTheBoundedAttempts) {
+  TempDir dir;
+  DaemonProcess daemon(dir / "state",
+                       write_daemon_config(dir.path(), 1, 1, "[campaigns]\nmax_resume_attempts = 2\n"));
+  auto api = api_for(daemon);
+  auto e = start(api, "luminance-spot", {{"readings", 100}});
+  std::string id = e["id"];
+  wait_measurements(api, e, 2);
+  daemon.kill9();
+  // The step after it "crashes" the daemon each time: killed as soon as it serves again, before
+  // a reading (0.45 s at this time scale) can be committed.
+  for (int attempt = 1; attempt <= 2; ++attempt) {
+    daemon.start();
+    daemon.kill9();
+  }
+  daemon.start();
+  api = api_for(daemon);
+  auto done = wait_terminal(api, id, std::chrono::seconds(10));
+  ASSERT_EQ(done["status"], "finished_error") << done.dump();
+  EXPECT_NE(done["reason"].get<std::string>().find("3 times in a row"), std::string::npos) << done.dump();
+  EXPECT_EQ(done["resume_attempts"], 3);
+  // What was measured before stays.
+  EXPECT_GE(measurement_count(api, e), 2u);
+}
