@@ -3,7 +3,9 @@
 //   transaction (QCoDeS's fix for slow inserts, PR #1187);
 // - a page of runs deep in a 20 000-run catalogue: keyset (colorlab) vs OFFSET (QCoDeS #1915).
 #include <benchmark/benchmark.h>
+#include <fcntl.h>
 #include <sqlite3.h>
+#include <unistd.h>
 
 #include "colorlab/store/store.hpp"
 #include "colorlab/testing/temp_dir.hpp"
@@ -23,6 +25,46 @@ void BM_CommitMeasurement_Full(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations());
 }
 BENCHMARK(BM_CommitMeasurement_Full)->Unit(benchmark::kMicrosecond);
+
+// One campaign step as the engine commits it: a journal entry, a measurement, the progress and the
+// event in one transaction (synchronous=FULL). The target: within 2× of this machine's
+// fdatasync, measured beside it in the same run (BM_Fdatasync4k).
+void BM_CommitCampaignStep_Full(benchmark::State& state) {
+  colorlab::testing::TempDir dir;
+  colorlab::store::Store store(dir / "colorlab.db");
+  colorlab::store::NewRun run{"luminance-spot", nlohmann::json::object(), true, nlohmann::json::array(), std::nullopt};
+  run.script_sha256 = "bench";
+  run.script_source = "return {}";
+  auto e = store.create_execution(run).execution;
+  std::int64_t i = 0;
+  for (auto _ : state) {
+    colorlab::store::StepRecord step;
+    nlohmann::json result{{"luminance", 245.3}, {"unit", "cd/m2"}, {"instrument", "ls110"}, {"raw", "OK00,   245.30"}};
+    step.journal.push_back({i, "meter.measure", nlohmann::json::array(), result});
+    step.measurements.push_back({"reading/" + std::to_string(i), "ls110", true, "luminance", 245.3, "cd/m2",
+                                 {{"raw", "OK00,   245.30"}}});
+    step.progress = 0.5;
+    step.step = "reading/" + std::to_string(i);
+    store.commit_step(e, step);
+    ++i;
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_CommitCampaignStep_Full)->Unit(benchmark::kMicrosecond);
+
+// The floor any durable commit stands on: 4 KiB appended and fdatasync'd in the same directory.
+void BM_Fdatasync4k(benchmark::State& state) {
+  colorlab::testing::TempDir dir;
+  int fd = ::open((dir / "sync.bin").c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+  std::string block(4096, 'x');
+  for (auto _ : state) {
+    if (::write(fd, block.data(), block.size()) != static_cast<ssize_t>(block.size())) state.SkipWithError("write");
+    ::fdatasync(fd);
+  }
+  ::close(fd);
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_Fdatasync4k)->Unit(benchmark::kMicrosecond);
 
 // The same rows through raw SQLite: NORMAL (no fsync per commit) and one transaction for all.
 void raw_inserts(benchmark::State& state, const char* sync, bool batched) {
@@ -50,6 +92,9 @@ void raw_inserts(benchmark::State& state, const char* sync, bool batched) {
   state.SetItemsProcessed(state.iterations());
 }
 void BM_RawInsert_Normal(benchmark::State& s) { raw_inserts(s, "NORMAL", false); }
+// colorlab's settings on raw SQLite (WAL, FULL, one row per commit): the reference for the store's own cost.
+void BM_RawInsert_Full(benchmark::State& s) { raw_inserts(s, "FULL", false); }
+BENCHMARK(BM_RawInsert_Full)->Unit(benchmark::kMicrosecond);
 void BM_RawInsert_OneTransaction(benchmark::State& s) { raw_inserts(s, "FULL", true); }
 BENCHMARK(BM_RawInsert_Normal)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_RawInsert_OneTransaction)->Unit(benchmark::kMicrosecond);

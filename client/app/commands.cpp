@@ -131,6 +131,19 @@ void add_daemon_commands(CLI::App& app, GlobalOptions& global) {
     print(global, make_client(global).get(target), format_runs);
   });
 
+  // Pause, resume and abort land at the campaign's next safe point (the step before is committed).
+  for (const char* action : {"pause", "resume", "abort"}) {
+    auto id = std::make_shared<std::string>();
+    std::string help = std::string(action) == "pause"    ? "Pause a running execution at its next safe point"
+                       : std::string(action) == "resume" ? "Resume a paused or suspended execution"
+                                                         : "Abort an execution at its next safe point (its measurements stay)";
+    auto* cmd = app.add_subcommand(action, help);
+    cmd->add_option("execution", *id, "execution id (from `colorlab run --detach` or GET /v1/executions/{id})")->required();
+    cmd->callback([&global, id, action = std::string(action)] {
+      print(global, make_client(global).post("/v1/executions/" + *id + "/" + action, json::object()), format_execution);
+    });
+  }
+
   auto run_id = std::make_shared<std::string>();
   auto* show = app.add_subcommand("show", "Show one run with its measurements");
   show->add_option("run", *run_id, "run id")->required();

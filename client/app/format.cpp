@@ -46,10 +46,25 @@ std::string format_instruments(const json& list) {
 std::string format_campaigns(const json& list) {
   std::ostringstream o;
   for (const auto& c : list["items"]) {
-    o << str(c, "name") << "\n    " << str(c, "description") << "\n";
-    for (const auto& [k, v] : c["parameters"].items()) {
-      o << "    --param " << k << "=" << (v.contains("default") ? v["default"].dump() : "") << "\n";
+    o << str(c, "name") << "  (" << str(c, "origin") << ")\n    " << str(c, "description") << "\n";
+    if (c.contains("needs") && !c["needs"].empty()) {
+      o << "    needs:";
+      for (const auto& n : c["needs"]) o << " " << n.get<std::string>();
+      o << "\n";
     }
+    for (const auto& [k, v] : c["parameters"].items()) {
+      o << "    --param " << k << "=" << (v.contains("default") && !v["default"].is_null() ? v["default"].dump() : "")
+        << "   " << v.value("type", std::string());
+      if (!v.value("unit", std::string()).empty()) o << ", " << v["unit"].get<std::string>();
+      if (v.contains("min")) o << ", ≥ " << v["min"].dump();
+      if (v.contains("max")) o << ", ≤ " << v["max"].dump();
+      if (v.contains("values")) o << ", one of " << v["values"].dump();
+      if (!v.value("description", std::string()).empty()) o << " — " << v["description"].get<std::string>();
+      o << "\n";
+    }
+  }
+  if (list.contains("broken")) {
+    for (const auto& b : list["broken"]) o << "BROKEN " << str(b, "path") << "\n    " << str(b, "error") << "\n";
   }
   return o.str();
 }
@@ -96,7 +111,9 @@ std::string format_run(const json& r) {
 std::string format_execution(const json& e) {
   std::ostringstream o;
   o << "execution " << str(e, "id") << "  " << str(e, "campaign") << "  " << str(e, "status") << "  "
-    << number(100.0 * e.value("progress", 0.0), 0) << "%  " << str(e, "step") << "\n";
+    << number(100.0 * e.value("progress", 0.0), 0) << "%  " << str(e, "step");
+  if (!e.value("reason", std::string()).empty()) o << "  (" << e["reason"].get<std::string>() << ")";
+  o << "\n";
   return o.str();
 }
 

@@ -15,7 +15,7 @@ namespace {
 
 json run_frame_average(std::uint64_t seed, int max_delay_ms, int& kills_done) {
   TempDir dir;
-  DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), 4, 1));  // the same lab; seed times the kill
+  DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), 4, 1, "", true));  // the same lab; seed times the kill
   auto api = api_for(daemon);
   bool have_camera = false;
   json instruments = api.get("/v1/instruments");

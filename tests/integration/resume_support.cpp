@@ -10,10 +10,15 @@
 namespace colorlab::testing {
 
 std::filesystem::path write_daemon_config(const std::filesystem::path& dir, double time_scale, std::uint64_t seed,
-                                          const std::string& extra) {
+                                          const std::string& extra, bool camera) {
   auto path = dir / "colorlabd.toml";
-  std::ofstream(path) << "[simulator]\nenabled = true\ntime_scale = " << time_scale << "\nseed = " << seed << "\n"
-                      << extra;
+  std::ofstream out(path);
+  out << "[simulator]\nenabled = true\ntime_scale = " << time_scale << "\nseed = " << seed << "\n";
+  if (!camera) {
+    std::ofstream(dir / "lab.toml") << "[genicam]\nenabled = false\n";
+    out << "config = \"lab.toml\"\n";
+  }
+  out << extra;
   return path;
 }
 

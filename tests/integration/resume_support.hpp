@@ -13,9 +13,11 @@
 
 namespace colorlab::testing {
 
-// Writes <dir>/colorlabd.toml: embedded simulated lab at `time_scale`, plus `extra` TOML.
+// Writes <dir>/colorlabd.toml: embedded simulated lab at `time_scale`, plus `extra` TOML. Without
+// `camera`, the simulated lab starts no GigE Vision camera: only one can serve 127.0.0.1, and tests
+// that need it hold the ctest lock gigevision_loopback.
 std::filesystem::path write_daemon_config(const std::filesystem::path& dir, double time_scale, std::uint64_t seed,
-                                          const std::string& extra = {});
+                                          const std::string& extra = {}, bool camera = false);
 client::ApiClient api_for(const DaemonProcess& daemon);
 // Polls the execution until it is terminal; returns its last state.
 nlohmann::json wait_terminal(const client::ApiClient& api, const std::string& execution_id,
