@@ -131,15 +131,26 @@ SplineModel fit_spline(const ChartData& train, const SplineOptions& o) {
   if (!o.smoothing) {
     double best = std::numeric_limits<double>::infinity();
     const int steps = std::max(2, o.smoothing_steps);
+    std::vector<std::pair<double, double>> scores;
     for (int k = 0; k < steps; ++k) {
       const double l = o.smoothing_min * std::pow(o.smoothing_max / o.smoothing_min, k / double(steps - 1));
       const Solved s = solve_at(K, P, w, Y, l, true);
       const double e = mean_de00(loo_predictions(s, Y), train, o.target);
-      if (e < best) {  // ties keep the smaller λ's predecessor: the grid runs from rough to smooth
+      scores.emplace_back(l, e);
+      if (e < best) {
         best = e;
         lambda = l;
       }
     }
+    double tol = o.smoothing_tolerance.value_or(0);
+    if (!o.smoothing_tolerance) {
+      const Solved s = solve_at(K, P, w, Y, lambda, true);
+      const Eigen::MatrixXd pr = loo_predictions(s, Y);
+      const auto ev = evaluate(o.target == FitTarget::lab_direct ? pr : xyz_rows_to_lab(pr, train.white), train.lab);
+      tol = ev.s00.stdev / std::sqrt(static_cast<double>(n));
+    }
+    for (const auto& [l, e] : scores)
+      if (e <= best + tol && l > lambda) lambda = l;
     if (!std::isfinite(best))
       throw Error(ErrorClass::bad_data, model.method_ + ": no smoothing value gives finite leave-one-out errors");
   }

@@ -76,10 +76,10 @@ TEST_F(AnalysisStability, ExtrapolationToTheMostSaturatedPatches) {
     EXPECT_GT(outside, inside) << m;
   }
   // Goal: what selection picks extrapolates no worse than ArgyllCMS's cLUT (colprof -qm -ax) trained and checked on the
-  // same patches. NOT MET: measured mean / max ΔE00 2.09 / 4.16 (rbf:rootpoly:2) against colprof -ax 1.68 / 3.33 —
-  // leave-one-out on the 120 remaining patches rewards interpolation and cannot see extrapolation, and the r³ kernel
-  // grows away from the data where Argyll's regularised grid flattens. What is achieved and asserted: better than
-  // Argyll's shaper/matrix profile (colprof -am) on the same split.
+  // same patches. Met on the mean (measured 1.22 against 1.68 ΔE00, rbf:ccm). NOT MET on the maximum: 4.16 against
+  // 3.33 — leave-one-out on the 120 remaining patches cannot see extrapolation, and the spline's kernel part keeps
+  // bending away from the data where Argyll's regularised grid flattens. So the maximum is held to what is achieved
+  // against an independent reference: below Argyll's shaper/matrix profile (colprof -am: 6.98) on the same split.
   if (!have_argyll()) GTEST_SKIP() << "colprof/profcheck not installed (Debian package argyll): no reference for the selected model";
   std::string label;
   const auto ours = selected_on(train, test, &label);
@@ -89,7 +89,7 @@ TEST_F(AnalysisStability, ExtrapolationToTheMostSaturatedPatches) {
   ASSERT_TRUE(std::isfinite(ax.avg) && std::isfinite(am.avg)) << "colprof/profcheck failed in " << dir;
   std::cout << "20 most saturated held out: selected " << label << " mean " << ours.s00.mean << " max " << ours.s00.max
             << "; colprof -qm -ax mean " << ax.avg << " max " << ax.peak << "; -am mean " << am.avg << " max " << am.peak << "\n";
-  EXPECT_LT(ours.s00.mean, am.avg);
+  EXPECT_LT(ours.s00.mean, ax.avg);
   EXPECT_LT(ours.s00.max, am.peak);
 }
 
@@ -145,10 +145,8 @@ TEST_F(AnalysisStability, RawNoiseFromPointOneToTwoPercent) {
     EXPECT_LT(selected, test_error("poly:11", noisy, cc24_));
     if (noise == 0.01) noisy_1pc = noisy;
   }
-  // Goal: with noisy RAW, selection among every family still beats ArgyllCMS's cLUT made from the same noisy chart.
-  // NOT MET at 1 % noise: measured mean / max ΔE00 0.686 / 1.90 (rbf:ccm) against colprof -qm -ax 0.684 / 1.60 — a
-  // tie on the mean, worse on the worst patch (noise in the inputs, which no λ chosen on output residuals models).
-  // What is achieved and asserted: better than Argyll's shaper/matrix profile (colprof -am) on the same noisy chart.
+  // Goal: with noisy RAW, selection among every family still beats ArgyllCMS's cLUT made from the same noisy chart, on
+  // the mean and the worst patch (measured 0.58 / 1.18 against colprof -qm -ax 0.68 / 1.60). -am is printed beside it.
   if (!have_argyll()) GTEST_SKIP() << "colprof/profcheck not installed (Debian package argyll): no reference at 1 % noise";
   std::string label;
   const auto ours = selected_on(noisy_1pc, cc24_, &label);
@@ -158,8 +156,8 @@ TEST_F(AnalysisStability, RawNoiseFromPointOneToTwoPercent) {
   ASSERT_TRUE(std::isfinite(ax.avg) && std::isfinite(am.avg)) << "colprof/profcheck failed in " << dir;
   std::cout << "1 % RAW noise, SG -> CC24: selected " << label << " mean " << ours.s00.mean << " max " << ours.s00.max
             << "; colprof -qm -ax mean " << ax.avg << " max " << ax.peak << "; -am mean " << am.avg << " max " << am.peak << "\n";
-  EXPECT_LT(ours.s00.mean, am.avg);
-  EXPECT_LT(ours.s00.max, am.peak);
+  EXPECT_LT(ours.s00.mean, ax.avg);
+  EXPECT_LT(ours.s00.max, ax.peak);
 }
 
 TEST_F(AnalysisStability, ExposurePlusMinusOneStop) {

@@ -33,7 +33,7 @@ class Characterization {
 Characterization fit_method(const std::string& method, const ChartData& train, const FitOptions& options = {});
 FitReport report_method(const std::string& method, const ChartData& data, const FitOptions& options, const CvSpec& cv);
 
-// The two spline candidates selection tries: over the 3×3 matrix and over the 6-term root-polynomial.
+// The spline candidates selection tries (the spline over the 3×3 matrix; see characterization.cpp for why only it).
 std::vector<std::string> spline_methods();
 // Every polynomial term set, then the splines.
 std::vector<std::string> all_methods();

@@ -10,9 +10,12 @@
 //   P = base term set ∪ {1, u_r, u_g, u_b}   (r³ is conditionally positive definite of order 2: needs 1 and u)
 //   minimise Σ w_i² ‖y_i − f(rgb_i)‖² + λ·cᵀKc   (w = FitTarget weights, y = XYZ or L*a*b*; u lies in the unit cube)
 //
-// The fit is a linear smoother (fitted = H y), so leave-one-out errors are exact from e_i / (1 − h_ii), λ is the
-// grid value with the smallest LOO mean ΔE00, and tr(H) is its effective number of parameters per channel — the
-// size that model selection compares with a polynomial's term count.
+// The fit is a linear smoother (fitted = H y), so leave-one-out errors are exact from e_i / (1 − h_ii), and tr(H) is
+// its effective number of parameters per channel — the size that model selection compares with a polynomial's term
+// count. λ follows the same rule as selection, "the smallest model within tolerance of the best": the smoothest λ
+// whose LOO mean ΔE00 is within one standard error of the lowest. Why not the lowest: LOO inside the training cloud
+// rewards following it closely; one standard error more smoothing costs nothing measurable there and halves the
+// worst error with 1 % RAW noise and on patches outside the training gamut (docs/ACCURACY.md §4).
 #include <Eigen/Dense>
 #include <optional>
 #include <string>
@@ -27,7 +30,10 @@ struct SplineOptions {
   double input_scale = 0;                         // as FitOptions::input_scale
   std::optional<double> smoothing;                // λ; unset = chosen by leave-one-out ΔE00
   double smoothing_min = 1e-8, smoothing_max = 1e2;
-  int smoothing_steps = 41;                      // log-spaced grid
+  int smoothing_steps = 41;
+  // λ is the smoothest grid value whose LOO mean ΔE00 is within this of the best λ's; unset = one standard error of
+  // the best λ's mean (the one-standard-error rule of Breiman et al. 1984).
+  std::optional<double> smoothing_tolerance;                      // log-spaced grid
 };
 
 class SplineModel {
