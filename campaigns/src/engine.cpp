@@ -195,6 +195,17 @@ asio::awaitable<RunOutcome> run_campaign_script(ScriptRunSetup setup, Lab& lab, 
             if (restore_pending) {
               restore_pending = false;
               sink.status_text("restoring the lab after a resume (step " + engine.label_ + ")");
+              if (setup.verify_serials) {
+                auto changed = co_await lab.serial_mismatches(setup.expected_serials);
+                if (!changed.empty()) {
+                  std::string why = "another unit answers where the run's instrument was (";
+                  for (std::size_t i = 0; i < changed.size(); ++i) why += (i ? "; " : "") + changed[i];
+                  why += "): check it is the right instrument, then resume the execution to accept it";
+                  ExecutionControl pause{ExecutionControl::Request::pause, why};
+                  stop_for(pause);
+                  break;
+                }
+              }
               json actions = co_await lab.restore(state, control);
               sink.restored(actions);
             }

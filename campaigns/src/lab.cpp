@@ -125,6 +125,23 @@ void Lab::check_needs(const std::vector<std::string>& roles) const {
   }
 }
 
+asio::awaitable<std::vector<std::string>> Lab::serial_mismatches(std::map<std::string, std::string> expected) {
+  std::vector<std::string> out;
+  for (const auto& [id, serial] : expected) {
+    auto i = instruments_.find(id);
+    if (!i || serial.empty()) continue;
+    log::debug("lab", "checking " + id + " is still the unit the run started with");
+    try {
+      co_await ready(*i);
+    } catch (const Error&) {
+      continue;  // not there at all: the lab call that needs it reports that
+    }
+    auto now = i->identity().serial;
+    if (!now.empty() && now != serial) out.push_back(id + ": the run started with serial " + serial + ", now " + now);
+  }
+  co_return out;
+}
+
 json Lab::roles() const {
   json j = json::object();
   for (const char* r : {"luminance_meter", "spectrophotometer", "table", "lamps", "dimmer", "camera"}) {
@@ -188,9 +205,12 @@ asio::awaitable<json> Lab::wait_stable(const StabilityCriterion& c, const Execut
     auto r = co_await meter->measure_luminance();
     ++readings;
     double t = lab_seconds();
+    log::debug("lab", "wait_stable: reading " + std::to_string(readings) + " at " + std::to_string(t) + " s: " +
+                          std::to_string(r.luminance) + " " + r.unit);
     window.emplace_back(t, r.luminance);
-    while (window.size() > 3 && t - window.front().first > c.window_s) window.pop_front();
-    if (window.size() >= 3 && t - window.front().first >= c.window_s * 0.999) {
+    // Keep the shortest tail of readings that still spans the whole window.
+    while (window.size() > 3 && t - window[1].first >= c.window_s) window.pop_front();
+    if (window.size() >= 3 && t - window.front().first >= c.window_s) {
       // Drift from a straight-line fit, not max − min: the meter's noise must not read as drift.
       double n = static_cast<double>(window.size()), st = 0, sl = 0, stt = 0, stl = 0;
       for (auto [ti, li] : window) {
@@ -203,6 +223,8 @@ asio::awaitable<json> Lab::wait_stable(const StabilityCriterion& c, const Execut
       double slope = denom > 0 ? (n * stl - st * sl) / denom : 0;
       double mean = sl / n;
       drift_pct = mean > 0 ? std::abs(slope) * c.window_s / mean * 100 : 100;
+      log::debug("lab", "wait_stable: " + std::to_string(r.luminance) + " " + r.unit + ", drift " +
+                            std::to_string(drift_pct) + " % over " + std::to_string(c.window_s) + " s");
       if (drift_pct <= c.tolerance_pct) {
         co_return json{{"luminance", r.luminance}, {"unit", r.unit},          {"instrument", meter->id()},
                        {"drift_pct", drift_pct},   {"readings", readings},    {"waited_s", t}};
@@ -386,6 +408,7 @@ asio::awaitable<json> Lab::restore(const LabState& desired, const ExecutionContr
     done.push_back(json{{"dimmer_percent", *desired.dimmer_percent}});
   }
   if (desired.any_lamp_on()) {
+    log::debug("lab", "restore: waiting for the lamps to be stable again");
     bool warm = std::all_of(desired.lamps_on->begin(), desired.lamps_on->end(),
                             [&](const std::string& l) { return known_warm_.count(l) > 0; });
     if (!warm) {

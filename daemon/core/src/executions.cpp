@@ -161,13 +161,13 @@ void Executions::resume_unfinished() {
 }
 
 void Executions::launch(store::ExecutionRecord record, std::shared_ptr<const campaigns::CampaignScript> script,
-                        json params, bool resumed) {
+                        json params, bool resumed, bool accept_units) {
   auto active = std::make_shared<Active>();
   active->record = record;
   active_[record.id] = active;
   asio::co_spawn(
       io_,
-      [this, active, script, params, resumed]() -> asio::awaitable<void> {
+      [this, active, script, params, resumed, accept_units]() -> asio::awaitable<void> {
         auto& record = active->record;
         campaigns::RunOutcome outcome;
         try {
@@ -182,6 +182,15 @@ void Executions::launch(store::ExecutionRecord record, std::shared_ptr<const cam
           if (resumed) {
             for (auto& j : store_.journal(record.id)) setup.journal.push_back({j.seq, j.call, j.args, j.result});
             setup.stored_steps = store_.measurement_steps(record.run_id);
+            if (auto run = store_.run(record.run_id); run && run->instruments.is_array()) {
+              for (const auto& i : run->instruments) {
+                if (i.contains("id") && i.contains("serial") && i["serial"].is_string()) {
+                  setup.expected_serials[i["id"].get<std::string>()] = i["serial"].get<std::string>();
+                }
+              }
+            }
+            // An operator resuming a paused run has looked at the lab: accept the units as they are.
+            setup.verify_serials = !accept_units;
           }
           StoreSink sink(store_, record, instruments_, status_text_);
           outcome = co_await campaigns::run_campaign_script(std::move(setup), lab_, sink, active->control);
@@ -277,7 +286,7 @@ store::ExecutionRecord Executions::resume(const std::string& id) {
   auto script = std::make_shared<campaigns::CampaignScript>(campaigns::parse_campaign_script(record.campaign, *source));
   script->origin = "stored";
   auto run = store_.run(record.run_id);
-  launch(record, script, run ? run->params : json::object(), true);
+  launch(record, script, run ? run->params : json::object(), true, record.status == ExecutionStatus::paused);
   return require(id);
 }
 

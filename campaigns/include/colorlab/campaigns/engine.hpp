@@ -8,6 +8,7 @@
 // stored are skipped, and at the first call past the journal the lab is restored to the state the
 // replay says it should be in; from there the script runs live. docs/ARCHITECTURE.md says why.
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <optional>
 #include <set>
@@ -79,6 +80,11 @@ struct ScriptRunSetup {
   std::uint64_t random_seed = 0;
   std::string initial_label;               // progress label to start from
   double initial_progress = 0;
+  // After a crash the port, even the unit, may have changed: instrument id → serial recorded when
+  // the run started. A unit that now reports another serial pauses the run for the operator
+  // (resuming it from the API accepts the unit: verify_serials = false).
+  std::map<std::string, std::string> expected_serials;
+  bool verify_serials = true;
 };
 
 boost::asio::awaitable<RunOutcome> run_campaign_script(ScriptRunSetup setup, Lab& lab, ExecutionSink& sink,

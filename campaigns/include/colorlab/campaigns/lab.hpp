@@ -5,6 +5,7 @@
 // state at shutdown. Times a script gives are lab seconds; with the simulated lab they shrink by
 // its time scale.
 #include <chrono>
+#include <map>
 #include <memory>
 #include <set>
 #include <string>
@@ -49,6 +50,9 @@ class Lab {
   boost::asio::awaitable<nlohmann::json> restore(const LabState& desired, const ExecutionControl& control);
   // Table home with the head up; lamps off if configured. Errors are logged, not thrown.
   boost::asio::awaitable<void> safe_state();
+  // Connects the instruments named in `expected` (id → serial the run started with) and lists those
+  // that now report another serial: "id: the run started with serial A, now B".
+  boost::asio::awaitable<std::vector<std::string>> serial_mismatches(std::map<std::string, std::string> expected);
   // Which instrument plays each role now, for the run's snapshot.
   nlohmann::json roles() const;
 

@@ -49,7 +49,7 @@ class Executions {
  private:
   struct Active;
   void launch(store::ExecutionRecord record, std::shared_ptr<const campaigns::CampaignScript> script,
-              nlohmann::json params, bool resumed);
+              nlohmann::json params, bool resumed, bool accept_units = false);
   store::ExecutionRecord require(const std::string& id);
   void maybe_done();
 
