@@ -94,6 +94,25 @@ int raise_top(lua_State* L) {
   return lua_error(L);
 }
 
+// Runs `f`, turning an exception into a Lua error at the caller's line. The message is pushed and
+// every C++ object of the try block is destroyed before lua_error longjmps over this frame.
+template <class F>
+void guarded(lua_State* L, F&& f) {
+  bool failed = false;
+  {
+    try {
+      f();
+    } catch (const Error& e) {
+      lua_pushstring(L, e.info().message.c_str());
+      failed = true;
+    } catch (const std::exception& e) {
+      lua_pushstring(L, e.what());
+      failed = true;
+    }
+  }
+  if (failed) raise_top(L);
+}
+
 int yielding_call(lua_State* L) {
   LabCallSink* sink = sink_of(L);
   const char* call = lua_tostring(L, lua_upvalueindex(2));
@@ -101,25 +120,15 @@ int yielding_call(lua_State* L) {
   if (!sink->is_campaign_thread(L) || !lua_isyieldable(L)) {
     return luaL_error(L, "lab.%s cannot be called from a coroutine or a callback (table.sort, string.gsub); call it from run", call);
   }
-  bool failed = false;
-  {
-    try {
-      json args = json::array();
-      int n = lua_gettop(L);
-      for (int i = 1; i <= n; ++i) args.push_back(to_json(L, i, "argument #" + std::to_string(i) + " to lab." + call));
-      while (!args.empty() && args.back().is_null()) args.erase(args.end() - 1);
-      std::string problem = check_args(call, args);
-      if (!problem.empty()) throw Error(ErrorClass::script_error, problem);
-      sink->request(call, std::move(args));
-    } catch (const Error& e) {
-      lua_pushstring(L, e.info().message.c_str());
-      failed = true;
-    } catch (const std::exception& e) {
-      lua_pushstring(L, e.what());
-      failed = true;
-    }
-  }
-  if (failed) return raise_top(L);
+  guarded(L, [&] {
+    json args = json::array();
+    int n = lua_gettop(L);
+    for (int i = 1; i <= n; ++i) args.push_back(to_json(L, i, "argument #" + std::to_string(i) + " to lab." + call));
+    while (!args.empty() && args.back().is_null()) args.erase(args.end() - 1);
+    std::string problem = check_args(call, args);
+    if (!problem.empty()) throw Error(ErrorClass::script_error, problem);
+    sink->request(call, std::move(args));
+  });
   lua_settop(L, 0);
   return lua_yield(L, 0);
 }
@@ -127,32 +136,22 @@ int yielding_call(lua_State* L) {
 int lab_record(lua_State* L) {
   LabCallSink* sink = sink_of(L);
   if (!sink) return luaL_error(L, "lab.record can only be called while the campaign runs (inside run)");
-  bool failed = false;
-  {
-    try {
-      if (lua_type(L, 1) != LUA_TSTRING) throw Error(ErrorClass::script_error, "bad argument #1 to lab.record (step key string expected)");
-      if (lua_type(L, 2) != LUA_TTABLE) {
-        throw Error(ErrorClass::script_error, "bad argument #2 to lab.record (table {quantity=, value=, unit=, instrument=, data=} expected)");
-      }
-      std::string step = lua_tostring(L, 1);
-      json fields = to_json(L, 2, "lab.record's fields");
-      if (step.empty() || step.size() > 256) throw Error(ErrorClass::script_error, "lab.record: the step key must be 1 to 256 characters");
-      if (!fields.is_object() || !fields.contains("quantity") || !fields["quantity"].is_string()) {
-        throw Error(ErrorClass::script_error, "lab.record: fields.quantity (a string) is required");
-      }
-      if (fields.contains("value") && !fields["value"].is_number() && !fields["value"].is_null()) {
-        throw Error(ErrorClass::script_error, "lab.record: fields.value must be a number (put other payloads in fields.data)");
-      }
-      sink->record(step, fields);
-    } catch (const Error& e) {
-      lua_pushstring(L, e.info().message.c_str());
-      failed = true;
-    } catch (const std::exception& e) {
-      lua_pushstring(L, e.what());
-      failed = true;
+  guarded(L, [&] {
+    if (lua_type(L, 1) != LUA_TSTRING) throw Error(ErrorClass::script_error, "bad argument #1 to lab.record (step key string expected)");
+    if (lua_type(L, 2) != LUA_TTABLE) {
+      throw Error(ErrorClass::script_error, "bad argument #2 to lab.record (table {quantity=, value=, unit=, instrument=, data=} expected)");
     }
-  }
-  if (failed) return raise_top(L);
+    std::string step = lua_tostring(L, 1);
+    json fields = to_json(L, 2, "lab.record's fields");
+    if (step.empty() || step.size() > 256) throw Error(ErrorClass::script_error, "lab.record: the step key must be 1 to 256 characters");
+    if (!fields.is_object() || !fields.contains("quantity") || !fields["quantity"].is_string()) {
+      throw Error(ErrorClass::script_error, "lab.record: fields.quantity (a string) is required");
+    }
+    if (fields.contains("value") && !fields["value"].is_number() && !fields["value"].is_null()) {
+      throw Error(ErrorClass::script_error, "lab.record: fields.value must be a number (put other payloads in fields.data)");
+    }
+    sink->record(step, fields);
+  });
   return 0;
 }
 
@@ -163,16 +162,7 @@ int lab_progress(lua_State* L) {
   if (!(fraction >= 0 && fraction <= 1)) return luaL_error(L, "lab.progress takes a fraction from 0 to 1");
   std::size_t n = 0;
   const char* label = luaL_optlstring(L, 2, "", &n);
-  bool failed = false;
-  {
-    try {
-      sink->progress(fraction, std::string(label, n));
-    } catch (const std::exception& e) {
-      lua_pushstring(L, e.what());
-      failed = true;
-    }
-  }
-  if (failed) return raise_top(L);
+  guarded(L, [&] { sink->progress(fraction, std::string(label, n)); });
   return 0;
 }
 
@@ -187,18 +177,7 @@ int lab_log(lua_State* L) {
     luaL_addvalue(&b);
   }
   luaL_pushresult(&b);
-  if (sink) {
-    bool failed = false;
-    {
-      try {
-        sink->log(lua_tostring(L, -1));
-      } catch (const std::exception& e) {
-        lua_pushstring(L, e.what());
-        failed = true;
-      }
-    }
-    if (failed) return raise_top(L);
-  }
+  if (sink) guarded(L, [&] { sink->log(lua_tostring(L, -1)); });
   return 0;
 }
 

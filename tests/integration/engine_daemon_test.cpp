@@ -2,10 +2,6 @@
 // directory, scripts that misbehave, pause/resume/abort from the API, SIGTERM in the middle of a
 // run, and a step that kills the daemon every time (a bounded number of resumes, then a reason).
 #include <stdlib.h>
-#include <sys/socket.h>
-#include <sys/un.h>
-#include <unistd.h>
-
 #include <csignal>
 #include <cstring>
 #include <fstream>
@@ -14,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "colorlab/client/api_client.hpp"
+#include "colorlab/testing/notify_socket.hpp"
 #include "resume_support.hpp"
 
 using namespace colorlab::testing;
@@ -104,14 +101,7 @@ return {
 // goes on feeding systemd's watchdog and serving the API.
 TEST(EngineInDaemon, MisbehavingScriptsEndInTypedErrorsWhileTheDaemonKeepsServing) {
   TempDir dir;
-  std::string sock_path = (dir / "notify.sock").string();
-  int fd = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
-  sockaddr_un addr{};
-  addr.sun_family = AF_UNIX;
-  std::strncpy(addr.sun_path, sock_path.c_str(), sizeof addr.sun_path - 1);
-  ASSERT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
-  timeval tv{0, 20000};
-  ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+  NotifySocket systemd(dir / "notify.sock");
   std::filesystem::create_directories(dir / "state" / "campaigns");
   struct Case {
     const char* name;
@@ -129,7 +119,7 @@ TEST(EngineInDaemon, MisbehavingScriptsEndInTypedErrorsWhileTheDaemonKeepsServin
     std::ofstream(dir / "state" / "campaigns" / (std::string(c.name) + ".lua"))
         << "return {\n  limits = { memory_mib = 16 },\n  run = function(p)\n" << c.body << "\n  end,\n}\n";
   }
-  ::setenv("NOTIFY_SOCKET", sock_path.c_str(), 1);
+  ::setenv("NOTIFY_SOCKET", systemd.path().c_str(), 1);
   ::setenv("WATCHDOG_USEC", "400000", 1);
   DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), 20, 1));
   ::unsetenv("NOTIFY_SOCKET");
@@ -142,9 +132,7 @@ TEST(EngineInDaemon, MisbehavingScriptsEndInTypedErrorsWhileTheDaemonKeepsServin
     int pings = 0;
     json done;
     for (;;) {
-      char buf[256];
-      ssize_t n = ::recv(fd, buf, sizeof buf, 0);
-      if (n > 0 && std::string(buf, static_cast<std::size_t>(n)).find("WATCHDOG=1") != std::string::npos) ++pings;
+      if (systemd.receive(std::chrono::milliseconds(20)).find("WATCHDOG=1") != std::string::npos) ++pings;
       done = api.get("/v1/executions/" + e["id"].get<std::string>());  // the API answers meanwhile
       if (done["status"] != "running" && done["status"] != "waiting") break;
       ASSERT_LT(std::chrono::steady_clock::now() - started, std::chrono::seconds(60));
@@ -163,7 +151,6 @@ TEST(EngineInDaemon, MisbehavingScriptsEndInTypedErrorsWhileTheDaemonKeepsServin
     }
   }
   EXPECT_EQ(api.get("/v1")["server"], "colorlabd");
-  ::close(fd);
 }
 
 TEST(EngineInDaemon, PauseResumeAndAbortLandAtSafePoints) {
