@@ -114,14 +114,52 @@ std::shared_ptr<T> Lab::role(const std::string& name) const {
               "add one to colorlabd's configuration, or run the simulated lab");
 }
 
+template <class T>
+asio::awaitable<std::shared_ptr<T>> Lab::acquire(const std::string& name) {
+  if (auto t = find_role<T>(name)) {
+    co_await ready(*t);
+    co_return t;
+  }
+  // A driver may learn what it offers only when connected (a Spectrolino is on a table or not):
+  // connect the candidates, then look again.
+  for (const auto& i : instruments_.all()) {
+    auto s = i->state();
+    if (!std::dynamic_pointer_cast<T>(i) ||
+        (s != drivers::InstrumentState::disconnected && s != drivers::InstrumentState::initialising)) {
+      continue;
+    }
+    try {
+      co_await ready(*i);
+    } catch (const Error&) {
+      continue;
+    }
+  }
+  co_return role<T>(name);
+}
+
+template <class T>
+bool Lab::may_offer(const std::string& name) const {
+  if (find_role<T>(name)) return true;
+  for (const auto& i : instruments_.all()) {
+    auto s = i->state();
+    if (std::dynamic_pointer_cast<T>(i) &&
+        (s == drivers::InstrumentState::disconnected || s == drivers::InstrumentState::initialising)) {
+      return true;
+    }
+  }
+  return false;
+}
+
 void Lab::check_needs(const std::vector<std::string>& roles) const {
+  // An instrument still connecting may turn out to offer the role: accept it now, decide at the call.
   for (const auto& r : roles) {
-    if (r == "luminance_meter") role<drivers::LuminanceMeter>(r);
-    else if (r == "spectrophotometer") role<drivers::Spectrometer>(r);
-    else if (r == "table") role<drivers::XyTable>(r);
-    else if (r == "lamps") role<drivers::LampController>(r);
-    else if (r == "dimmer") role<drivers::Dimmer>(r);
-    else if (r == "camera") role<cam::CameraInstrument>(r);
+    bool ok = r == "luminance_meter"     ? may_offer<drivers::LuminanceMeter>(r)
+              : r == "spectrophotometer" ? may_offer<drivers::Spectrometer>(r)
+              : r == "table"             ? may_offer<drivers::XyTable>(r)
+              : r == "lamps"             ? may_offer<drivers::LampController>(r)
+              : r == "dimmer"            ? may_offer<drivers::Dimmer>(r)
+                                         : may_offer<cam::CameraInstrument>(r);
+    if (!ok) role<drivers::Instrument>(r);  // throws the not_found with its hint
   }
 }
 
@@ -191,8 +229,7 @@ asio::awaitable<void> Lab::sleep_lab_seconds(double seconds, const ExecutionCont
 }
 
 asio::awaitable<json> Lab::wait_stable(const StabilityCriterion& c, const ExecutionControl& control) {
-  auto meter = role<drivers::LuminanceMeter>("luminance_meter");
-  co_await ready(*meter);
+  auto meter = co_await acquire<drivers::LuminanceMeter>("luminance_meter");
   auto start = std::chrono::steady_clock::now();
   auto lab_seconds = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() * options_.time_scale;
@@ -241,8 +278,7 @@ asio::awaitable<json> Lab::wait_stable(const StabilityCriterion& c, const Execut
 }
 
 asio::awaitable<void> Lab::switch_lamps(std::vector<std::string> on) {
-  auto lamps = role<drivers::LampController>("lamps");
-  co_await ready(*lamps);
+  auto lamps = co_await acquire<drivers::LampController>("lamps");
   auto before = lamps->lamps_on();
   co_await lamps->set_lamps(on);
   for (const auto& l : on) {
@@ -255,8 +291,7 @@ asio::awaitable<void> Lab::switch_lamps(std::vector<std::string> on) {
 
 asio::awaitable<json> Lab::perform(const std::string& call, const json& args, const ExecutionControl& control) {
   if (call == "meter.measure") {
-    auto meter = role<drivers::LuminanceMeter>("luminance_meter");
-    co_await ready(*meter);
+    auto meter = co_await acquire<drivers::LuminanceMeter>("luminance_meter");
     auto r = co_await meter->measure_luminance();
     co_return json{{"luminance", r.luminance}, {"unit", r.unit}, {"instrument", meter->id()}, {"raw", r.raw_reply}};
   }
@@ -296,15 +331,13 @@ asio::awaitable<json> Lab::perform(const std::string& call, const json& args, co
     co_return json(lamps->lamp_names());
   }
   if (call == "dimmer.set") {
-    auto dimmer = role<drivers::Dimmer>("dimmer");
-    co_await ready(*dimmer);
+    auto dimmer = co_await acquire<drivers::Dimmer>("dimmer");
     const std::string channel = "dimmer";
     co_await dimmer->set_level(channel, args[0].get<double>() / 100.0);
     co_return json{{"dimmer_percent", args[0]}};
   }
   if (call.rfind("table.", 0) == 0) {
-    auto table = role<drivers::XyTable>("table");
-    co_await ready(*table);
+    auto table = co_await acquire<drivers::XyTable>("table");
     if (call == "table.move") {
       co_await table->move_to(args[0].get<double>(), args[1].get<double>());
     } else if (call == "table.home") {
@@ -322,8 +355,7 @@ asio::awaitable<json> Lab::perform(const std::string& call, const json& args, co
     co_return json(nullptr);
   }
   if (call.rfind("spectro.", 0) == 0) {
-    auto spectro = role<drivers::Spectrometer>("spectrophotometer");
-    co_await ready(*spectro);
+    auto spectro = co_await acquire<drivers::Spectrometer>("spectrophotometer");
     if (call == "spectro.mode") {
       co_await spectro->set_mode(mode_from(args[0].get<std::string>()));
     } else if (call == "spectro.calibrate") {
@@ -335,8 +367,7 @@ asio::awaitable<json> Lab::perform(const std::string& call, const json& args, co
     co_return json(nullptr);
   }
   if (call == "camera.configure" || call == "camera.capture") {
-    auto camera = role<cam::CameraInstrument>("camera");
-    co_await ready(*camera);
+    auto camera = co_await acquire<cam::CameraInstrument>("camera");
     if (call == "camera.capture") {
       // Named, not a temporary in the co_await: GCC 12 destroys such temporaries twice.
       json options = args.empty() ? json::object() : args[0];
@@ -374,15 +405,13 @@ asio::awaitable<json> Lab::restore(const LabState& desired, const ExecutionContr
   json done = json::array();
   std::shared_ptr<drivers::XyTable> table;
   if (desired.table_used) {
-    table = role<drivers::XyTable>("table");
-    co_await ready(*table);
+    table = co_await acquire<drivers::XyTable>("table");
     // A process killed mid-move may have left the head down: never drag it across the chart.
     co_await table->head_up();
     done.push_back("head up");
   }
   if (desired.spectro_mode || desired.spectro_calibrated) {
-    auto spectro = role<drivers::Spectrometer>("spectrophotometer");
-    co_await ready(*spectro);
+    auto spectro = co_await acquire<drivers::Spectrometer>("spectrophotometer");
     if (desired.spectro_mode) co_await spectro->set_mode(mode_from(*desired.spectro_mode));
     if (desired.spectro_calibrated) {
       bool valid = false;
@@ -401,8 +430,7 @@ asio::awaitable<json> Lab::restore(const LabState& desired, const ExecutionContr
     done.push_back(json{{"lamps_on", *desired.lamps_on}});
   }
   if (desired.dimmer_percent) {
-    auto dimmer = role<drivers::Dimmer>("dimmer");
-    co_await ready(*dimmer);
+    auto dimmer = co_await acquire<drivers::Dimmer>("dimmer");
     const std::string channel = "dimmer";
     co_await dimmer->set_level(channel, *desired.dimmer_percent / 100.0);
     done.push_back(json{{"dimmer_percent", *desired.dimmer_percent}});

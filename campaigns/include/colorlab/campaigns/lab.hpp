@@ -64,6 +64,11 @@ class Lab {
   std::shared_ptr<T> role(const std::string& name) const;  // or Error{not_found}
   template <class T>
   std::shared_ptr<T> find_role(const std::string& name) const;  // or nullptr
+  // The role's instrument, connected (connecting candidates first if none offers it yet).
+  template <class T>
+  boost::asio::awaitable<std::shared_ptr<T>> acquire(const std::string& name);
+  template <class T>
+  bool may_offer(const std::string& name) const;
   boost::asio::awaitable<void> ready(drivers::Instrument& instrument);
   boost::asio::awaitable<void> sleep_lab_seconds(double seconds, const ExecutionControl& control);
   boost::asio::awaitable<nlohmann::json> wait_stable(const StabilityCriterion& c, const ExecutionControl& control);
