@@ -334,6 +334,12 @@ asio::awaitable<json> Lab::perform(const std::string& call, const json& args, co
     auto dimmer = co_await acquire<drivers::Dimmer>("dimmer");
     const std::string channel = "dimmer";
     co_await dimmer->set_level(channel, args[0].get<double>() / 100.0);
+    // The driver ramps at its configured rate and settles; a script may ask for more settling.
+    if (args.size() > 1 && args[1].is_object() && args[1].contains("settle_s")) {
+      double settle = args[1]["settle_s"].is_number() ? args[1]["settle_s"].get<double>() : -1;
+      if (!(settle >= 0 && settle <= 3600)) throw Error(ErrorClass::script_error, "lab.dimmer.set: settle_s must be from 0 to 3600");
+      co_await sleep_lab_seconds(settle, control);
+    }
     co_return json{{"dimmer_percent", args[0]}};
   }
   if (call.rfind("table.", 0) == 0) {

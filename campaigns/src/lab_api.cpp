@@ -8,6 +8,7 @@
 #include <lua5.4/lua.hpp>
 
 #include "colorlab/analysis/statistics.hpp"
+#include "colorlab/analysis/uniformity.hpp"
 #include "colorlab/campaigns/lua_value.hpp"
 #include "colorlab/core/error.hpp"
 
@@ -28,7 +29,7 @@ const std::map<std::string, CallSpec>& call_specs() {
       {"lamps.set", {CallKind::effect, {"list"}}},
       {"lamps.off", {CallKind::effect, {}}},
       {"lamps.names", {CallKind::reading, {}}},
-      {"dimmer.set", {CallKind::effect, {"number"}}},
+      {"dimmer.set", {CallKind::effect, {"number", "table?"}}},
       {"table.move", {CallKind::effect, {"number", "number"}}},
       {"table.home", {CallKind::effect, {}}},
       {"table.head_up", {CallKind::effect, {}}},
@@ -209,6 +210,71 @@ int analysis_summarize(lua_State* L) {
   return 1;
 }
 
+Eigen::MatrixXd matrix_from(const json& rows, const char* what) {
+  if (!rows.is_array() || rows.empty() || !rows[0].is_array() || rows[0].empty()) {
+    throw Error(ErrorClass::script_error, std::string(what) + " must be a list of rows of numbers");
+  }
+  Eigen::MatrixXd m(static_cast<Eigen::Index>(rows.size()), static_cast<Eigen::Index>(rows[0].size()));
+  for (std::size_t r = 0; r < rows.size(); ++r) {
+    if (!rows[r].is_array() || rows[r].size() != rows[0].size()) {
+      throw Error(ErrorClass::script_error, std::string(what) + ": every row needs " + std::to_string(rows[0].size()) + " values");
+    }
+    for (std::size_t c = 0; c < rows[r].size(); ++c) {
+      if (!rows[r][c].is_number()) throw Error(ErrorClass::script_error, std::string(what) + " holds a value that is not a number");
+      m(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) = rows[r][c].get<double>();
+    }
+  }
+  return m;
+}
+
+json rows_of(const Eigen::MatrixXd& m) {
+  json out = json::array();
+  for (Eigen::Index r = 0; r < m.rows(); ++r) {
+    json row = json::array();
+    for (Eigen::Index c = 0; c < m.cols(); ++c) row.push_back(m(r, c));
+    out.push_back(row);
+  }
+  return out;
+}
+
+// lab.analysis.uniformity(left_half_grid, {window_rows = 4, window_cols = 5}) → §6.2 (Tables 3–6).
+int analysis_uniformity(lua_State* L) {
+  guarded(L, [&] {
+    json grid = to_json(L, 1, "lab.analysis.uniformity's grid");
+    json options = lua_gettop(L) >= 2 ? to_json(L, 2, "lab.analysis.uniformity's options") : json::object();
+    analysis::UniformityOptions o;
+    if (options.is_object()) {
+      o.window_rows = options.value("window_rows", o.window_rows);
+      o.window_cols = options.value("window_cols", o.window_cols);
+    }
+    auto u = analysis::analyse_uniformity(matrix_from(grid, "lab.analysis.uniformity's grid"), o);
+    json result{{"min", u.min},
+                {"max", u.max},
+                {"best", {{"row", u.best.row}, {"col", u.best.col}, {"stdev", u.best.stdev}}},
+                {"window_stdev", rows_of(u.window_stdev)},
+                {"full", rows_of(u.full)},
+                {"difference", rows_of(u.difference)}};
+    lua_settop(L, 0);
+    push_json(L, result);
+  });
+  return 1;
+}
+
+// lab.analysis.dimmer_proportionality(full_difference, low_difference, setting) → {max_abs_error, error, scaled}.
+int analysis_dimmer(lua_State* L) {
+  guarded(L, [&] {
+    json full = to_json(L, 1, "full_difference");
+    json low = to_json(L, 2, "low_difference");
+    if (!lua_isnumber(L, 3)) throw Error(ErrorClass::script_error, "lab.analysis.dimmer_proportionality: setting (0..1) expected as argument #3");
+    double setting = lua_tonumber(L, 3);
+    auto d = analysis::dimmer_proportionality(matrix_from(full, "full_difference"), matrix_from(low, "low_difference"), setting);
+    json result{{"setting", d.setting}, {"max_abs_error", d.max_abs_error}, {"error", rows_of(d.error)}, {"scaled", rows_of(d.scaled)}};
+    lua_settop(L, 0);
+    push_json(L, result);
+  });
+  return 1;
+}
+
 void set_function(lua_State* L, const char* field, lua_CFunction f, LabCallSink* sink, const char* call = nullptr) {
   lua_pushlightuserdata(L, sink);
   if (call) {
@@ -250,6 +316,10 @@ void install_lab_api(lua_State* L, LabCallSink* sink) {
   lua_newtable(L);
   lua_pushcfunction(L, analysis_summarize);
   lua_setfield(L, -2, "summarize");
+  lua_pushcfunction(L, analysis_uniformity);
+  lua_setfield(L, -2, "uniformity");
+  lua_pushcfunction(L, analysis_dimmer);
+  lua_setfield(L, -2, "dimmer_proportionality");
   lua_setfield(L, -2, "analysis");
   lua_setglobal(L, "lab");
 }

@@ -145,3 +145,36 @@ TEST(Sandbox, LongComputationDoesNotStarveTheEventLoop) {
   EXPECT_GE(ticks, static_cast<int>(seconds / 0.020 / 3)) << "computation took " << seconds << " s";
   EXPECT_GE(ticks, 3);
 }
+
+// The analysis library from a script: §6.2 on a grid whose answer is known. A 4 × 5 block of
+// equal values in an otherwise graded 8 × 10 half-grid is the only zero-spread window.
+TEST(LabAnalysis, UniformityAndDimmerProportionalityFromAScript) {
+  ScriptRunSetup setup;
+  setup.script = script_from("grid", R"lua(return { run = function()
+    local g = {}
+    for r = 1, 8 do
+      g[r] = {}
+      for c = 1, 10 do g[r][c] = 100 + 3 * r + 7 * c end
+    end
+    for r = 3, 6 do for c = 2, 6 do g[r][c] = 150 end end
+    local u = lab.analysis.uniformity(g)
+    local half = {}
+    for r = 1, #u.difference do
+      half[r] = {}
+      for c = 1, #u.difference[r] do half[r][c] = u.difference[r][c] * 0.5 end
+    end
+    local d = lab.analysis.dimmer_proportionality(u.difference, half, 0.5)
+    local ok, err = pcall(lab.analysis.uniformity, { { 1, 2 }, { 3 } })
+    return { best = u.best, min = u.min, max = u.max, dimmer_error = d.max_abs_error, ragged = err }
+  end })lua");
+  MemorySink sink;
+  ExecutionControl control;
+  auto o = run_script(setup, sink, control).outcome;
+  ASSERT_EQ(o.kind, RunOutcome::Kind::finished) << (o.error ? o.error->what() : "");
+  EXPECT_EQ(o.result["best"]["row"], 2);  // 0-based: rows 3..6, columns 2..6 in Lua's 1-based terms
+  EXPECT_EQ(o.result["best"]["col"], 1);
+  EXPECT_NEAR(o.result["best"]["stdev"].get<double>(), 0.0, 1e-12);
+  EXPECT_DOUBLE_EQ(o.result["min"].get<double>(), 110.0);
+  EXPECT_NEAR(o.result["dimmer_error"].get<double>(), 0.0, 1e-9);  // exactly proportional by construction
+  EXPECT_NE(o.result["ragged"].get<std::string>().find("every row needs 2 values"), std::string::npos);
+}
