@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "colorlab/client/api_client.hpp"
+#include "colorlab/testing/daemon.hpp"
 #include "colorlab/testing/process.hpp"
 #include "colorlab/testing/temp_dir.hpp"
 
@@ -61,12 +62,7 @@ class DaemonHttp : public ::testing::Test {
         std::vector<std::string>{colorlab::testing::bin_path("colorlabd"), "--config", (dir / "colorlabd.toml").string(),
                                  "--listen", "127.0.0.1:0"},
         dir / "colorlabd.log");
-    auto endpoint_file = dir / "state" / "colorlabd.endpoint";
-    for (int i = 0; i < 200 && !std::filesystem::exists(endpoint_file); ++i) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(25));
-    }
-    ASSERT_TRUE(std::filesystem::exists(endpoint_file)) << "colorlabd did not start";
-    json endpoint = json::parse(std::ifstream(endpoint_file));
+    json endpoint = colorlab::testing::wait_for_endpoint(dir / "state", daemon->pid());
     port = endpoint["port"];
     socket_path = endpoint["unix_socket"];
   }

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "colorlab/testing/daemon.hpp"
 #include "lab_fixture.hpp"
 
 using colorlab::testing::Process;
@@ -47,8 +48,7 @@ TEST(Discovery, DaemonReportsInstrumentsThatComeAndGo) {
                                         << "\"\nsimulated = true\n";
   Process daemon({colorlab::testing::bin_path("colorlabd"), "--config", (dir / "colorlabd.toml").string()},
                  dir / "colorlabd.log");
-  ASSERT_TRUE(eventually([&] { return std::filesystem::exists(dir / "state" / "colorlabd.endpoint"); }));
-  std::string url = json::parse(std::ifstream(dir / "state" / "colorlabd.endpoint"))["url"];
+  std::string url = colorlab::testing::wait_for_endpoint(dir / "state", daemon.pid())["url"];
   auto get = [&](const std::string& path) {
     auto r = colorlab::testing::run_command({"/usr/bin/curl", "-sf", url + path});
     EXPECT_EQ(r.exit_code, 0) << path;

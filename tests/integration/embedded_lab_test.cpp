@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "colorlab/testing/daemon.hpp"
 #include "colorlab/testing/process.hpp"
 #include "colorlab/testing/temp_dir.hpp"
 
@@ -21,12 +22,7 @@ class EmbeddedDaemon {
       : daemon_({colorlab::testing::bin_path("colorlabd"), "--state", (dir_ / "state").string(), "--listen",
                  "127.0.0.1:0"},
                 dir_ / "colorlabd.log") {
-    auto endpoint_file = dir_ / "state" / "colorlabd.endpoint";
-    for (int i = 0; i < 400 && !std::filesystem::exists(endpoint_file); ++i) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(25));
-    }
-    if (!std::filesystem::exists(endpoint_file)) throw std::runtime_error("colorlabd did not start");
-    url_ = json::parse(std::ifstream(endpoint_file))["url"];
+    url_ = colorlab::testing::wait_for_endpoint(dir_ / "state", daemon_.pid())["url"];
   }
   colorlab::testing::RunResult cli(std::vector<std::string> args) {
     std::vector<std::string> argv{colorlab::testing::bin_path("colorlab"), "--url", url_, "--json"};

@@ -1,5 +1,7 @@
 #include "lab_fixture.hpp"
 
+#include "colorlab/testing/daemon.hpp"
+
 #include <fstream>
 #include <thread>
 
@@ -41,17 +43,10 @@ LabFixture::LabFixture(double time_scale, std::string ls110_options) {
 LabFixture::~LabFixture() = default;
 
 void LabFixture::start_daemon() {
-  auto endpoint_file = dir / "state" / "colorlabd.endpoint";
-  std::error_code ec;
-  std::filesystem::remove(endpoint_file, ec);
   daemon_ = std::make_unique<Process>(
       std::vector<std::string>{bin_path("colorlabd"), "--config", (dir / "colorlabd.toml").string()},
       dir / "colorlabd.log");
-  for (int i = 0; i < 400 && !std::filesystem::exists(endpoint_file); ++i) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(25));
-  }
-  if (!std::filesystem::exists(endpoint_file)) throw std::runtime_error("colorlabd did not start");
-  url_ = json::parse(std::ifstream(endpoint_file))["url"];
+  url_ = wait_for_endpoint(dir / "state", daemon_->pid())["url"];
 }
 
 void LabFixture::kill_daemon() {
