@@ -184,29 +184,21 @@ int lab_log(lua_State* L) {
 
 // lab.analysis.summarize({...}) → {count, mean, stdev, median, min, max}: the one summary used everywhere.
 int analysis_summarize(lua_State* L) {
-  luaL_checktype(L, 1, LUA_TTABLE);
-  lua_Integer n = luaL_len(L, 1);
-  std::vector<double> values;
-  values.reserve(static_cast<std::size_t>(std::max<lua_Integer>(n, 0)));
-  for (lua_Integer i = 1; i <= n; ++i) {
-    lua_rawgeti(L, 1, i);
-    int isnum = 0;
-    double v = lua_tonumberx(L, -1, &isnum);
-    lua_pop(L, 1);
-    if (!isnum) return luaL_error(L, "lab.analysis.summarize: element %d is not a number", static_cast<int>(i));
-    values.push_back(v);
-  }
-  if (values.empty()) return luaL_error(L, "lab.analysis.summarize: no values");
-  analysis::Summary s = analysis::summarize(values);
-  lua_createtable(L, 0, 6);
-  lua_pushinteger(L, static_cast<lua_Integer>(s.count));
-  lua_setfield(L, -2, "count");
-  const std::pair<const char*, double> fields[] = {
-      {"mean", s.mean}, {"stdev", s.stdev}, {"median", s.median}, {"min", s.min}, {"max", s.max}};
-  for (const auto& [k, v] : fields) {
-    lua_pushnumber(L, v);
-    lua_setfield(L, -2, k);
-  }
+  guarded(L, [&] {
+    if (lua_type(L, 1) != LUA_TTABLE) throw Error(ErrorClass::script_error, "lab.analysis.summarize takes a list of numbers");
+    json list = to_json(L, 1, "lab.analysis.summarize's list");
+    std::vector<double> values;
+    for (std::size_t i = 0; i < (list.is_array() ? list.size() : 0); ++i) {
+      if (!list[i].is_number()) {
+        throw Error(ErrorClass::script_error, "lab.analysis.summarize: element " + std::to_string(i + 1) + " is not a number");
+      }
+      values.push_back(list[i].get<double>());
+    }
+    if (values.empty()) throw Error(ErrorClass::script_error, "lab.analysis.summarize: no values");
+    analysis::Summary s = analysis::summarize(values);
+    lua_settop(L, 0);
+    push_json(L, json{{"count", s.count}, {"mean", s.mean}, {"stdev", s.stdev}, {"median", s.median}, {"min", s.min}, {"max", s.max}});
+  });
   return 1;
 }
 
