@@ -196,7 +196,7 @@ TEST(EngineInDaemon, SigtermSuspendsTheRunningStepAndTheNextStartResumesIt) {
   TempDir dir;
   DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), 4, 1));
   auto api = api_for(daemon);
-  auto e = start(api, "luminance-spot", {{"readings", 20}});
+  auto e = start(api, "luminance-spot", {{"readings", 20}, {"interval_s", 1}});
   std::string id = e["id"];
   wait_measurements(api, e, 3);
   EXPECT_EQ(daemon.terminate(), 0) << "colorlabd must stop cleanly on SIGTERM";
@@ -258,6 +258,7 @@ return {
     for i = 1, 40 do
       local r = lab.meter.measure()
       lab.record("reading/" .. i, { quantity = "luminance", value = r.luminance, unit = r.unit, instrument = r.instrument })
+      lab.wait(2)  -- long enough that the kill lands mid-run even on a loaded machine
     end
   end,
 }

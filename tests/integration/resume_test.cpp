@@ -94,7 +94,7 @@ Reference* KillNineLuminanceSpot::reference_ = nullptr;
 TEST_P(KillNineLuminanceSpot, ResumesByItselfWithTheUninterruptedRunsSteps) {
   const auto seed = static_cast<std::uint64_t>(GetParam());
   int kills = 0;
-  json run = interrupted_run("luminance-spot", {{"readings", kReadings}}, seed, 1400, kills);
+  json run = interrupted_run("luminance-spot", {{"readings", kReadings}}, seed, 1000, kills);
   EXPECT_GE(kills, 1) << "the kill must land mid-campaign";
   EXPECT_EQ(steps_of(run), reference_->steps);
   // Within the simulator's noise of the uninterrupted run (6 of its standard deviations).

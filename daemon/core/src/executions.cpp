@@ -30,13 +30,19 @@ namespace {
 class StoreSink final : public campaigns::ExecutionSink {
  public:
   StoreSink(store::Store& store, const store::ExecutionRecord& record, const campaigns::InstrumentSet& instruments,
-            std::function<void(const std::string&)> status)
-      : store_(store), record_(record), instruments_(instruments), status_(std::move(status)) {}
+            std::function<void(const std::string&)> status, json snapshot, bool replace_serials)
+      : store_(store),
+        record_(record),
+        instruments_(instruments),
+        status_(std::move(status)),
+        snapshot_(std::move(snapshot)),
+        replace_serials_(replace_serials) {}
 
   void commit(const campaigns::StepCommit& step) override {
     store::StepRecord s;
     s.progress = step.progress;
     s.step = step.label;
+    s.instruments = updated_snapshot();
     for (const auto& j : step.journal) s.journal.push_back({j.seq, j.call, j.args, j.result});
     for (const auto& m : step.measurements) {
       auto instrument = instruments_.find(m.instrument_id);
@@ -54,10 +60,34 @@ class StoreSink final : public campaigns::ExecutionSink {
   }
 
  private:
+  // The run's snapshot is taken when it is created, possibly before every instrument has connected
+  // and named its serial. Serials learned since are written with the next step, so a resume can
+  // tell whether the same unit is still there. A recorded serial is replaced only once an operator
+  // has accepted another unit.
+  std::optional<json> updated_snapshot() {
+    if (!snapshot_.is_array()) return std::nullopt;
+    bool changed = false;
+    for (auto& entry : snapshot_) {
+      auto i = instruments_.find(entry.value("id", std::string()));
+      if (!i) continue;
+      auto serial = i->identity().serial;
+      auto recorded = entry.value("serial", std::string());
+      if (!serial.empty() && serial != recorded && (recorded.empty() || replace_serials_)) {
+        entry = drivers::describe(*i);
+        changed = true;
+      }
+    }
+    replace_serials_ = false;
+    if (!changed) return std::nullopt;
+    return snapshot_;
+  }
+
   store::Store& store_;
   const store::ExecutionRecord& record_;
   const campaigns::InstrumentSet& instruments_;
   std::function<void(const std::string&)> status_;
+  json snapshot_;
+  bool replace_serials_ = false;
 };
 
 json problem_json(const Error& e, const json& location) {
@@ -192,7 +222,9 @@ void Executions::launch(store::ExecutionRecord record, std::shared_ptr<const cam
             // An operator resuming a paused run has looked at the lab: accept the units as they are.
             setup.verify_serials = !accept_units;
           }
-          StoreSink sink(store_, record, instruments_, status_text_);
+          auto run = store_.run(record.run_id);
+          StoreSink sink(store_, record, instruments_, status_text_, run ? run->instruments : json(nullptr),
+                         resumed && accept_units);
           outcome = co_await campaigns::run_campaign_script(std::move(setup), lab_, sink, active->control);
         } catch (const Error& e) {
           outcome.kind = campaigns::RunOutcome::Kind::failed;

@@ -300,6 +300,12 @@ void Store::commit_step(const ExecutionRecord& execution, const StepRecord& step
       ins.reset();
     }
   }
+  if (step.instruments) {
+    db_.prepare("UPDATE runs SET instruments = ?2 WHERE id = ?1")
+        .bind(1, std::string_view(execution.run_id))
+        .bind(2, std::string_view(step.instruments->dump()))
+        .run();
+  }
   // Only a step that did something (a lab call or a measurement) proves a resume got past the
   // point that killed the previous process.
   bool progressed = !step.journal.empty() || !step.measurements.empty();

@@ -69,6 +69,9 @@ struct StepRecord {
   std::vector<MeasurementRow> measurements;
   double progress = 0;
   std::string step;
+  // When set, replaces the run's instrument snapshot in the same transaction (serials learned
+  // once the instruments connected).
+  std::optional<nlohmann::json> instruments;
 };
 
 struct MeasurementRecord {
