@@ -140,7 +140,16 @@ void add_daemon_commands(CLI::App& app, GlobalOptions& global) {
     auto* cmd = app.add_subcommand(action, help);
     cmd->add_option("execution", *id, "execution id (from `colorlab run --detach` or GET /v1/executions/{id})")->required();
     cmd->callback([&global, id, action = std::string(action)] {
-      print(global, make_client(global).post("/v1/executions/" + *id + "/" + action, json::object()), format_execution);
+      auto api = make_client(global);
+      json e = api.post("/v1/executions/" + *id + "/" + action, json::object());
+      // Pause and abort land at the campaign's next safe point: wait for it (a reading, a move) so
+      // the answer says what the execution is now, not what it was.
+      const std::string before = action == "resume" ? "paused" : "running";
+      for (int i = 0; i < 600 && e.value("status", std::string()) == before; ++i) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        e = api.get("/v1/executions/" + *id);
+      }
+      print(global, e, format_execution);
     });
   }
 

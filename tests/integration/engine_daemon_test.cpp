@@ -379,3 +379,30 @@ return {
   EXPECT_NE(what.find("white calibration"), std::string::npos) << what;
   EXPECT_NE(what.find("table_mm"), std::string::npos) << what;
 }
+
+// The same control from the CLI: each command returns once the execution has reached the state
+// (pause and abort land at the next safe point), and a refused one exits 2 with the server's reason.
+TEST(EngineInDaemon, CliPausesResumesAndAbortsAndSaysWhyItCannot) {
+  TempDir dir;
+  DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), 4, 1));
+  auto cli = [&](std::vector<std::string> args) {
+    std::vector<std::string> argv{bin_path("colorlab"), "--url", daemon.url(), "--json"};
+    argv.insert(argv.end(), args.begin(), args.end());
+    return run_command(argv, std::chrono::seconds(60));
+  };
+  auto started = cli({"run", "luminance-spot", "-p", "readings=300", "--detach"});
+  ASSERT_EQ(started.exit_code, 0) << started.err;
+  std::string id = json::parse(started.out)["id"];
+  auto paused = cli({"pause", id});
+  ASSERT_EQ(paused.exit_code, 0) << paused.err;
+  EXPECT_EQ(json::parse(paused.out)["status"], "paused");
+  auto resumed = cli({"resume", id});
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
+  EXPECT_EQ(json::parse(resumed.out)["status"], "running");
+  auto aborted = cli({"abort", id});
+  ASSERT_EQ(aborted.exit_code, 0) << aborted.err;
+  EXPECT_EQ(json::parse(aborted.out)["status"], "aborted");
+  auto again = cli({"abort", id});
+  EXPECT_EQ(again.exit_code, 2);
+  EXPECT_NE(again.err.find("already ended"), std::string::npos) << again.err;
+}
