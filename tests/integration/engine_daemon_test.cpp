@@ -254,7 +254,8 @@ return {
   needs = { "lamps", "luminance_meter" },
   run = function(p)
     lab.lamps.select("D65")
-    lab.dimmer.set(100)  -- the widget sends the whole universe: an unset dimmer channel is 0 %
+    lab.dimmer.set(100, { settle_s = 1 })  -- the widget sends the whole universe: an unset dimmer is 0 %
+    lab.wait_stable({ window_s = 20 })     -- as any campaign does before it measures under a lamp
     for i = 1, 40 do
       local r = lab.meter.measure()
       lab.record("reading/" .. i, { quantity = "luminance", value = r.luminance, unit = r.unit, instrument = r.instrument })
@@ -301,6 +302,7 @@ return {
     lab.dimmer.set(100)
     lab.wait(30)
     lab.lamps.select("TL84")
+    lab.wait(2)  -- the widget's frame reaches the lamp; 2 s of warm-up change its output by 0.2 %
     local cold = lab.meter.measure()
     local s = lab.wait_stable({ tolerance_pct = 0.5, window_s = 60, interval_s = 5, timeout_s = 3600 })
     local warm = lab.meter.measure()
