@@ -180,22 +180,6 @@ asio::awaitable<std::vector<std::string>> Lab::serial_mismatches(std::map<std::s
   co_return out;
 }
 
-json Lab::roles() const {
-  json j = json::object();
-  for (const char* r : {"luminance_meter", "spectrophotometer", "table", "lamps", "dimmer", "camera"}) {
-    auto capability = capability_of(r);
-    for (const auto& i : instruments_.all()) {
-      auto caps = i->capabilities();
-      if (std::find(caps.begin(), caps.end(), capability) != caps.end()) {
-        auto id = i->identity();
-        j[r] = {{"id", i->id()}, {"serial", id.serial}, {"model", id.model}, {"simulated", id.simulated}};
-        break;
-      }
-    }
-  }
-  return j;
-}
-
 asio::awaitable<void> Lab::ready(drivers::Instrument& instrument) {
   using drivers::InstrumentState;
   auto deadline = std::chrono::steady_clock::now() + options_.connect_timeout;

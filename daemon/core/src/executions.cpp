@@ -174,20 +174,24 @@ void Executions::resume_unfinished() {
           continue;
         }
       }
-      auto source = store_.script_source(record.script_sha256);
-      if (!source) throw Error(ErrorClass::not_found, "the run's script " + record.script_sha256 + " is missing from the store");
-      auto script = std::make_shared<campaigns::CampaignScript>(campaigns::parse_campaign_script(record.campaign, *source));
-      script->origin = "stored";
-      auto run = store_.run(record.run_id);
-      json params = run ? run->params : json::object();
       log::info("executions", "resuming " + record.id + " (" + record.campaign + ") from step '" + record.step + "'");
-      launch(record, script, params, true);
+      relaunch(record, false);
     } catch (const Error& e) {
       log::error("executions", record.id + ": cannot resume: " + e.what());
       store_.finish_execution(record, ExecutionStatus::finished_error, record.step, nullptr, problem_json(e, nullptr),
                               std::string("cannot resume: ") + e.what());
     }
   }
+}
+
+// A run continues with the exact text and parameters it started with, never an edited file.
+void Executions::relaunch(const store::ExecutionRecord& record, bool accept_units) {
+  auto source = store_.script_source(record.script_sha256);
+  if (!source) throw Error(ErrorClass::not_found, "the run's script " + record.script_sha256 + " is missing from the store");
+  auto script = std::make_shared<campaigns::CampaignScript>(campaigns::parse_campaign_script(record.campaign, *source));
+  script->origin = "stored";
+  auto run = store_.run(record.run_id);
+  launch(record, script, run ? run->params : json::object(), true, accept_units);
 }
 
 void Executions::launch(store::ExecutionRecord record, std::shared_ptr<const campaigns::CampaignScript> script,
@@ -209,22 +213,20 @@ void Executions::launch(store::ExecutionRecord record, std::shared_ptr<const cam
           setup.random_seed = record.random_seed;
           setup.initial_label = record.step;
           setup.initial_progress = record.progress;
+          auto run = store_.run(record.run_id);
+          json snapshot = run ? run->instruments : json(nullptr);
           if (resumed) {
             for (auto& j : store_.journal(record.id)) setup.journal.push_back({j.seq, j.call, j.args, j.result});
             setup.stored_steps = store_.measurement_steps(record.run_id);
-            if (auto run = store_.run(record.run_id); run && run->instruments.is_array()) {
-              for (const auto& i : run->instruments) {
-                if (i.contains("id") && i.contains("serial") && i["serial"].is_string()) {
-                  setup.expected_serials[i["id"].get<std::string>()] = i["serial"].get<std::string>();
-                }
+            for (const auto& i : snapshot.is_array() ? snapshot : json::array()) {
+              if (i.contains("id") && i.contains("serial") && i["serial"].is_string()) {
+                setup.expected_serials[i["id"].get<std::string>()] = i["serial"].get<std::string>();
               }
             }
             // An operator resuming a paused run has looked at the lab: accept the units as they are.
             setup.verify_serials = !accept_units;
           }
-          auto run = store_.run(record.run_id);
-          StoreSink sink(store_, record, instruments_, status_text_, run ? run->instruments : json(nullptr),
-                         resumed && accept_units);
+          StoreSink sink(store_, record, instruments_, status_text_, snapshot, resumed && accept_units);
           outcome = co_await campaigns::run_campaign_script(std::move(setup), lab_, sink, active->control);
         } catch (const Error& e) {
           outcome.kind = campaigns::RunOutcome::Kind::failed;
@@ -313,12 +315,7 @@ store::ExecutionRecord Executions::resume(const std::string& id) {
                                           ", not paused", "only a paused or suspended execution can be resumed");
   }
   if (shutting_down_) throw Error(ErrorClass::conflict, "colorlabd is shutting down");
-  auto source = store_.script_source(record.script_sha256);
-  if (!source) throw Error(ErrorClass::not_found, "the run's script is missing from the store");
-  auto script = std::make_shared<campaigns::CampaignScript>(campaigns::parse_campaign_script(record.campaign, *source));
-  script->origin = "stored";
-  auto run = store_.run(record.run_id);
-  launch(record, script, run ? run->params : json::object(), true, record.status == ExecutionStatus::paused);
+  relaunch(record, record.status == ExecutionStatus::paused);
   return require(id);
 }
 

@@ -53,8 +53,6 @@ class Lab {
   // Connects the instruments named in `expected` (id → serial the run started with) and lists those
   // that now report another serial: "id: the run started with serial A, now B".
   boost::asio::awaitable<std::vector<std::string>> serial_mismatches(std::map<std::string, std::string> expected);
-  // Which instrument plays each role now, for the run's snapshot.
-  nlohmann::json roles() const;
 
   const LabOptions& options() const { return options_; }
   double time_scale() const { return options_.time_scale; }

@@ -28,7 +28,6 @@ class LuaSandbox {
   LuaSandbox& operator=(const LuaSandbox&) = delete;
 
   lua_State* state() const { return L_; }
-  const std::string& script_name() const { return name_; }
 
   // Compiles `source` as text (never bytecode) under the chunk name "@<script_name>" and runs it;
   // leaves its first return value on the stack. Throws Error{script_error} naming script and line.
@@ -41,7 +40,6 @@ class LuaSandbox {
   // The script exceeded a limit: every further instruction raises, so `pcall` cannot swallow it.
   bool killed() const { return !kill_reason_.empty(); }
   const std::string& kill_reason() const { return kill_reason_; }
-  std::size_t memory_in_use() const { return memory_; }
   // True if the last resume yielded because of the time slice (not a lab call).
   bool take_slice_yield() {
     bool y = slice_yield_;

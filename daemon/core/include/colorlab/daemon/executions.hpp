@@ -50,6 +50,7 @@ class Executions {
   struct Active;
   void launch(store::ExecutionRecord record, std::shared_ptr<const campaigns::CampaignScript> script,
               nlohmann::json params, bool resumed, bool accept_units = false);
+  void relaunch(const store::ExecutionRecord& record, bool accept_units);
   store::ExecutionRecord require(const std::string& id);
   void maybe_done();
 
