@@ -14,8 +14,17 @@ std::string_view to_string(ImageFormat f) {
     case ImageFormat::raw: return "raw";
     case ImageFormat::jpeg: return "jpeg";
     case ImageFormat::raw_and_jpeg: return "raw+jpeg";
+    case ImageFormat::raw_jpeg_tiff: return "raw+jpeg+tiff";
   }
   return "?";
+}
+
+ImageFormat image_format_from_string(std::string_view name) {
+  for (auto f : {ImageFormat::raw, ImageFormat::jpeg, ImageFormat::raw_and_jpeg, ImageFormat::raw_jpeg_tiff}) {
+    if (to_string(f) == name) return f;
+  }
+  throw Error(ErrorClass::bad_parameter, "unknown image format '" + std::string(name) + "'",
+              "use one of raw, jpeg, raw+jpeg, raw+jpeg+tiff");
 }
 
 std::string_view to_string(PixelFormat f) {

@@ -3,9 +3,12 @@
 #include "colorlab/core/error.hpp"
 #include "colorlab/drivers/camera/aravis_camera.hpp"
 #include "colorlab/drivers/camera/camera_instrument.hpp"
+#include "colorlab/drivers/camera/gphoto2_camera.hpp"
+#include "colorlab/drivers/camera/sim_dslr_camera.hpp"
 #include "colorlab/drivers/enttec_dmx.hpp"
 #include "colorlab/drivers/hid_relay.hpp"
 #include "colorlab/drivers/hidapi_transport.hpp"
+#include "colorlab/drivers/socket_hid_transport.hpp"
 #include "colorlab/drivers/ls110.hpp"
 #include "colorlab/drivers/spectrolino.hpp"
 
@@ -109,9 +112,15 @@ std::shared_ptr<Instrument> make_hidrelay(boost::asio::any_io_executor executor,
   o.expected_board_id = j.value("board_id", std::string{});
   if (j.contains("switch_attempts")) o.switch_attempts = j["switch_attempts"].get<int>();
   o.reconnect = reconnect_policy(j);
-  // port "auto" takes the first dcttech board; otherwise a /dev/hidrawN path.
-  std::string path = c.port == "auto" ? std::string{} : c.port;
-  return std::make_shared<HidRelay>(executor, std::make_unique<HidapiTransport>(path), o);
+  // port "auto" takes the first dcttech board, "unix:/path" the simulated lab's board behind its
+  // socket; otherwise a /dev/hidrawN path.
+  std::unique_ptr<HidTransport> transport;
+  if (c.port.starts_with("unix:")) {
+    transport = std::make_unique<SocketHidTransport>(c.port.substr(5), ms(j, "reply_timeout_ms", std::chrono::milliseconds(1000)));
+  } else {
+    transport = std::make_unique<HidapiTransport>(c.port == "auto" ? std::string{} : c.port);
+  }
+  return std::make_shared<HidRelay>(executor, std::move(transport), o);
 }
 
 }  // namespace
@@ -128,7 +137,38 @@ std::shared_ptr<Instrument> make_genicam(const InstrumentConfig& c) {
   return std::make_shared<camera::CameraInstrument>(c.id, c.port, c.simulated, std::make_unique<camera::AravisCamera>(o));
 }
 
-std::vector<std::string> known_instrument_kinds() { return {"ls110", "spectrolino", "dmx", "hidrelay", "genicam"}; }
+namespace {
+
+// The tethered DSLR through libgphoto2: port "auto" (the first camera libgphoto2 detects),
+// "usb:BUS,DEV", or "disk:/dir" (the Directory Browse camlib, for tests without a camera).
+std::shared_ptr<Instrument> make_gphoto2(const InstrumentConfig& c) {
+  camera::Gphoto2Options o;
+  o.port = c.port == "auto" ? std::string{} : c.port;
+  const auto& j = c.options;
+  if (j.contains("model")) o.model = j["model"].get<std::string>();
+  if (j.contains("keep_dir")) o.keep_dir = j["keep_dir"].get<std::string>();
+  if (j.contains("delete_on_card")) o.delete_on_card = j["delete_on_card"].get<bool>();
+  if (j.contains("pair_wait_ms")) o.pair_wait_ms = j["pair_wait_ms"].get<int>();
+  o.call_timeout = ms(j, "call_timeout_ms", o.call_timeout);
+  return std::make_shared<camera::CameraInstrument>(c.id, c.port, c.simulated, std::make_unique<camera::Gphoto2Camera>(o));
+}
+
+// The simulated lab's DSLR: port is the socket path colorlab-sim announces.
+std::shared_ptr<Instrument> make_simdslr(const InstrumentConfig& c) {
+  camera::SimDslrOptions o;
+  o.socket_path = c.port;
+  const auto& j = c.options;
+  if (j.contains("keep_dir")) o.keep_dir = j["keep_dir"].get<std::string>();
+  o.request_timeout = ms(j, "request_timeout_ms", o.request_timeout);
+  o.capture_timeout = ms(j, "capture_timeout_ms", o.capture_timeout);
+  return std::make_shared<camera::CameraInstrument>(c.id, c.port, true, std::make_unique<camera::SimDslrCamera>(o));
+}
+
+}  // namespace
+
+std::vector<std::string> known_instrument_kinds() {
+  return {"ls110", "spectrolino", "dmx", "hidrelay", "genicam", "gphoto2", "simdslr"};
+}
 
 std::shared_ptr<Instrument> make_instrument(boost::asio::any_io_executor executor, const InstrumentConfig& config) {
   if (config.id.empty()) throw Error(ErrorClass::bad_parameter, "an instrument entry has no id");
@@ -139,6 +179,8 @@ std::shared_ptr<Instrument> make_instrument(boost::asio::any_io_executor executo
     if (config.kind == "dmx") return make_dmx(executor, config);
     if (config.kind == "hidrelay") return make_hidrelay(executor, config);
     if (config.kind == "genicam") return make_genicam(config);
+    if (config.kind == "gphoto2") return make_gphoto2(config);
+    if (config.kind == "simdslr") return make_simdslr(config);
   } catch (const nlohmann::json::exception& e) {
     throw Error(ErrorClass::bad_parameter, "instrument '" + config.id + "': bad option: " + e.what());
   }

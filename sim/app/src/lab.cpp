@@ -2,6 +2,8 @@
 
 #include <unistd.h>
 
+#include <cstdlib>
+
 #include "colorlab/core/error.hpp"
 #include <boost/asio/steady_timer.hpp>
 
@@ -11,13 +13,37 @@
 #include "colorlab/sim/camera/camera_model.hpp"
 #include "colorlab/sim/clock.hpp"
 #include "colorlab/sim/dmx_sim.hpp"
+#include "colorlab/sim/dslr/dslr_server.hpp"
 #include "colorlab/sim/ls110_sim.hpp"
+#include "colorlab/sim/relay_socket_server.hpp"
 #include "colorlab/sim/scene.hpp"
 #include "colorlab/sim/spectrolino_sim.hpp"
 
 namespace colorlab::sim {
 
 using nlohmann::json;
+
+namespace {
+
+// Where sockets go when the configuration names none: beside the default control socket.
+std::filesystem::path runtime_path(const std::string& name) {
+  const char* runtime = std::getenv("XDG_RUNTIME_DIR");
+  std::filesystem::path dir = runtime && *runtime ? runtime : std::filesystem::temp_directory_path();
+  return dir / ("colorlab-sim-" + std::to_string(::getpid()) + "-" + name);
+}
+
+// A fault command's relay keys over the board's current faults (unmentioned keys stay).
+RelayBoardFaults relay_faults(const json& f, RelayBoardFaults now) {
+  for (const auto& [key, value] : f.items()) {
+    if (key == "stuck_mask") now.stuck_mask = value.get<std::uint8_t>();
+    else if (key == "unplugged") now.unplugged = value.get<bool>();
+    else if (key == "replug_after_opens") now.replug_after_opens = value.get<int>();
+    else throw Error(ErrorClass::bad_parameter, "unknown relay fault '" + key + "'", "stuck_mask, unplugged, replug_after_opens");
+  }
+  return now;
+}
+
+}  // namespace
 
 struct Lab::Impl {
   boost::asio::io_context* io = nullptr;
@@ -29,6 +55,10 @@ struct Lab::Impl {
   std::shared_ptr<DmxSim> dmx;
   std::shared_ptr<const camera::CameraModel> camera_model;
   std::unique_ptr<aravis::GvFakeCamera> genicam;
+  std::unique_ptr<dslr::DslrServer> dslr;
+  std::filesystem::path dslr_temp_dir;  // created here, removed with the lab
+  std::shared_ptr<RelayBoard> relay_board;
+  std::unique_ptr<RelaySocketServer> relay;
   std::vector<std::shared_ptr<boost::asio::steady_timer>> dropouts;
   int aim_row = 0, aim_col = 0;
 
@@ -136,10 +166,66 @@ Lab::Lab(boost::asio::io_context& io, LabConfig config) : impl_(std::make_unique
       d.genicam.reset();
     }
   }
+
+  if (d.config.dslr.enabled) start_dslr();
+  if (d.config.relay.enabled) start_relay();
+}
+
+void Lab::start_dslr() {
+  auto& d = *impl_;
+  const auto& dc = d.config.dslr;
+  // The Lab owns the scene and outlives the camera, so the model gets a non-owning pointer.
+  std::shared_ptr<const Scene> scene(std::shared_ptr<const Scene>{}, d.scene.get());
+  camera::CameraConfig cc;
+  cc.width = dc.width;
+  cc.height = dc.height;
+  cc.seed = d.scene->stream_seed("dslr");  // another body than the GenICam camera: its own noise and defects
+  if (dc.pose == DslrLabConfig::Pose::seeded) cc.pose = camera::random_chart_pose(dc.pose_seed.value_or(d.scene->stream_seed("dslr-pose")));
+  if (dc.pose == DslrLabConfig::Pose::given) cc.pose = dc.given_pose;
+  dslr::DslrBodyConfig bc;
+  bc.serial = dc.serial;
+  bc.transfer_s = dc.transfer_s;
+  if (dc.capture_dir) {
+    bc.capture_dir = *dc.capture_dir;
+  } else {
+    d.dslr_temp_dir = std::filesystem::temp_directory_path() / ("colorlab-sim-" + std::to_string(::getpid()) + "-dslr");
+    bc.capture_dir = d.dslr_temp_dir;
+  }
+  auto body = std::make_shared<dslr::DslrBody>(std::make_shared<camera::CameraModel>(scene, cc), bc);
+  d.dslr = std::make_unique<dslr::DslrServer>(d.io->get_executor(), body, dc.socket.value_or(runtime_path("dslr.sock")), d.clock);
+  d.dslr->start();
+  if (!dc.faults.empty()) d.dslr->set_faults(dc.faults);
+}
+
+void Lab::start_relay() {
+  auto& d = *impl_;
+  const auto& rc = d.config.relay;
+  d.relay_board = std::make_shared<RelayBoard>(rc.relays, rc.board_id, "/dev/hidraw-sim0");
+  // The board starts with the relays of the lamps the scene starts with closed, so both agree.
+  std::uint8_t mask = 0;
+  for (const auto& [lamp, relay] : rc.lamps) {
+    if (d.scene->lamp_on(lamp_from_string(lamp))) mask |= static_cast<std::uint8_t>(1u << (relay - 1));
+  }
+  d.relay_board->set_mask(mask);
+  // The board's relays drive the cabinet's lamps, so the LS-110 and the cameras see what it switches.
+  auto on_switch = [impl = &d](int relay, bool on) {
+    for (const auto& [lamp, r] : impl->config.relay.lamps) {
+      if (r == relay) impl->scene->set_lamp(lamp_from_string(lamp), on);
+    }
+  };
+  d.relay = std::make_unique<RelaySocketServer>(d.io->get_executor(), d.relay_board, rc.socket.value_or(runtime_path("relay.sock")), on_switch);
+  d.relay->start();
+  if (!rc.faults.empty()) d.relay_board->set_faults(relay_faults(rc.faults, d.relay_board->faults()));
 }
 
 Lab::~Lab() {
   impl_->genicam.reset();
+  if (impl_->dslr) impl_->dslr->stop();
+  if (impl_->relay) impl_->relay->stop();
+  if (!impl_->dslr_temp_dir.empty()) {
+    std::error_code ec;
+    std::filesystem::remove_all(impl_->dslr_temp_dir, ec);
+  }
   if (impl_->ls110) impl_->ls110->stop();
   if (impl_->spectrolino) impl_->spectrolino->stop();
   if (impl_->dmx) impl_->dmx->stop();
@@ -191,6 +277,25 @@ json Lab::announcement() const {
                            {"serial", d.genicam->serial()},
                            {"simulated", true}});
   }
+  if (d.dslr) {
+    instruments.push_back({{"id", d.config.dslr.id},
+                           {"kind", "simdslr"},
+                           {"model", "Simulated Canon EOS 20D (tethered; DNG, JPEG, TIFF)"},
+                           {"port", d.dslr->socket_path().string()},
+                           {"serial", d.config.dslr.serial},
+                           {"capture_dir", d.dslr->body().config().capture_dir.string()},
+                           {"simulated", true}});
+  }
+  if (d.relay) {
+    json lamps = json::object();
+    for (const auto& [lamp, relay] : d.config.relay.lamps) lamps[lamp] = relay;
+    instruments.push_back({{"id", d.config.relay.id},
+                           {"kind", "hidrelay"},
+                           {"model", "dcttech USBRelay" + std::to_string(d.config.relay.relays) + " (HID feature reports over a socket)"},
+                           {"port", "unix:" + d.relay->socket_path().string()},
+                           {"simulated", true},
+                           {"driver_options", {{"lamps", lamps}, {"board_id", d.config.relay.board_id}}}});
+  }
   return {{"colorlab_sim", 1},
           {"pid", ::getpid()},
           {"seed", d.config.seed},
@@ -211,6 +316,14 @@ json Lab::control(const json& command) {
       json lamps = json::array();
       for (auto l : d.scene->lamps_on()) lamps.push_back(to_string(l));
       t["lamps_on"] = lamps;
+      json warmup = json::object();
+      for (auto l : d.scene->lamps_on()) warmup[std::string(to_string(l))] = d.scene->warmup_factor(l);
+      t["warmup"] = warmup;  // 1 = fully warm
+      if (d.dslr) t["dslr"] = d.dslr->truth();
+      if (d.relay) {
+        t["relay"] = {{"board_id", d.relay_board->board_id()}, {"mask", d.relay_board->mask()},
+                      {"requests", d.relay->requests()}, {"socket", d.relay->socket_path().string()}};
+      }
       if (d.ls110) {
         auto lt = d.ls110_truth();
         t["ls110"] = {{"luminance", lt.luminance}, {"noise_sigma", lt.noise_sigma},
@@ -253,6 +366,16 @@ json Lab::control(const json& command) {
         answer["faults"] = {{"capture_timeout", faults.value("capture_timeout", false)}};
         return answer;
       }
+      if (d.dslr && id == d.config.dslr.id) {
+        answer["faults"] = d.dslr->set_faults(faults);
+        return answer;
+      }
+      if (d.relay && id == d.config.relay.id) {
+        d.relay_board->set_faults(relay_faults(faults, d.relay_board->faults()));
+        const auto f = d.relay_board->faults();
+        answer["faults"] = {{"stuck_mask", f.stuck_mask}, {"unplugged", f.unplugged}, {"replug_after_opens", f.replug_after_opens}};
+        return answer;
+      }
       if (d.dmx && id == d.config.dmx.id) {
         auto f = d.dmx->faults();
         from_json(faults, f);
@@ -282,6 +405,16 @@ json Lab::control(const json& command) {
       }
       return {{"ok", true}, {"spectrolino", d.spectrolino_truth()}};
     }
+    if (cmd == "camera_truth") {
+      if (!d.dslr || command.value("instrument", d.config.dslr.id) != d.config.dslr.id) {
+        throw Error(ErrorClass::not_found, "no simulated DSLR '" + command.value("instrument", std::string()) + "'");
+      }
+      std::optional<std::string> file;
+      if (command.contains("file")) file = command["file"].get<std::string>();
+      json t = d.dslr->shot_truth(file);
+      t["ok"] = true;
+      return t;
+    }
     if (cmd == "aim") {
       int row = command.value("row", -1), col = command.value("col", -1);
       d.scene->floor_luminance(row, col);  // throws for spots off the grid
@@ -298,7 +431,7 @@ json Lab::control(const json& command) {
       return {{"ok", true}};
     }
     throw Error(ErrorClass::bad_parameter, "unknown control command '" + cmd + "'",
-                "commands: announce, truth, fault, place, aim, lamp, dimmer");
+                "commands: announce, truth, camera_truth, fault, place, aim, lamp, dimmer");
   } catch (const Error& e) {
     return {{"ok", false}, {"error", to_string(e.cls())}, {"message", e.info().message}, {"hint", e.hint()}};
   } catch (const json::exception& e) {

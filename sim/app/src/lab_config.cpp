@@ -18,6 +18,125 @@ namespace {
 }
 
 
+std::filesystem::path path_value(const std::filesystem::path& file, const toml::node& n, const std::string& key) {
+  auto v = n.value<std::string>();
+  if (!v || v->empty()) bad(file, n, key + " must be a path");
+  return std::filesystem::path(*v).is_absolute() ? std::filesystem::path(*v) : file.parent_path() / *v;
+}
+
+void load_dslr(const std::filesystem::path& file, const toml::table& t, DslrLabConfig& dc) {
+  for (const auto& [sk, sn] : t) {
+    std::string s(sk.str());
+    if (s == "enabled") {
+      dc.enabled = sn.value_or(true);
+    } else if (s == "id") {
+      dc.id = sn.value_or(std::string("dslr"));
+    } else if (s == "serial") {
+      auto v = sn.value<std::string>();
+      if (!v || v->empty() || v->size() > 31) bad(file, sn, "dslr.serial must be 1..31 characters");
+      dc.serial = *v;
+    } else if (s == "size") {
+      auto a = sn.as_array();
+      auto w = a && a->size() == 2 ? (*a)[0].value<int64_t>() : std::nullopt;
+      auto h = a && a->size() == 2 ? (*a)[1].value<int64_t>() : std::nullopt;
+      if (!w || !h || *w < 64 || *h < 64 || *w % 2 || *h % 2 || *w > 8192 || *h > 8192) {
+        bad(file, sn, "dslr.size must be [width, height], even, 64..8192");
+      }
+      dc.width = static_cast<int>(*w);
+      dc.height = static_cast<int>(*h);
+    } else if (s == "pose") {
+      if (auto name = sn.value<std::string>()) {
+        if (*name == "seeded") dc.pose = DslrLabConfig::Pose::seeded;
+        else if (*name == "square") dc.pose = DslrLabConfig::Pose::square;
+        else bad(file, sn, "dslr.pose must be \"seeded\", \"square\" or a table of ChartPose fields");
+      } else if (auto pt = sn.as_table()) {
+        dc.pose = DslrLabConfig::Pose::given;
+        auto& p = dc.given_pose;
+        for (const auto& [pk, pn] : *pt) {
+          std::string f(pk.str());
+          auto v = pn.value<double>();
+          if (!v) bad(file, pn, "dslr.pose." + f + " must be a number");
+          if (f == "rotation_deg") p.rotation_deg = *v;
+          else if (f == "tilt_deg") p.tilt_deg = *v;
+          else if (f == "swing_deg") p.swing_deg = *v;
+          else if (f == "distance_mm") p.distance_mm = *v;
+          else if (f == "shift_x") p.shift_x = *v;
+          else if (f == "shift_y") p.shift_y = *v;
+          else if (f == "k1") p.k1 = *v;
+          else if (f == "k2") p.k2 = *v;
+          else bad(file, pn, "unknown key dslr.pose." + f + " (rotation_deg, tilt_deg, swing_deg, distance_mm, shift_x, shift_y, k1, k2)");
+        }
+      } else {
+        bad(file, sn, "dslr.pose must be \"seeded\", \"square\" or a table of ChartPose fields");
+      }
+    } else if (s == "pose_seed") {
+      auto v = sn.value<int64_t>();
+      if (!v || *v < 0) bad(file, sn, "dslr.pose_seed must be a non-negative integer");
+      dc.pose_seed = static_cast<std::uint64_t>(*v);
+    } else if (s == "socket") {
+      dc.socket = path_value(file, sn, "dslr.socket");
+    } else if (s == "capture_dir") {
+      dc.capture_dir = path_value(file, sn, "dslr.capture_dir");
+    } else if (s == "transfer_s") {
+      auto v = sn.value<double>();
+      if (!v || *v < 0) bad(file, sn, "dslr.transfer_s must be a non-negative number of seconds");
+      dc.transfer_s = *v;
+    } else if (s == "faults") {
+      dc.faults = toml_to_json(sn);
+    } else {
+      bad(file, sn, "unknown key dslr." + s);
+    }
+  }
+}
+
+void load_relay(const std::filesystem::path& file, const toml::table& t, RelayLabConfig& rc) {
+  for (const auto& [sk, sn] : t) {
+    std::string s(sk.str());
+    if (s == "enabled") {
+      rc.enabled = sn.value_or(false);
+    } else if (s == "id") {
+      rc.id = sn.value_or(std::string("relay"));
+    } else if (s == "board_id") {
+      auto v = sn.value<std::string>();
+      if (!v || v->size() != 5) bad(file, sn, "relay.board_id must be 5 characters");
+      rc.board_id = *v;
+    } else if (s == "relays") {
+      auto v = sn.value<int64_t>();
+      if (!v || *v < 1 || *v > 8) bad(file, sn, "relay.relays must be 1..8 (USBRelay1..USBRelay8)");
+      rc.relays = static_cast<int>(*v);
+    } else if (s == "lamps") {
+      auto lt = sn.as_table();
+      if (!lt) bad(file, sn, "relay.lamps must be a table like { D65 = 1, TL84 = 2 }");
+      rc.lamps.clear();
+      for (const auto& [lamp, relay] : *lt) {
+        auto v = relay.value<int64_t>();
+        if (!v || *v < 1 || *v > 8) bad(file, relay, "relay.lamps." + std::string(lamp.str()) + " must be a relay 1..8");
+        try {
+          (void)lamp_from_string(std::string(lamp.str()));
+        } catch (const Error& e) {
+          bad(file, relay, e.info().message);
+        }
+        for (const auto& [other, r] : rc.lamps) {
+          if (r == *v) bad(file, relay, "relay " + std::to_string(*v) + " switches both " + other + " and " + std::string(lamp.str()));
+        }
+        rc.lamps.emplace_back(std::string(lamp.str()), static_cast<int>(*v));
+      }
+    } else if (s == "socket") {
+      rc.socket = path_value(file, sn, "relay.socket");
+    } else if (s == "faults") {
+      rc.faults = toml_to_json(sn);
+    } else {
+      bad(file, sn, "unknown key relay." + s);
+    }
+  }
+  for (const auto& [lamp, relay] : rc.lamps) {
+    if (relay > rc.relays) {
+      throw Error(ErrorClass::bad_parameter, file.string() + ": relay.lamps." + lamp + " is relay " + std::to_string(relay) +
+                                                 " but the board has " + std::to_string(rc.relays), "see docs/simulator.md");
+    }
+  }
+}
+
 }  // namespace
 
 LabConfig load_lab_config(const std::filesystem::path& file) {
@@ -204,6 +323,14 @@ LabConfig load_lab_config(const std::filesystem::path& file) {
           bad(file, sn, "unknown key genicam." + s);
         }
       }
+    } else if (k == "dslr") {
+      auto t = node.as_table();
+      if (!t) bad(file, node, "[dslr] must be a table");
+      load_dslr(file, *t, c.dslr);
+    } else if (k == "relay") {
+      auto t = node.as_table();
+      if (!t) bad(file, node, "[relay] must be a table");
+      load_relay(file, *t, c.relay);
     } else {
       bad(file, node, "unknown key '" + k + "'");
     }

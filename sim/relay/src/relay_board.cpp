@@ -103,6 +103,10 @@ void RelayBoard::set_faults(const RelayBoardFaults& f) {
   shared_->faults = f;
   shared_->open_attempts_while_unplugged = 0;
 }
+void RelayBoard::set_mask(std::uint8_t mask) {
+  std::lock_guard lock(shared_->mutex);
+  shared_->mask = static_cast<std::uint8_t>(mask & ((1u << shared_->relays) - 1));
+}
 RelayBoardFaults RelayBoard::faults() const {
   std::lock_guard lock(shared_->mutex);
   return shared_->faults;

@@ -28,6 +28,9 @@ class Lab {
   const LabConfig& config() const;
 
  private:
+  void start_dslr();
+  void start_relay();
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

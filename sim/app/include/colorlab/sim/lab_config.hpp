@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "colorlab/sim/camera/camera_model.hpp"
 #include "colorlab/sim/dmx_sim.hpp"
 #include "colorlab/sim/spectrolino_model.hpp"
 
@@ -48,6 +49,36 @@ struct GenicamLabConfig {
   int height = 2336;
 };
 
+// The tethered DSLR: an EOS 20D-like body rendered by the scene's camera model, writing DNG (and JPEG /
+// TIFF) files and serving the tethered-camera protocol on a Unix socket.
+struct DslrLabConfig {
+  bool enabled = true;
+  std::string id = "dslr";
+  std::string serial = "SIM20D0001";
+  int width = 3504;
+  int height = 2336;
+  // The chart's pose in front of the camera: seeded (random_chart_pose of pose_seed), square, or given.
+  enum class Pose { seeded, square, given } pose = Pose::seeded;
+  std::optional<std::uint64_t> pose_seed;  // default: derived from the lab seed
+  camera::ChartPose given_pose;
+  std::optional<std::filesystem::path> socket;       // default: beside the control socket
+  std::optional<std::filesystem::path> capture_dir;  // default: a fresh directory, removed at exit
+  double transfer_s = 1.2;                           // card write + USB transfer of the raw (simulated s)
+  nlohmann::json faults = nlohmann::json::object();
+};
+
+// The dcttech USB relay board switching the lamps, on a Unix socket carrying HID feature reports.
+// Off by default: the default lab switches its lamps through the DMX widget.
+struct RelayLabConfig {
+  bool enabled = false;
+  std::string id = "relay";
+  std::string board_id = "CLRLB";  // 5 characters
+  int relays = 8;                  // USBRelay1..8
+  std::vector<std::pair<std::string, int>> lamps{{"D65", 1}, {"TL84", 2}, {"CWF", 3}, {"A", 4}, {"UV", 5}};
+  std::optional<std::filesystem::path> socket;  // default: beside the control socket
+  nlohmann::json faults = nlohmann::json::object();
+};
+
 struct LabConfig {
   std::uint64_t seed = 1;
   double time_scale = 1.0;
@@ -59,6 +90,8 @@ struct LabConfig {
   SpectrolinoLabConfig spectrolino;
   DmxLabConfig dmx;
   GenicamLabConfig genicam;
+  DslrLabConfig dslr;
+  RelayLabConfig relay;
 };
 
 // Throws Error{bad_parameter} naming file, line and key.

@@ -27,6 +27,8 @@ class RelayBoard {
   std::unique_ptr<drivers::HidTransport> make_transport();
 
   void set_faults(const RelayBoardFaults& f);
+  // The relays' state before any host talks to the board (lamps switched on by hand at start).
+  void set_mask(std::uint8_t mask);
   RelayBoardFaults faults() const;
   std::uint8_t mask() const;
   std::string board_id() const;

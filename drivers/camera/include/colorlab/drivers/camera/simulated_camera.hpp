@@ -1,7 +1,8 @@
 #pragma once
-// The simulated DSLR: renders each frame with the scene's CameraModel, writes it as a real DNG
-// into a capture directory and hands the file's bytes to the same LibRaw decode stage a real
-// DSLR's CR2 goes through, so everything downstream of the camera runs its production path.
+// An in-process simulated DSLR for driver tests and benches: renders each frame with a CameraModel
+// the caller owns, writes it as a real DNG into a capture directory and hands the file's bytes to
+// the same LibRaw decode stage a real DSLR's CR2 goes through. The simulated lab's DSLR, which the
+// daemon uses, lives in colorlab-sim (sim/dslr) and is reached through SimDslrCamera.
 //
 // Image format RAW + JPEG adds the camera's own processed JPEG with the same basename, as the
 // EOS 20D pairs IMG_nnnn.CR2 and IMG_nnnn.JPG (an 8-bit TIFF when built without libjpeg).
