@@ -118,8 +118,8 @@ json SimDslrCamera::request(json req, std::chrono::milliseconds timeout) {
                             .hint = "driver and simulator disagree about the tethered-camera protocol; reconnect",
                             .retryable = true});
     }
-    // An answer without our id: a refusal of the whole connection (id null), or the late answer to
-    // an earlier request that already timed out, which is dropped.
+    // An answer with another id is the late answer to an earlier request that already timed out:
+    // dropped. One with a null id refuses a request the camera could not read.
     if (answer.contains("id") && answer["id"].is_number_unsigned() && answer["id"].get<std::uint64_t>() != id) {
       note("< (stale, dropped) " + clip(text));
       continue;

@@ -158,6 +158,27 @@ asio::awaitable<void> serve(std::shared_ptr<DslrServer::Impl> d, std::shared_ptr
   if (d->client == socket) d->client.reset();
 }
 
+// Answers the first request of a connection the camera cannot serve with in_use, then closes it.
+// Waiting for that request (rather than refusing at once) means the client always finds the
+// refusal as the answer to what it sent, never a connection reset under its first write.
+asio::awaitable<void> turn_away(std::shared_ptr<local::socket> socket) {
+  asio::steady_timer give_up(socket->get_executor(), std::chrono::seconds(5));
+  give_up.async_wait([socket](boost::system::error_code ec) {
+    if (!ec) socket->close(ec);
+  });
+  asio::streambuf buf(kMaxRequestBytes);
+  boost::system::error_code ec;
+  const std::size_t n = co_await asio::async_read_until(*socket, buf, '\n', asio::redirect_error(asio::use_awaitable, ec));
+  give_up.cancel();
+  if (ec) co_return;
+  const std::string line(asio::buffers_begin(buf.data()), asio::buffers_begin(buf.data()) + static_cast<long>(n));
+  const json req = json::parse(line, nullptr, false);
+  const json id = req.is_object() && req.contains("id") ? req["id"] : json(nullptr);
+  const std::string out = refusal(id, "in_use", "another client holds the camera").dump() + "\n";
+  co_await asio::async_write(*socket, asio::buffer(out), asio::redirect_error(asio::use_awaitable, ec));
+  socket->close(ec);
+}
+
 asio::awaitable<void> accept_loop(std::shared_ptr<DslrServer::Impl> d, std::shared_ptr<local::acceptor> acceptor) {
   for (;;) {
     boost::system::error_code ec;
@@ -166,9 +187,7 @@ asio::awaitable<void> accept_loop(std::shared_ptr<DslrServer::Impl> d, std::shar
     if (d->client) {
       // One USB connection per camera: a second program is turned away, the first keeps it.
       ++d->refused_connections;
-      std::string out = refusal(nullptr, "in_use", "another client holds the camera").dump() + "\n";
-      co_await asio::async_write(*socket, asio::buffer(out), asio::redirect_error(asio::use_awaitable, ec));
-      socket->close(ec);
+      asio::co_spawn(d->executor, turn_away(socket), asio::detached);
       continue;
     }
     ++d->connections;
