@@ -190,8 +190,31 @@ asio::awaitable<RunOutcome> run_campaign_script(ScriptRunSetup setup, Lab& lab, 
             stop_for(control);
             break;
           }
-          flush();  // the step before this call is whole: commit it before anything moves
           try {
+            // The step before this call is whole: commit it before anything moves. A disk that
+            // refuses it suspends the execution until there is room; nothing is lost meanwhile.
+            bool storage_suspended = false;
+            for (;;) {
+              std::optional<Error> refused;
+              try {
+                flush();
+              } catch (const Error& e) {
+                if (e.cls() != ErrorClass::io_error) throw;
+                refused = e;
+              }
+              if (!refused) break;
+              if (!storage_suspended) {
+                storage_suspended = true;
+                log::warning(script.name, std::string("suspended: storage: ") + refused->what());
+                try {
+                  sink.suspended(std::string("storage: ") + refused->what(), *refused);
+                } catch (const Error&) {
+                  // The same full disk refuses the status: the log line above is all there is.
+                }
+              }
+              co_await lab.wait_retry(control);
+            }
+            if (storage_suspended) sink.resumed(json{{"condition", "storage"}});
             if (restore_pending) {
               restore_pending = false;
               sink.status_text("restoring the lab after a resume (step " + engine.label_ + ")");
@@ -211,7 +234,25 @@ asio::awaitable<RunOutcome> run_campaign_script(ScriptRunSetup setup, Lab& lab, 
             }
             if (kind != CallKind::control) {
               sink.status_text(engine.label_.empty() ? call : engine.label_ + ": " + call);
-              result = co_await lab.perform(call, args, control);
+              // Suspend, not fail: a condition that waiting mends stops the execution until it has
+              // cleared, then the same call is made again (the interrupted step measured anew).
+              for (;;) {
+                std::optional<Error> failure;
+                try {
+                  result = co_await lab.perform(call, args, control);
+                } catch (const Error& e) {
+                  failure = e;
+                }
+                if (!failure) break;
+                auto cause = Lab::suspend_cause(*failure);
+                if (!cause || control.requested() || !setup.suspend_on_conditions) throw *failure;
+                std::string reason = *cause + ": " + failure->what();
+                log::warning(script.name, "suspended at " + call + ": " + reason);
+                sink.suspended(reason, *failure);
+                json how = co_await lab.await_recovery(call, *failure, control);
+                log::info(script.name, "condition cleared (" + how.dump() + "); measuring the interrupted step again");
+                sink.resumed(how);
+              }
               state.apply(call, args, result);
               engine.pending_.journal.push_back(JournalEntry{static_cast<std::int64_t>(replay_index), call, args, result});
               ++replay_index;

@@ -252,10 +252,13 @@ asio::awaitable<json> Lab::wait_stable(const StabilityCriterion& c, const Execut
       }
     }
     if (t >= c.timeout_s) {
-      throw Error(ErrorClass::needs_operator,
-                  "the light did not settle within " + std::to_string(static_cast<int>(c.timeout_s)) + " s (drift " +
-                      std::to_string(drift_pct) + " % over " + std::to_string(static_cast<int>(c.window_s)) + " s)",
-                  "check the lamp; a failing tube flickers and drifts");
+      ErrorInfo info;
+      info.cls = ErrorClass::needs_operator;
+      info.message = "the light did not settle within " + std::to_string(static_cast<int>(c.timeout_s)) + " s (drift " +
+                     std::to_string(drift_pct) + " % over " + std::to_string(static_cast<int>(c.window_s)) + " s)";
+      info.hint = "check the lamp; a failing tube flickers and drifts";
+      info.device_code = "lamp:unstable";
+      throw Error(std::move(info));
     }
     co_await sleep_lab_seconds(c.interval_s, control);
   }
@@ -265,6 +268,7 @@ asio::awaitable<void> Lab::switch_lamps(std::vector<std::string> on) {
   auto lamps = co_await acquire<drivers::LampController>("lamps");
   auto before = lamps->lamps_on();
   co_await lamps->set_lamps(on);
+  if (before != on) stable_light_.reset();
   for (const auto& l : on) {
     if (std::find(before.begin(), before.end(), l) == before.end()) known_warm_.erase(l);
   }
@@ -277,11 +281,13 @@ asio::awaitable<json> Lab::perform(const std::string& call, const json& args, co
   if (call == "meter.measure") {
     auto meter = co_await acquire<drivers::LuminanceMeter>("luminance_meter");
     auto r = co_await meter->measure_luminance();
+    check_dropout(r.luminance, r.unit);
     co_return json{{"luminance", r.luminance}, {"unit", r.unit}, {"instrument", meter->id()}, {"raw", r.raw_reply}};
   }
   if (call == "wait_stable") {
     auto c = StabilityCriterion::from_json(args.empty() ? json::object() : args[0], options_.warmup);
     json r = co_await wait_stable(c, control);
+    note_stable(r["luminance"].get<double>());
     if (auto lamps = find_role<drivers::LampController>("lamps")) {
       for (const auto& l : lamps->lamps_on()) known_warm_.insert(l);
     }
@@ -318,6 +324,7 @@ asio::awaitable<json> Lab::perform(const std::string& call, const json& args, co
     auto dimmer = co_await acquire<drivers::Dimmer>("dimmer");
     const std::string channel = "dimmer";
     co_await dimmer->set_level(channel, args[0].get<double>() / 100.0);
+    dimmer_percent_ = args[0].get<double>();
     // The driver ramps at its configured rate and settles; a script may ask for more settling.
     if (args.size() > 1 && args[1].is_object() && args[1].contains("settle_s")) {
       double settle = args[1]["settle_s"].is_number() ? args[1]["settle_s"].get<double>() : -1;
@@ -341,6 +348,24 @@ asio::awaitable<json> Lab::perform(const std::string& call, const json& args, co
     } else if (call == "table.measure_at") {
       auto r = co_await table->move_and_measure(args[0].get<double>(), args[1].get<double>());
       co_return spectrum_json(r, table->id());
+    } else if (call == "table.read_patch") {
+      drivers::ChartPatchVisit visit;
+      visit.x_mm = args[0].get<double>();
+      visit.y_mm = args[1].get<double>();
+      const json options = args.size() > 2 && args[2].is_object() ? args[2] : json::object();
+      visit.row_start = options.value("row_start", false);
+      visit.row_length = options.value("row_length", 1);
+      visit.index = options.value("index", 0);
+      if (visit.row_length < 1 || visit.row_length > 1000) {
+        throw Error(ErrorClass::script_error, "lab.table.read_patch: row_length must be from 1 to 1000");
+      }
+      auto r = co_await table->read_chart_patch(visit);
+      json j = spectrum_json(r, table->id());
+      // How long the white calibration lasts from here: shows where the table recalibrated.
+      for (const auto& c : table->calibration()) {
+        if (c.valid && c.readings_left) j["calibration_readings_left"] = *c.readings_left;
+      }
+      co_return j;
     }
     co_return json(nullptr);
   }
@@ -378,6 +403,10 @@ asio::awaitable<json> Lab::perform(const std::string& call, const json& args, co
     auto error = co_await cam::async_configure(camera->camera(), s, asio::use_awaitable);
     if (error) throw *error;
     co_return json(nullptr);
+  }
+  if (call == "operator.request") {
+    json answer = co_await operator_request(args[0], control);
+    co_return answer;
   }
   if (call == "wait") {
     co_await sleep_lab_seconds(args[0].get<double>(), control);
@@ -423,6 +452,7 @@ asio::awaitable<json> Lab::restore(const LabState& desired, const ExecutionContr
     auto dimmer = co_await acquire<drivers::Dimmer>("dimmer");
     const std::string channel = "dimmer";
     co_await dimmer->set_level(channel, *desired.dimmer_percent / 100.0);
+    dimmer_percent_ = *desired.dimmer_percent;
     done.push_back(json{{"dimmer_percent", *desired.dimmer_percent}});
   }
   if (desired.any_lamp_on()) {
@@ -432,6 +462,7 @@ asio::awaitable<json> Lab::restore(const LabState& desired, const ExecutionContr
     if (!warm) {
       if (find_role<drivers::LuminanceMeter>("luminance_meter")) {
         json r = co_await wait_stable(options_.warmup, control);
+        note_stable(r["luminance"].get<double>());
         done.push_back(json{{"lamps_stable", r}});
       } else {
         co_await sleep_lab_seconds(options_.lamp_warmup_s, control);
@@ -447,6 +478,13 @@ asio::awaitable<json> Lab::restore(const LabState& desired, const ExecutionContr
     }
     if (desired.head_down) co_await table->head_down();
     if (desired.paper_held) co_await table->hold_paper(*desired.paper_held);
+  }
+  if (hands_) {
+    // What the simulated lab's "hands" did (the meter's aim) died with the old simulator.
+    for (const auto& [action, details] : desired.done_by_hands) {
+      auto redone = co_await hands_->perform(action, details);
+      if (redone) done.push_back(json{{"operator_action", action}, {"details", details}});
+    }
   }
   if (!desired.camera_settings.is_null()) {
     const std::string configure = "camera.configure";

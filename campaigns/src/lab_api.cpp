@@ -9,6 +9,7 @@
 
 #include "colorlab/analysis/statistics.hpp"
 #include "colorlab/analysis/uniformity.hpp"
+#include "colorlab/campaigns/chart_plan.hpp"
 #include "colorlab/campaigns/lua_value.hpp"
 #include "colorlab/core/error.hpp"
 
@@ -36,6 +37,8 @@ const std::map<std::string, CallSpec>& call_specs() {
       {"table.head_down", {CallKind::effect, {}}},
       {"table.hold_paper", {CallKind::effect, {"boolean"}}},
       {"table.measure_at", {CallKind::reading, {"number", "number"}}},
+      {"table.read_patch", {CallKind::reading, {"number", "number", "table?"}}},
+      {"operator.request", {CallKind::reading, {"table"}}},
       {"spectro.mode", {CallKind::effect, {"string"}}},
       {"spectro.calibrate", {CallKind::effect, {}}},
       {"spectro.measure", {CallKind::reading, {}}},
@@ -267,6 +270,51 @@ int analysis_dimmer(lua_State* L) {
   return 1;
 }
 
+// lab.analysis.compare_lamps({names...}, {left_half_grid...}, {window_rows=, window_cols=}) → per lamp {name, min, max, range, best, worst_window}.
+int analysis_compare_lamps(lua_State* L) {
+  guarded(L, [&] {
+    json names = to_json(L, 1, "lab.analysis.compare_lamps's names");
+    json grids = to_json(L, 2, "lab.analysis.compare_lamps's grids");
+    json options = lua_gettop(L) >= 3 ? to_json(L, 3, "lab.analysis.compare_lamps's options") : json::object();
+    analysis::UniformityOptions o;
+    if (options.is_object()) {
+      o.window_rows = options.value("window_rows", o.window_rows);
+      o.window_cols = options.value("window_cols", o.window_cols);
+    }
+    if (!names.is_array() || !grids.is_array() || names.size() != grids.size() || names.empty()) {
+      throw Error(ErrorClass::script_error, "lab.analysis.compare_lamps takes a list of lamp names and a list of as many grids");
+    }
+    std::vector<std::string> n;
+    std::vector<analysis::UniformityResult> results;
+    for (std::size_t i = 0; i < names.size(); ++i) {
+      if (!names[i].is_string()) throw Error(ErrorClass::script_error, "lab.analysis.compare_lamps: names must be strings");
+      n.push_back(names[i].get<std::string>());
+      results.push_back(analysis::analyse_uniformity(matrix_from(grids[i], "lab.analysis.compare_lamps's grid"), o));
+    }
+    json out = json::array();
+    for (const auto& l : analysis::compare_lamps(n, results)) {
+      out.push_back({{"name", l.name}, {"min", l.min}, {"max", l.max}, {"range", l.range},
+                     {"best", {{"row", l.best.row}, {"col", l.best.col}, {"stdev", l.best.stdev}}},
+                     {"worst_window", l.worst_window}});
+    }
+    lua_settop(L, 0);
+    push_json(L, out);
+  });
+  return 1;
+}
+
+// lab.chart.plan{chart=, first_x_mm=, first_y_mm=, pitch_mm=} → the chart's patches on the table in visiting order.
+int chart_plan_fn(lua_State* L) {
+  guarded(L, [&] {
+    json options = lua_gettop(L) >= 1 && !lua_isnil(L, 1) ? to_json(L, 1, "lab.chart.plan's options") : json::object();
+    if (options.is_array() && options.empty()) options = json::object();
+    json plan = chart_plan(options);
+    lua_settop(L, 0);
+    push_json(L, plan);
+  });
+  return 1;
+}
+
 void set_function(lua_State* L, const char* field, lua_CFunction f, LabCallSink* sink, const char* call = nullptr) {
   lua_pushlightuserdata(L, sink);
   if (call) {
@@ -312,7 +360,13 @@ void install_lab_api(lua_State* L, LabCallSink* sink) {
   lua_setfield(L, -2, "uniformity");
   lua_pushcfunction(L, analysis_dimmer);
   lua_setfield(L, -2, "dimmer_proportionality");
+  lua_pushcfunction(L, analysis_compare_lamps);
+  lua_setfield(L, -2, "compare_lamps");
   lua_setfield(L, -2, "analysis");
+  lua_newtable(L);
+  lua_pushcfunction(L, chart_plan_fn);
+  lua_setfield(L, -2, "plan");
+  lua_setfield(L, -2, "chart");
   lua_setglobal(L, "lab");
 }
 

@@ -4,7 +4,7 @@ namespace colorlab::campaigns {
 
 using nlohmann::json;
 
-void LabState::apply(const std::string& call, const json& args, const json& /*result*/) {
+void LabState::apply(const std::string& call, const json& args, const json& result) {
   if (call == "lamps.select") {
     lamps_on = std::vector<std::string>{args[0].get<std::string>()};
   } else if (call == "lamps.set") {
@@ -31,7 +31,11 @@ void LabState::apply(const std::string& call, const json& args, const json& /*re
   } else if (call == "table.hold_paper") {
     table_used = true;
     paper_held = args[0].get<bool>();
-  } else if (call == "table.measure_at") {
+  } else if (call == "operator.request") {
+    if (result.is_object() && result.value("by", std::string()) == "simulator") {
+      done_by_hands[result.value("action", std::string())] = result.value("details", json::object());
+    }
+  } else if (call == "table.measure_at" || call == "table.read_patch") {
     // Move, lower, measure, raise: the head ends up over the patch.
     table_used = true;
     table_xy = std::make_pair(args[0].get<double>(), args[1].get<double>());

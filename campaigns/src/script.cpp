@@ -184,6 +184,8 @@ CampaignScript parse_campaign_script(const std::string& name, const std::string&
     bad_declaration(name, "declares name '" + decl["name"].dump() + "' but its file is " + name + ".lua");
   }
   s.description = decl.value("description", std::string());
+  // Lua cannot tell an empty list from an empty table: `needs = {}` arrives as {}.
+  if (decl.contains("needs") && decl["needs"].is_object() && decl["needs"].empty()) decl["needs"] = json::array();
   if (decl.contains("needs")) {
     if (!decl["needs"].is_array()) bad_declaration(name, "`needs` must be a list of roles");
     for (const auto& role : decl["needs"]) {
@@ -194,6 +196,9 @@ CampaignScript parse_campaign_script(const std::string& name, const std::string&
       }
       s.needs.push_back(r);
     }
+  }
+  if (decl.contains("parameters") && decl["parameters"].is_array() && decl["parameters"].empty()) {
+    decl["parameters"] = json::object();
   }
   if (decl.contains("parameters")) {
     if (!decl["parameters"].is_object()) bad_declaration(name, "`parameters` must be a table of name = {type = ...}");

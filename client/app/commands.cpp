@@ -1,6 +1,7 @@
 #include "commands.hpp"
 
 #include <chrono>
+#include <set>
 #include <iostream>
 #include <thread>
 
@@ -72,8 +73,17 @@ int run_campaign(const GlobalOptions& g, const RunOptions& o) {
     return 0;
   }
   std::string last_line;
-  for (;;) {
+  std::set<std::string> requests_shown;
+  for (int poll = 0;; ++poll) {
     execution = api.get("/v1/executions/" + id);
+    // An unattended campaign may still ask a person something: show it where the operator looks.
+    if (!o.id_only && poll % 10 == 0) {
+      for (const auto& r : api.get("/v1/requests").value("items", json::array())) {
+        if (r.value("execution_id", std::string()) == id && requests_shown.insert(r.value("id", std::string())).second) {
+          std::cerr << format_request(r);
+        }
+      }
+    }
     auto status = protocol::execution_status_from_string(execution.value("status", std::string()));
     if (!o.id_only && !g.json) {
       std::string line = format_execution(execution);
@@ -152,6 +162,21 @@ void add_daemon_commands(CLI::App& app, GlobalOptions& global) {
       print(global, e, format_execution);
     });
   }
+
+  auto* requests = app.add_subcommand("requests", "List the operator requests campaigns are waiting for");
+  requests->callback([&global] { print(global, make_client(global).get("/v1/requests"), format_requests); });
+
+  auto request_id = std::make_shared<std::string>();
+  auto answer = std::make_shared<std::string>();
+  auto by = std::make_shared<std::string>("operator");
+  auto* answer_cmd = app.add_subcommand("answer", "Answer an operator request (see `colorlab requests`)");
+  answer_cmd->add_option("request", *request_id, "request id")->required();
+  answer_cmd->add_option("option", *answer, "one of the request's options, e.g. done")->required();
+  answer_cmd->add_option("--by", *by, "who answers (recorded with the run's events)");
+  answer_cmd->callback([&global, request_id, answer, by] {
+    json r = make_client(global).post("/v1/requests/" + *request_id, {{"answer", *answer}, {"by", *by}});
+    print(global, r, format_request);
+  });
 
   auto run_id = std::make_shared<std::string>();
   auto* show = app.add_subcommand("show", "Show one run with its measurements");

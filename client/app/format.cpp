@@ -117,4 +117,25 @@ std::string format_execution(const json& e) {
   return o.str();
 }
 
+std::string format_request(const json& r) {
+  std::ostringstream o;
+  o << "operator request " << str(r, "id") << " (" << str(r, "action") << "): " << str(r, "prompt") << "\n";
+  if (r.contains("answer")) {
+    o << "  answered " << str(r, "answer") << " by " << str(r, "answered_by") << "\n";
+    return o.str();
+  }
+  std::string options;
+  for (const auto& opt : r.value("options", json::array())) options += (options.empty() ? "" : " | ") + opt.get<std::string>();
+  o << "  answer: colorlab answer " << str(r, "id") << " <" << options << ">   default " << str(r, "default")
+    << " at " << str(r, "deadline") << "\n";
+  return o.str();
+}
+
+std::string format_requests(const json& list) {
+  if (!list.contains("items") || list["items"].empty()) return "no operator requests waiting\n";
+  std::string out;
+  for (const auto& r : list["items"]) out += format_request(r);
+  return out;
+}
+
 }  // namespace colorlab::cli

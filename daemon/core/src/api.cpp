@@ -52,7 +52,7 @@ unsigned page_limit(const HttpRequest& req) {
 HttpResponse get_root(ApiContext& ctx) {
   json features = json::array({"instruments", "ports", "events", "campaigns", "lua-campaigns", "executions",
                                "execution-control", "resume-after-restart", "runs", "run-script", "problem+json",
-                               "cursor-paging", "idempotency-key"});
+                               "cursor-paging", "idempotency-key", "operator-requests"});
   return HttpResponse::json(200, {{"server", "colorlabd"},
                                   {"server_version", COLORLAB_VERSION},
                                   {"api_version", protocol::kApiVersion},
@@ -206,6 +206,7 @@ HttpResponse handle_api(ApiContext& ctx, const HttpRequest& req) {
   const std::string& p = req.path;
   const std::string prefix(protocol::kPrefix);
   try {
+    if (auto r = handle_operator_api(ctx, req)) return *r;
     if (p == prefix || p == prefix + "/") {
       if (req.method != "GET") return method_not_allowed(req, "GET");
       return get_root(ctx);

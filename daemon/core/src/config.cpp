@@ -126,6 +126,12 @@ DaemonConfig load_config(const std::filesystem::path& file) {
           number(c.campaigns.stable_interval_s, 0.01, 3600);
         } else if (ck == "stable_timeout_s") {
           number(c.campaigns.stable_timeout_s, 0, 7 * 86400);
+        } else if (ck == "suspend_retry_s") {
+          number(c.campaigns.suspend_retry_s, 0, 86400);
+        } else if (ck == "suspend_settle_s") {
+          number(c.campaigns.suspend_settle_s, 0, 86400);
+        } else if (ck == "suspend_max_s") {
+          number(c.campaigns.suspend_max_s, 0, 30 * 86400);
         } else if (ck == "time_scale") {
           number(c.campaigns.time_scale, 1e-3, 1e6);
         } else {

@@ -19,6 +19,7 @@
 #include "colorlab/daemon/api.hpp"
 #include "colorlab/daemon/embedded_sim.hpp"
 #include "colorlab/daemon/executions.hpp"
+#include "colorlab/daemon/simulator_hands.hpp"
 #include "colorlab/daemon/systemd_notify.hpp"
 #include "colorlab/drivers/discovery_monitor.hpp"
 #include "colorlab/http/server.hpp"
@@ -35,6 +36,8 @@ struct Daemon::Impl {
   campaigns::InstrumentSet instruments;
   std::unique_ptr<campaigns::ScriptCatalogue> catalogue;
   std::unique_ptr<campaigns::Lab> lab;
+  campaigns::OperatorDesk desk;
+  std::unique_ptr<SimulatorHands> hands;
   std::unique_ptr<Executions> executions;
   std::unique_ptr<ApiContext> api;
   std::unique_ptr<http::Server> server;
@@ -128,12 +131,28 @@ Daemon::Daemon(DaemonConfig config) : impl_(std::make_unique<Impl>()) {
   lab_options.warmup = {cc.stable_tolerance_pct, cc.stable_window_s, cc.stable_interval_s, cc.stable_timeout_s};
   lab_options.lamp_warmup_s = cc.lamp_warmup_s;
   lab_options.lamps_off_at_shutdown = cc.lamps_off_at_shutdown;
+  lab_options.suspend.retry_s = cc.suspend_retry_s;
+  lab_options.suspend.settle_s = cc.suspend_settle_s;
+  lab_options.suspend.max_s = cc.suspend_max_s;
   d.lab = std::make_unique<campaigns::Lab>(d.io.get_executor(), d.instruments, lab_options);
+  if (d.sim && d.sim->announcement().contains("control")) {
+    d.hands = std::make_unique<SimulatorHands>(d.io.get_executor(), d.sim->announcement()["control"].get<std::string>());
+  }
+  d.lab->set_operator(&d.desk, d.hands.get());
+  d.desk.set_listener([&d](const std::string& event, const campaigns::OperatorRequest& r) {
+    log::info("operator", event + ": " + r.prompt + (r.answer ? " → " + *r.answer + " (" + r.answered_by + ")" : ""));
+    try {
+      d.store->append_event("operator", {{"event", event}, {"request", r.to_json()}});
+    } catch (const Error& e) {
+      log::warning("operator", std::string("cannot record the request: ") + e.what());
+    }
+  });
   d.executions = std::make_unique<Executions>(d.io, *d.store, *d.catalogue, d.instruments, *d.lab,
                                               ExecutionOptions{cc.max_resume_attempts},
                                               [&d](const std::string& text) { d.notifier.status(text); });
   d.api = std::make_unique<ApiContext>(ApiContext{*d.store, d.instruments, *d.catalogue, *d.executions,
-                                                  d.config.simulator.enabled, now_iso8601(), d.discovery.get(), ""});
+                                                  d.config.simulator.enabled, now_iso8601(), d.discovery.get(), "",
+                                                  &d.desk});
 
   http::ServerOptions so;
   so.tcp_host = d.config.listen_host;
@@ -159,7 +178,11 @@ void Daemon::write_endpoint_file() {
                    {"url", "http://" + d.config.listen_host + ":" + std::to_string(d.server->bound_port())},
                    {"port", d.server->bound_port()},
                    {"unix_socket", d.config.socket_path().string()}};
-  if (d.sim) j["simulator_pid"] = d.sim->pid();
+  if (d.sim) {
+    j["simulator_pid"] = d.sim->pid();
+    // Tests and demos inject faults and read the ground truth there.
+    if (d.sim->announcement().contains("control")) j["simulator_control"] = d.sim->announcement()["control"];
+  }
   auto path = endpoint_file_path(d.config);
   auto tmp = path;
   tmp += ".tmp";

@@ -58,6 +58,15 @@ class StoreSink final : public campaigns::ExecutionSink {
   void status_text(const std::string& text) override {
     if (status_) status_(record_.campaign + " " + record_.id.substr(0, 8) + ": " + text);
   }
+  void suspended(const std::string& reason, const Error& cause) override {
+    status_text("suspended: " + reason);
+    store_.set_execution_status(record_, ExecutionStatus::suspended, reason,
+                                json{{"suspended", true}, {"problem", protocol::problem_from_error(cause).to_json()}});
+  }
+  void resumed(const json& how) override {
+    status_text("condition cleared, going on");
+    store_.set_execution_status(record_, ExecutionStatus::running, "", json{{"resumed_after_suspension", how}});
+  }
 
  private:
   // The run's snapshot is taken when it is created, possibly before every instrument has connected
@@ -198,6 +207,7 @@ void Executions::launch(store::ExecutionRecord record, std::shared_ptr<const cam
                         json params, bool resumed, bool accept_units) {
   auto active = std::make_shared<Active>();
   active->record = record;
+  active->control.execution_id = record.id;
   active_[record.id] = active;
   asio::co_spawn(
       io_,
@@ -307,7 +317,10 @@ store::ExecutionRecord Executions::resume(const std::string& id) {
   auto it = active_.find(id);
   if (it != active_.end()) {
     // Still running towards its safe point: simply cancel the pause.
-    if (it->second->control.request == Request::pause) it->second->control = {};
+    if (it->second->control.request == Request::pause) {
+      it->second->control.request = Request::none;
+      it->second->control.reason.clear();
+    }
     return record;
   }
   if (record.status != ExecutionStatus::paused && record.status != ExecutionStatus::suspended) {

@@ -566,6 +566,60 @@ asio::awaitable<SpectralReading> Spectrolino::move_and_measure(double x_mm, doub
   }
 }
 
+asio::awaitable<SpectralReading> Spectrolino::read_chart_patch(const ChartPatchVisit& visit) {
+  require_table("read a chart patch");
+  require_ready("read a chart patch");
+  if (visit.row_length < 1) throw Error(ErrorClass::bad_parameter, "a chart row has at least one patch");
+  const PatchVisit patch{visit.index, visit.x_mm, visit.y_mm};
+  // Recalibrate at the start of a row rather than let the count run out in the middle of one.
+  bool row_start = visit.row_start;
+  std::optional<Error> last;
+  bool lost_link = false;
+  for (int attempt = 1; attempt <= options_.patch_attempts; ++attempt) {
+    if (lost_link) {
+      // Silence mid-chart usually means a power cycle or a replugged cable: the device is back at
+      // its power-on speed without calibration. Reconnect (same instrument only) and carry on.
+      lost_link = false;
+      // A named std::function, not a temporary inside co_await (GCC 12 double-destroys those).
+      const Reconnector::Verify same_instrument = [this, serial = identity_.serial]() -> asio::awaitable<void> {
+        verify_serial(serial);
+        co_return;
+      };
+      co_await reconnector_.reconnect(*this, same_instrument);
+    }
+    const bool row_would_expire = row_start && readings_since_cal_ + visit.row_length > cal_interval();
+    try {
+      // A failed recalibration counts as a failed try of this patch.
+      if (!calibrated_ || row_would_expire || readings_since_cal_ >= cal_interval()) co_await calibrate_now();
+      row_start = false;
+      state_ = InstrumentState::busy;
+      auto r = co_await measure_patch(patch);
+      r.attempts = attempt;
+      ++readings_since_cal_;
+      state_ = InstrumentState::ready;
+      co_return r;
+    } catch (const Error& e) {
+      const bool retry = e.cls() == ErrorClass::misread || e.cls() == ErrorClass::timeout ||
+                         e.cls() == ErrorClass::coms_fail || e.cls() == ErrorClass::needs_calibration ||
+                         e.cls() == ErrorClass::device_error;
+      state_ = InstrumentState::ready;
+      if (!retry) fail(e);
+      last = e;
+      log::warning("spectrolino", options_.id + ": patch " + std::to_string(patch.index) + " attempt " +
+                                      std::to_string(attempt) + " failed: " + e.what());
+      // After a failed reading the white reference is suspect: recalibrate before trying again.
+      calibrated_ = false;
+      lost_link = calls_for_reconnect(e);
+    }
+  }
+  if (!last) fail(Error(ErrorClass::bad_parameter, options_.id + ": patch_attempts must be at least 1"));
+  ErrorInfo info = last->info();
+  info.message = options_.id + ": patch " + std::to_string(patch.index) + " failed " +
+                 std::to_string(options_.patch_attempts) + " times: " + info.message;
+  info.retryable = false;
+  fail(Error(std::move(info)));
+}
+
 asio::awaitable<std::vector<SpectralReading>> Spectrolino::read_chart(const ChartLayout& layout, Progress progress) {
   require_table("read a chart");
   require_ready("read a chart");
@@ -576,62 +630,13 @@ asio::awaitable<std::vector<SpectralReading>> Spectrolino::read_chart(const Char
   std::vector<SpectralReading> out(static_cast<std::size_t>(total));
   int done = 0;
   for (const auto& row : rows) {
-    // Recalibrate at the start of a row rather than let the count run out in the middle of one.
-    bool row_start = true;
-    for (const auto& patch : row) {
-      std::optional<Error> last;
-      bool lost_link = false;
-      for (int attempt = 1; attempt <= options_.patch_attempts; ++attempt) {
-        if (lost_link) {
-          // Silence mid-chart usually means a power cycle or a replugged cable: the device is back at
-          // its power-on speed without calibration. Reconnect (same instrument only) and carry on.
-          lost_link = false;
-          // A named std::function, not a temporary inside co_await (GCC 12 double-destroys those).
-          const Reconnector::Verify same_instrument = [this, serial = identity_.serial]() -> asio::awaitable<void> {
-            verify_serial(serial);
-            co_return;
-          };
-          co_await reconnector_.reconnect(*this, same_instrument);
-          state_ = InstrumentState::busy;
-        }
-        const bool row_would_expire = row_start && readings_since_cal_ + static_cast<int>(row.size()) > cal_interval();
-        try {
-          // A failed recalibration counts as a failed try of this patch.
-          if (!calibrated_ || row_would_expire || readings_since_cal_ >= cal_interval()) co_await calibrate_now();
-          row_start = false;
-          state_ = InstrumentState::busy;
-          auto r = co_await measure_patch(patch);
-          r.attempts = attempt;
-          ++readings_since_cal_;
-          out[static_cast<std::size_t>(patch.index)] = std::move(r);
-          last.reset();
-          break;
-        } catch (const Error& e) {
-          const bool retry = e.cls() == ErrorClass::misread || e.cls() == ErrorClass::timeout ||
-                             e.cls() == ErrorClass::coms_fail || e.cls() == ErrorClass::needs_calibration ||
-                             e.cls() == ErrorClass::device_error;
-          state_ = InstrumentState::ready;
-          if (!retry) fail(e);
-          last = e;
-          log::warning("spectrolino", options_.id + ": patch " + std::to_string(patch.index) + " attempt " +
-                                          std::to_string(attempt) + " failed: " + e.what());
-          // After a failed reading the white reference is suspect: recalibrate before trying again.
-          calibrated_ = false;
-          lost_link = calls_for_reconnect(e);
-        }
-      }
-      if (last) {
-        ErrorInfo info = last->info();
-        info.message = options_.id + ": patch " + std::to_string(patch.index) + " failed " +
-                       std::to_string(options_.patch_attempts) + " times: " + info.message;
-        info.retryable = false;
-        fail(Error(std::move(info)));
-      }
+    for (std::size_t k = 0; k < row.size(); ++k) {
+      const ChartPatchVisit visit{row[k].index, row[k].x_mm, row[k].y_mm, k == 0, static_cast<int>(row.size())};
+      out[static_cast<std::size_t>(row[k].index)] = co_await read_chart_patch(visit);
       ++done;
       if (progress) progress(done, total);
     }
   }
-  state_ = InstrumentState::ready;
   co_return out;
 }
 

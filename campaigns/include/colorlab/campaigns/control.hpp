@@ -9,6 +9,7 @@ struct ExecutionControl {
   enum class Request { none, pause, abort, shutdown };
   Request request = Request::none;
   std::string reason;
+  std::string execution_id;  // whose calls these are (operator requests name it)
   bool requested() const { return request != Request::none; }
 };
 

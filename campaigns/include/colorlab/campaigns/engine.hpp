@@ -59,6 +59,10 @@ class ExecutionSink {
   virtual void restored(const nlohmann::json& actions) = 0;
   // What the execution is doing now, for logs and systemd's STATUS=.
   virtual void status_text(const std::string& text) = 0;
+  // The execution waits out a condition (an instrument gone, a lamp out, a full disk) and then goes
+  // on by itself with the interrupted step. May throw (a full disk refuses the status too).
+  virtual void suspended(const std::string& /*reason*/, const Error& /*cause*/) {}
+  virtual void resumed(const nlohmann::json& /*how*/) {}
 };
 
 struct RunOutcome {
@@ -85,6 +89,8 @@ struct ScriptRunSetup {
   // (resuming it from the API accepts the unit: verify_serials = false).
   std::map<std::string, std::string> expected_serials;
   bool verify_serials = true;
+  // Wait out conditions that mend (instrument gone, lamp out, disk full) instead of failing.
+  bool suspend_on_conditions = true;
 };
 
 boost::asio::awaitable<RunOutcome> run_campaign_script(ScriptRunSetup setup, Lab& lab, ExecutionSink& sink,

@@ -6,6 +6,7 @@
 // its time scale.
 #include <chrono>
 #include <map>
+#include <optional>
 #include <memory>
 #include <set>
 #include <string>
@@ -18,6 +19,8 @@
 #include "colorlab/campaigns/control.hpp"
 #include "colorlab/campaigns/instrument_set.hpp"
 #include "colorlab/campaigns/lab_state.hpp"
+#include "colorlab/campaigns/operator_desk.hpp"
+#include "colorlab/core/error.hpp"
 
 namespace colorlab::campaigns {
 
@@ -29,12 +32,24 @@ struct StabilityCriterion {
   static StabilityCriterion from_json(const nlohmann::json& j, const StabilityCriterion& defaults);
 };
 
+// How an execution waits out a condition that stops it (an instrument gone, a lamp out, a full
+// disk): it is suspended, the condition is checked every `retry_s`, and once it has cleared and
+// stayed clear for `settle_s` the interrupted step is measured again. After `max_s` it fails.
+struct SuspendPolicy {
+  double retry_s = 30;    // lab seconds between checks (at least 0.2 s of wall time)
+  double settle_s = 60;   // lab seconds the condition must stay clear
+  double max_s = 8 * 3600;
+  // A reading below this fraction of what the last stable reading predicts means a lamp went out.
+  double dropout_fraction = 0.2;
+};
+
 struct LabOptions {
   double time_scale = 1;              // lab seconds per wall-clock second (the simulator's time scale)
   StabilityCriterion warmup;          // how a resume decides that relit lamps are stable again
   double lamp_warmup_s = 900;         // with no luminance meter: wait this long after relighting
   bool lamps_off_at_shutdown = false; // otherwise lamps stay as they are (a warm cabinet for the next run)
   std::chrono::seconds connect_timeout{60};
+  SuspendPolicy suspend;
 };
 
 class Lab {
@@ -46,6 +61,15 @@ class Lab {
   // One lab call, live. Long waits end early with Error{aborted} when `control` asks.
   boost::asio::awaitable<nlohmann::json> perform(const std::string& call, const nlohmann::json& args,
                                                  const ExecutionControl& control);
+  // Why a failed call should suspend the execution rather than fail it ("lamp", "instrument"), or
+  // nullopt for a failure no waiting mends (a bad argument, a script error, a device error code).
+  static std::optional<std::string> suspend_cause(const Error& e);
+  // Returns once the condition behind `cause` has cleared and stayed clear for the settle time;
+  // Error{aborted} when `control` asks, or `cause` again after SuspendPolicy::max_s.
+  boost::asio::awaitable<nlohmann::json> await_recovery(const std::string& call, const Error& cause,
+                                                        const ExecutionControl& control);
+  // One retry interval of a suspension (for conditions the engine checks itself, a full disk).
+  boost::asio::awaitable<void> wait_retry(const ExecutionControl& control);
   // Brings the instruments to `desired`; returns what it did, for the event log.
   boost::asio::awaitable<nlohmann::json> restore(const LabState& desired, const ExecutionControl& control);
   // Table home with the head up; lamps off if configured. Errors are logged, not thrown.
@@ -53,6 +77,12 @@ class Lab {
   // Connects the instruments named in `expected` (id → serial the run started with) and lists those
   // that now report another serial: "id: the run started with serial A, now B".
   boost::asio::awaitable<std::vector<std::string>> serial_mismatches(std::map<std::string, std::string> expected);
+
+  // Where operator requests go, and who can do them without a person (the simulated lab).
+  void set_operator(OperatorDesk* desk, OperatorHands* hands) {
+    desk_ = desk;
+    hands_ = hands;
+  }
 
   const LabOptions& options() const { return options_; }
   double time_scale() const { return options_.time_scale; }
@@ -71,6 +101,12 @@ class Lab {
   boost::asio::awaitable<void> sleep_lab_seconds(double seconds, const ExecutionControl& control);
   boost::asio::awaitable<nlohmann::json> wait_stable(const StabilityCriterion& c, const ExecutionControl& control);
   boost::asio::awaitable<void> switch_lamps(std::vector<std::string> on);
+  boost::asio::awaitable<nlohmann::json> operator_request(const nlohmann::json& spec, const ExecutionControl& control);
+  boost::asio::awaitable<void> sleep_wall(std::chrono::steady_clock::duration d, const ExecutionControl& control);
+  // Throws Error{needs_operator, "lamp:dropout"} when `luminance` is far below what the last stable
+  // reading under the same lamps predicts at the current dimmer level.
+  void check_dropout(double luminance, const std::string& unit) const;
+  void note_stable(double luminance);
 
   boost::asio::any_io_executor executor_;
   const InstrumentSet& instruments_;
@@ -78,6 +114,16 @@ class Lab {
   // Lamps this process has seen lit and stable since it last switched them: a resume in the same
   // process need not wait for them again; a fresh process knows nothing and waits.
   std::set<std::string> known_warm_;
+  // The last stable reading and the light it was taken under: the yardstick for a lamp dropout.
+  struct StableLight {
+    double luminance = 0;
+    std::vector<std::string> lamps;
+    double dimmer_percent = 100;
+  };
+  std::optional<StableLight> stable_light_;
+  double dimmer_percent_ = 100;
+  OperatorDesk* desk_ = nullptr;
+  OperatorHands* hands_ = nullptr;
 };
 
 }  // namespace colorlab::campaigns

@@ -22,6 +22,9 @@ struct LabState {
   std::optional<std::string> spectro_mode;
   bool spectro_calibrated = false;
   nlohmann::json camera_settings;  // merged configure() arguments, null if never configured
+  // Operator actions the simulated lab carried out (action → details, the last of each kind):
+  // redone after a resume, because a fresh simulator has forgotten them. A person's actions stay done.
+  std::map<std::string, nlohmann::json> done_by_hands;
 
   // Follows one completed call (live or replayed).
   void apply(const std::string& call, const nlohmann::json& args, const nlohmann::json& result);

@@ -27,6 +27,11 @@ struct CampaignConfig {
   double stable_window_s = 60;
   double stable_interval_s = 5;
   double stable_timeout_s = 1800;
+  // Suspend, not fail (lab seconds): check a stopping condition every retry_s, go on once it has
+  // stayed clear for settle_s, give up after max_s.
+  double suspend_retry_s = 30;
+  double suspend_settle_s = 60;
+  double suspend_max_s = 8 * 3600;
   double time_scale = 1;             // lab seconds per wall second for an external simulated lab
 };
 

@@ -43,6 +43,15 @@ struct TablePosition {
   bool head_down = false;
 };
 
+// One patch of a chart read in the table's visiting order. `row_start` and `row_length` let the
+// table decide at a row's first patch whether its white calibration would run out within the row.
+struct ChartPatchVisit {
+  int index = 0;  // the patch's number in the chart's own order (for messages)
+  double x_mm = 0, y_mm = 0;
+  bool row_start = false;
+  int row_length = 1;
+};
+
 class XyTable : public virtual Instrument {
  public:
   virtual boost::asio::awaitable<void> move_to(double x_mm, double y_mm) = 0;
@@ -53,6 +62,9 @@ class XyTable : public virtual Instrument {
   virtual boost::asio::awaitable<TablePosition> position() = 0;
   // Move, lower, measure, raise in one table command.
   virtual boost::asio::awaitable<SpectralReading> move_and_measure(double x_mm, double y_mm) = 0;
+  // move_and_measure with the table's chart-reading policy: calibration when due (and before a
+  // row it would not last through), retries with recalibration, reconnection after a lost link.
+  virtual boost::asio::awaitable<SpectralReading> read_chart_patch(const ChartPatchVisit& visit) = 0;
 };
 
 class LampController : public virtual Instrument {

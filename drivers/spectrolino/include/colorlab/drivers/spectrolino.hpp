@@ -78,6 +78,7 @@ class Spectrolino final : public Spectrometer, public XyTable {
   boost::asio::awaitable<void> hold_paper(bool hold) override;
   boost::asio::awaitable<TablePosition> position() override;
   boost::asio::awaitable<SpectralReading> move_and_measure(double x_mm, double y_mm) override;
+  boost::asio::awaitable<SpectralReading> read_chart_patch(const ChartPatchVisit& visit) override;
   boost::asio::awaitable<TableStatus> table_status();
 
   // Reads every patch in serpentine order; returns readings in the chart's own patch order.

@@ -1,0 +1,152 @@
+// Suspend, not fail: which failures an unattended night waits out, and how it knows they are over.
+#include <algorithm>
+
+#include <boost/asio/steady_timer.hpp>
+#include <boost/asio/use_awaitable.hpp>
+
+#include "colorlab/campaigns/lab.hpp"
+#include "colorlab/core/error.hpp"
+#include "colorlab/core/log.hpp"
+#include "colorlab/drivers/lab_capabilities.hpp"
+
+namespace colorlab::campaigns {
+
+namespace asio = boost::asio;
+using nlohmann::json;
+using drivers::Capability;
+
+namespace {
+
+// The capability a call needs, for finding the instrument to bring back.
+std::optional<Capability> capability_for(const std::string& call) {
+  if (call.rfind("meter.", 0) == 0 || call == "wait_stable") return Capability::luminance;
+  if (call.rfind("table.", 0) == 0) return Capability::xy_table;
+  if (call.rfind("spectro.", 0) == 0) return Capability::reflectance_spectrum;
+  if (call.rfind("lamps.", 0) == 0) return Capability::lamp_switching;
+  if (call.rfind("dimmer.", 0) == 0) return Capability::dimmer;
+  if (call.rfind("camera.", 0) == 0) return Capability::camera;
+  return std::nullopt;
+}
+
+bool is_lamp_condition(const Error& e) { return e.info().device_code.rfind("lamp:", 0) == 0; }
+
+}  // namespace
+
+std::optional<std::string> Lab::suspend_cause(const Error& e) {
+  if (is_lamp_condition(e)) return std::string("lamp");
+  switch (e.cls()) {
+    case ErrorClass::no_comms:
+    case ErrorClass::timeout:
+    case ErrorClass::coms_fail: return std::string("instrument");
+    default: return std::nullopt;
+  }
+}
+
+asio::awaitable<void> Lab::wait_retry(const ExecutionControl& control) {
+  auto d = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+      std::chrono::duration<double>(options_.suspend.retry_s / options_.time_scale));
+  co_await sleep_wall(std::max<std::chrono::steady_clock::duration>(d, std::chrono::milliseconds(200)), control);
+}
+
+asio::awaitable<void> Lab::sleep_wall(std::chrono::steady_clock::duration d, const ExecutionControl& control) {
+  auto end = std::chrono::steady_clock::now() + d;
+  for (;;) {
+    if (control.requested()) throw Error(ErrorClass::aborted, "suspension interrupted: " + control.reason);
+    auto now = std::chrono::steady_clock::now();
+    if (now >= end) co_return;
+    asio::steady_timer t(executor_, std::min<std::chrono::steady_clock::duration>(end - now, std::chrono::milliseconds(100)));
+    co_await t.async_wait(asio::use_awaitable);
+  }
+}
+
+void Lab::note_stable(double luminance) {
+  StableLight s;
+  s.luminance = luminance;
+  s.dimmer_percent = dimmer_percent_;
+  if (auto lamps = find_role<drivers::LampController>("lamps")) s.lamps = lamps->lamps_on();
+  stable_light_ = s;
+}
+
+void Lab::check_dropout(double luminance, const std::string& unit) const {
+  if (!stable_light_ || stable_light_->luminance <= 0 || stable_light_->dimmer_percent <= 0) return;
+  auto lamps = find_role<drivers::LampController>("lamps");
+  if (!lamps || lamps->lamps_on() != stable_light_->lamps || stable_light_->lamps.empty()) return;
+  // Proportional to the dimmer as a floor: a real dimmer gives more light at low settings, not less,
+  // and the cabinet's floor varies by far less than the factor allowed here.
+  double expected = stable_light_->luminance * dimmer_percent_ / stable_light_->dimmer_percent;
+  if (luminance >= options_.suspend.dropout_fraction * expected) return;
+  std::string lit;
+  for (const auto& l : stable_light_->lamps) lit += (lit.empty() ? "" : "+") + l;
+  ErrorInfo info;
+  info.cls = ErrorClass::needs_operator;
+  info.message = "the light dropped: " + std::to_string(luminance) + " " + unit + " where about " +
+                 std::to_string(expected) + " was expected under " + lit + " at " + std::to_string(dimmer_percent_) + " %";
+  info.hint = "a lamp went out or a tube failed; the execution waits for the light to come back and be stable";
+  info.device_code = "lamp:dropout";
+  throw Error(std::move(info));
+}
+
+asio::awaitable<json> Lab::await_recovery(const std::string& call, const Error& cause, const ExecutionControl& control) {
+  const auto& p = options_.suspend;
+  auto wall = [&](double lab_s) {
+    auto d = std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(lab_s / options_.time_scale));
+    return std::max<std::chrono::steady_clock::duration>(d, std::chrono::milliseconds(200));
+  };
+  const auto started = std::chrono::steady_clock::now();
+  const auto give_up = started + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                     std::chrono::duration<double>(p.max_s / options_.time_scale));
+  int checks = 0;
+  const auto reference = stable_light_;  // the light before it went
+  for (;;) {
+    if (std::chrono::steady_clock::now() > give_up) throw cause;
+    co_await sleep_wall(wall(p.retry_s), control);
+    ++checks;
+    try {
+      if (is_lamp_condition(cause)) {
+        // The light is back when it is stable again (a relit tube warms up first) …
+        json stable = co_await wait_stable(options_.warmup, control);
+        // A lamp still out is "stable" too, at darkness: held to the light before the dropout.
+        if (reference) {
+          stable_light_ = reference;
+          check_dropout(stable["luminance"].get<double>(), stable.value("unit", std::string("cd/m2")));
+        }
+        note_stable(stable["luminance"].get<double>());
+        // … and still there after the settle time.
+        co_await sleep_wall(wall(p.settle_s), control);
+        auto meter = co_await acquire<drivers::LuminanceMeter>("luminance_meter");
+        auto r = co_await meter->measure_luminance();
+        check_dropout(r.luminance, r.unit);
+        co_return json{{"condition", "lamp"}, {"checks", checks}, {"luminance", r.luminance}};
+      }
+      auto capability = capability_for(call);
+      std::shared_ptr<drivers::Instrument> instrument;
+      for (const auto& i : instruments_.all()) {
+        for (auto c : i->capabilities()) {
+          if (capability && c == *capability && !instrument) instrument = i;
+        }
+      }
+      if (!instrument) {
+        // Nothing offers it any more (a Spectrolino that lost its table): connect every instrument that
+        // is down and look again.
+        for (const auto& i : instruments_.all()) {
+          if (i->state() == drivers::InstrumentState::disconnected || i->state() == drivers::InstrumentState::fault) {
+            instrument = i;
+            break;
+          }
+        }
+      }
+      if (!instrument) co_return json{{"condition", "instrument"}, {"checks", checks}};
+      co_await instrument->connect();
+      // Hysteresis: a link that flaps must stay up for the settle time before measuring again.
+      co_await sleep_wall(wall(p.settle_s), control);
+      auto s = instrument->state();
+      if (s == drivers::InstrumentState::disconnected || s == drivers::InstrumentState::fault) continue;
+      co_return json{{"condition", "instrument"}, {"instrument", instrument->id()}, {"checks", checks}};
+    } catch (const Error& e) {
+      if (e.cls() == ErrorClass::aborted && control.requested()) throw;
+      log::debug("lab", "still suspended (" + std::string(e.what()) + ")");
+    }
+  }
+}
+
+}  // namespace colorlab::campaigns

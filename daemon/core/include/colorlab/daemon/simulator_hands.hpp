@@ -1,0 +1,27 @@
+#pragma once
+// The simulated lab's "hands": operator actions that colorlab-sim can carry out through its
+// control channel, so a campaign on the simulated lab never waits for a person to aim the meter
+// or put the Spectrolino on its tile. Actions it cannot do are left to a person (nullopt).
+#include <filesystem>
+
+#include <boost/asio/any_io_executor.hpp>
+
+#include "colorlab/campaigns/operator_desk.hpp"
+
+namespace colorlab::daemon {
+
+class SimulatorHands final : public campaigns::OperatorHands {
+ public:
+  SimulatorHands(boost::asio::any_io_executor executor, std::filesystem::path control_socket);
+  boost::asio::awaitable<std::optional<nlohmann::json>> perform(const std::string& action,
+                                                                 const nlohmann::json& details) override;
+
+ private:
+  // One line of JSON out, one back; Error{no_comms|timeout|device_error} otherwise.
+  boost::asio::awaitable<nlohmann::json> command(nlohmann::json cmd);
+
+  boost::asio::any_io_executor executor_;
+  std::filesystem::path socket_;
+};
+
+}  // namespace colorlab::daemon
