@@ -8,6 +8,7 @@
 #include <boost/asio/use_awaitable.hpp>
 
 #include "colorlab/analysis/colorimetry.hpp"
+#include "colorlab/campaigns/chart_photograph.hpp"
 #include "colorlab/campaigns/frame_statistics.hpp"
 #include "colorlab/core/error.hpp"
 #include "colorlab/core/ids.hpp"
@@ -403,6 +404,23 @@ asio::awaitable<json> Lab::perform(const std::string& call, const json& args, co
     auto error = co_await cam::async_configure(camera->camera(), s, asio::use_awaitable);
     if (error) throw *error;
     co_return json(nullptr);
+  }
+  if (call == "camera.photograph_chart") {
+    json options = args.empty() ? json::object() : args[0];
+    // A lab with two cameras (GenICam and DSLR) lets the script say which one photographs the chart.
+    std::shared_ptr<cam::CameraInstrument> camera;
+    if (options.is_object() && options.contains("camera")) {
+      camera = select_camera(instruments_, options["camera"]);
+      co_await ready(*camera);
+    } else {
+      camera = co_await acquire<cam::CameraInstrument>("camera");
+    }
+    json photographs = co_await photograph_chart(*camera, options);
+    co_return photographs;
+  }
+  if (call == "runs.chart_reference") {
+    if (!runs_) throw Error(ErrorClass::unsupported, "lab.runs.chart_reference: this lab keeps no runs to read");
+    co_return chart_reference(*runs_, args[0].get<std::string>());
   }
   if (call == "operator.request") {
     json answer = co_await operator_request(args[0], control);

@@ -9,6 +9,7 @@
 
 #include "colorlab/analysis/statistics.hpp"
 #include "colorlab/analysis/uniformity.hpp"
+#include "colorlab/campaigns/characterize.hpp"
 #include "colorlab/campaigns/chart_plan.hpp"
 #include "colorlab/campaigns/lua_value.hpp"
 #include "colorlab/core/error.hpp"
@@ -45,6 +46,8 @@ const std::map<std::string, CallSpec>& call_specs() {
       {"meter.measure", {CallKind::reading, {}}},
       {"camera.configure", {CallKind::effect, {"table"}}},
       {"camera.capture", {CallKind::reading, {"table?"}}},
+      {"camera.photograph_chart", {CallKind::reading, {"table?"}}},
+      {"runs.chart_reference", {CallKind::reading, {"string"}}},
       {"wait", {CallKind::effect, {"number"}}},
       {"wait_stable", {CallKind::reading, {"table?"}}},
       {"now", {CallKind::reading, {}}},
@@ -303,6 +306,19 @@ int analysis_compare_lamps(lua_State* L) {
   return 1;
 }
 
+// lab.analysis.characterize(camera_values, reference, options) → chapter 7's approaches (characterize.hpp).
+int analysis_characterize(lua_State* L) {
+  guarded(L, [&] {
+    json camera = to_json(L, 1, "lab.analysis.characterize's camera values");
+    json reference = to_json(L, 2, "lab.analysis.characterize's reference");
+    json options = lua_gettop(L) >= 3 && !lua_isnil(L, 3) ? to_json(L, 3, "lab.analysis.characterize's options") : json::object();
+    json result = characterize(camera, reference, options);
+    lua_settop(L, 0);
+    push_json(L, result);
+  });
+  return 1;
+}
+
 // lab.chart.plan{chart=, first_x_mm=, first_y_mm=, pitch_mm=} → the chart's patches on the table in visiting order.
 int chart_plan_fn(lua_State* L) {
   guarded(L, [&] {
@@ -362,6 +378,8 @@ void install_lab_api(lua_State* L, LabCallSink* sink) {
   lua_setfield(L, -2, "dimmer_proportionality");
   lua_pushcfunction(L, analysis_compare_lamps);
   lua_setfield(L, -2, "compare_lamps");
+  lua_pushcfunction(L, analysis_characterize);
+  lua_setfield(L, -2, "characterize");
   lua_setfield(L, -2, "analysis");
   lua_newtable(L);
   lua_pushcfunction(L, chart_plan_fn);

@@ -20,6 +20,7 @@
 #include "colorlab/daemon/embedded_sim.hpp"
 #include "colorlab/daemon/executions.hpp"
 #include "colorlab/daemon/simulator_hands.hpp"
+#include "store_run_reader.hpp"
 #include "colorlab/daemon/systemd_notify.hpp"
 #include "colorlab/drivers/discovery_monitor.hpp"
 #include "colorlab/http/server.hpp"
@@ -38,6 +39,7 @@ struct Daemon::Impl {
   std::unique_ptr<campaigns::Lab> lab;
   campaigns::OperatorDesk desk;
   std::unique_ptr<SimulatorHands> hands;
+  std::unique_ptr<StoreRunReader> run_reader;  // lab.runs.* (characterize-camera's reference)
   std::unique_ptr<Executions> executions;
   std::unique_ptr<ApiContext> api;
   std::unique_ptr<http::Server> server;
@@ -139,6 +141,8 @@ Daemon::Daemon(DaemonConfig config) : impl_(std::make_unique<Impl>()) {
     d.hands = std::make_unique<SimulatorHands>(d.io.get_executor(), d.sim->announcement()["control"].get<std::string>());
   }
   d.lab->set_operator(&d.desk, d.hands.get());
+  d.run_reader = std::make_unique<StoreRunReader>(*d.store);
+  d.lab->set_run_reader(d.run_reader.get());
   d.desk.set_listener([&d](const std::string& event, const campaigns::OperatorRequest& r) {
     log::info("operator", event + ": " + r.prompt + (r.answer ? " → " + *r.answer + " (" + r.answered_by + ")" : ""));
     try {

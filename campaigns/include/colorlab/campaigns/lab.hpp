@@ -20,6 +20,7 @@
 #include "colorlab/campaigns/instrument_set.hpp"
 #include "colorlab/campaigns/lab_state.hpp"
 #include "colorlab/campaigns/operator_desk.hpp"
+#include "colorlab/campaigns/run_reader.hpp"
 #include "colorlab/core/error.hpp"
 
 namespace colorlab::campaigns {
@@ -84,6 +85,9 @@ class Lab {
     hands_ = hands;
   }
 
+  // Where lab.runs.* reads earlier runs (the daemon's store); without one those calls fail.
+  void set_run_reader(RunReader* runs) { runs_ = runs; }
+
   const LabOptions& options() const { return options_; }
   double time_scale() const { return options_.time_scale; }
 
@@ -124,6 +128,7 @@ class Lab {
   double dimmer_percent_ = 100;
   OperatorDesk* desk_ = nullptr;
   OperatorHands* hands_ = nullptr;
+  RunReader* runs_ = nullptr;
 };
 
 }  // namespace colorlab::campaigns

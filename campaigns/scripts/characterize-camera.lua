@@ -1,0 +1,88 @@
+-- Camera characterization (dissertation chapter 7): the chart photographed in the cabinet as RAW,
+-- 16-bit TIFF, 8-bit TIFF and JPEG, N frames averaged per format; each patch's value from the
+-- chart's known layout once the chart is located in the photograph; the reference colours from a
+-- chart-read run; then the camera's colour space (§7.1), an ICC profile (§7.2) and the adapted
+-- polynomial/spline mappings with model selection (§7.3), each with training and cross-validated
+-- ΔE00. The selected model is returned, so it is stored with the run.
+return {
+  description = "Camera characterization (chapter 7): chart photographs as RAW, TIFF 16/8 and JPEG against a chart-read run, fitted and cross-validated",
+  needs = { "camera", "lamps", "luminance_meter" },
+  parameters = {
+    reference_run = { type = "string", description = "id of a finished chart-read run of the same chart (the reference L*a*b*)" },
+    frames = { type = "integer", default = 25, min = 1, max = 256, unit = "frames", description = "frames averaged per format" },
+    formats = { type = "array", items = "string", values = { "raw", "tiff16", "tiff8", "jpeg" },
+                default = { "raw", "tiff16", "tiff8", "jpeg" }, min_items = 1, max_items = 4,
+                description = "chapter 7's test cases to photograph and fit" },
+    chart = { type = "string", values = { "sg", "cc24" }, default = "sg", description = "the chart in the cabinet" },
+    camera = { type = "string", default = "dslr", description = "the camera's instrument id or kind (dslr, genicam)" },
+    lamp = { type = "string", default = "D65", description = "the cabinet lamp to photograph under; empty = leave the cabinet as it is" },
+    cv = { type = "string", default = "loo", description = "cross-validation: loo, or kN for N folds" },
+    load_timeout_s = { type = "number", default = 600, min = 0, max = 86400, unit = "s",
+                       description = "how long to wait for the operator to confirm the chart before photographing anyway" },
+  },
+  run = function(p)
+    if p.reference_run == nil or p.reference_run == "" then
+      error("reference_run is required: the id of a finished chart-read run of the chart in the cabinet (run chart-read first)")
+    end
+    local ref = lab.runs.chart_reference(p.reference_run)
+    if ref.chart ~= p.chart then
+      error(string.format("reference_run %s read a %s chart, but chart = %s", p.reference_run, ref.chart, p.chart))
+    end
+    local a = lab.operator.request {
+      action = "load_chart",
+      prompt = string.format("Put the %s in the cabinet in front of the camera %s, facing it and evenly lit",
+                             p.chart == "sg" and "ColorChecker SG" or "ColorChecker 24", p.camera),
+      options = { "loaded", "cancel" }, default = "loaded", timeout_s = p.load_timeout_s,
+      details = { chart = p.chart, where = "cabinet" },
+    }
+    if a.answer == "cancel" then error("the operator cancelled the characterization") end
+    if p.lamp ~= "" then
+      -- wait_stable reads the LS-110: it must see the cabinet's floor, not whatever it last pointed at.
+      local aim = lab.operator.request {
+        action = "aim_meter", prompt = "Aim the LS-110 at the cabinet floor beside the chart (spot row 4, column 5)",
+        options = { "aimed", "skip" }, default = "aimed", timeout_s = p.load_timeout_s, details = { row = 3, col = 4 },
+      }
+      lab.log("meter: " .. aim.answer)
+      lab.lamps.select(p.lamp)
+      lab.wait_stable()  -- a warming lamp would tint the first formats differently from the last
+    end
+    lab.progress(0.1, "photographing")
+    local shots = lab.camera.photograph_chart { frames = p.frames, chart = p.chart, formats = p.formats, camera = p.camera }
+    local out = { reference_run = p.reference_run, chart = p.chart, frames = p.frames, lamp = p.lamp,
+                  instrument = shots.instrument, formats = {} }
+    local best_format, best_cv
+    for k, format in ipairs(p.formats) do
+      local f = shots.formats[format]
+      lab.record("chart/" .. format, {
+        quantity = "chart_location", value = f.confidence, unit = "confidence", instrument = shots.instrument,
+        data = { format = format, corners = f.corners, rotation_deg = f.rotation_deg, patches_detected = f.patches_detected,
+                 reprojection_rms_px = f.reprojection_rms_px, check = f.check, frames = f.frames, files = f.files,
+                 width = f.width, height = f.height },
+      })
+      local unit = format == "raw" and "DN above black" or (f.bits == 8 and "8-bit code" or "16-bit code")
+      for i, id in ipairs(f.ids) do
+        lab.record("patch/" .. format .. "/" .. id, {
+          quantity = "camera_rgb", value = f.values[i][2], unit = unit, instrument = shots.instrument,
+          data = { id = id, format = format, rgb = f.values[i], detected = f.detected[i] },
+        })
+      end
+      lab.progress(0.1 + 0.9 * (k - 0.5) / #p.formats, "fitting " .. format)
+      local c = lab.analysis.characterize(f, ref, { cv = p.cv })
+      for name, approach in pairs(c.approaches) do
+        lab.record("characterization/" .. format .. "/" .. name, {
+          quantity = "delta_e00_cv_mean", value = approach.cv.mean, unit = "ΔE00", instrument = shots.instrument,
+          data = { format = format, approach = name, training = approach.training, cv = approach.cv, cv_name = c.cv },
+        })
+      end
+      local chosen = c.approaches.adapted_mapping.cv.mean
+      if best_cv == nil or chosen < best_cv then best_format, best_cv = format, chosen end
+      out.formats[format] = { confidence = f.confidence, rotation_deg = f.rotation_deg, corners = f.corners,
+                              check = f.check, approaches = c.approaches, best_approach = c.best_approach,
+                              selected = c.selected }
+    end
+    -- The model to use from now on: the adapted mapping of the format that cross-validates best.
+    out.selected = { format = best_format, cv_mean_de00 = best_cv, model = out.formats[best_format].selected }
+    lab.progress(1.0, "done")
+    return out
+  end,
+}

@@ -1,0 +1,250 @@
+#include "colorlab/campaigns/chart_photograph.hpp"
+
+#include <algorithm>
+#include <map>
+
+#include <boost/asio/co_spawn.hpp>
+#include <boost/asio/thread_pool.hpp>
+#include <boost/asio/use_awaitable.hpp>
+
+#include "chart_sampling.hpp"
+#include "colorlab/core/error.hpp"
+#include "colorlab/drivers/camera/asio_camera.hpp"
+#include "colorlab/drivers/camera/camera_instrument.hpp"
+
+namespace colorlab::campaigns {
+
+namespace asio = boost::asio;
+namespace cam = drivers::camera;
+namespace ca = analysis;
+using nlohmann::json;
+
+namespace {
+
+const std::vector<std::string> kFormats = {"raw", "tiff16", "tiff8", "jpeg"};
+
+struct PhotographOptions {
+  int frames = 25;
+  std::vector<std::string> formats = kFormats;
+  detail::SamplingOptions sampling;
+};
+
+PhotographOptions parse(const json& o) {
+  PhotographOptions p;
+  auto bad = [](const std::string& what) { return Error(ErrorClass::bad_parameter, "lab.camera.photograph_chart: " + what); };
+  if (!o.is_object() && !(o.is_array() && o.empty())) throw bad("takes a table {frames=, chart=, formats=, camera=}");
+  if (!o.is_object()) return p;
+  if (o.contains("frames")) {
+    if (!o["frames"].is_number_integer() || o["frames"].get<int>() < 1 || o["frames"].get<int>() > 256) throw bad("frames must be an integer from 1 to 256");
+    p.frames = o["frames"].get<int>();
+  }
+  if (o.contains("chart")) {
+    if (!o["chart"].is_string()) throw bad("chart must be \"sg\" or \"cc24\"");
+    p.sampling.chart = ca::chart_type_from_string(o["chart"].get<std::string>());
+  }
+  if (o.contains("formats")) {
+    p.formats.clear();
+    for (const auto& f : o["formats"]) {
+      if (!f.is_string() || std::find(kFormats.begin(), kFormats.end(), f.get<std::string>()) == kFormats.end()) {
+        throw bad("formats must name raw, tiff16, tiff8 or jpeg, got " + f.dump());
+      }
+      if (std::find(p.formats.begin(), p.formats.end(), f.get<std::string>()) == p.formats.end()) p.formats.push_back(f);
+    }
+    if (p.formats.empty()) throw bad("formats must name at least one of raw, tiff16, tiff8, jpeg");
+  }
+  auto fraction = [&](const char* key, double& out) {
+    if (!o.contains(key)) return;
+    if (!o[key].is_number() || !(o[key].get<double>() > 0 && o[key].get<double>() <= 1)) throw bad(std::string(key) + " must be a number in (0, 1]");
+    out = o[key].get<double>();
+  };
+  fraction("sample_fraction", p.sampling.sample_fraction);
+  fraction("min_confidence", p.sampling.min_confidence);
+  return p;
+}
+
+bool wants(const PhotographOptions& p, const std::string& format) {
+  return std::find(p.formats.begin(), p.formats.end(), format) != p.formats.end();
+}
+
+ca::CfaPattern cfa_of(const cam::CfaPattern& c, const std::string& camera) {
+  using C = cam::CfaColor;
+  if (c.cell[0][0] == C::red && c.cell[1][1] == C::blue) return ca::CfaPattern::rggb;
+  if (c.cell[0][0] == C::blue && c.cell[1][1] == C::red) return ca::CfaPattern::bggr;
+  if (c.cell[0][1] == C::red && c.cell[1][0] == C::blue) return ca::CfaPattern::grbg;
+  if (c.cell[0][1] == C::blue && c.cell[1][0] == C::red) return ca::CfaPattern::gbrg;
+  throw Error(ErrorClass::unsupported, camera + " delivers a " + c.name() + " sensor, not a Bayer mosaic",
+              "a chart characterization needs colour: use a colour camera");
+}
+
+// The raw frames' sum over the visible area, filled on the camera's decode thread; read on the io
+// thread only after the series has ended.
+struct RawSum {
+  std::vector<std::uint32_t> sum;
+  int width = 0, height = 0, frames = 0;
+  cam::CfaPattern cfa;
+  double black = 0;
+  int bits = 16;
+};
+
+int significant_bits(const cam::RawImage& image) {
+  int bits = 1;
+  while (bits < 16 && (1U << bits) <= image.white_level) ++bits;
+  return image.white_level > 0 ? bits : static_cast<int>(image.bits_per_sample);
+}
+
+// The sidecars of a series by format: a real DSLR's download has only JPEGs; the simulated one
+// writes 8- and 16-bit TIFFs as well, told apart by their sample type, not by a naming habit.
+std::map<std::string, detail::AveragedPhoto> average_sidecars(const std::vector<std::filesystem::path>& files,
+                                                              const PhotographOptions& p) {
+  std::map<std::string, std::vector<std::filesystem::path>> by_format;
+  for (const auto& f : files) {
+    std::string ext = f.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    if (ext == ".jpg" || ext == ".jpeg") by_format["jpeg"].push_back(f);
+    if (ext == ".tif" || ext == ".tiff") by_format["tiff"].push_back(f);
+  }
+  std::map<std::string, detail::AveragedPhoto> out;
+  if (wants(p, "jpeg") && !by_format["jpeg"].empty()) out["jpeg"] = detail::average_files("jpeg", by_format["jpeg"]);
+  if ((wants(p, "tiff8") || wants(p, "tiff16")) && !by_format["tiff"].empty()) {
+    auto tiffs = detail::average_tiffs(by_format["tiff"]);
+    for (auto& [format, photo] : tiffs) {
+      if (wants(p, format)) out[format] = std::move(photo);
+    }
+  }
+  return out;
+}
+
+// Runs on the worker pool: average the processed files, locate and sample every photograph.
+asio::awaitable<json> sample_all(std::shared_ptr<RawSum> raw, std::vector<std::filesystem::path> sidecars,
+                                 PhotographOptions p, std::string camera_name) {
+  json formats = json::object();
+  if (wants(p, "raw")) {
+    detail::AveragedPhoto a;
+    a.format = "raw";
+    a.frames = raw->frames;
+    a.bits = raw->bits;
+    a.scale = std::ldexp(1.0, 16 - raw->bits);
+    a.black_level = raw->black;
+    a.cfa = cfa_of(raw->cfa, camera_name);
+    a.photo.width = raw->width;
+    a.photo.height = raw->height;
+    a.photo.channels = 1;
+    a.photo.type = ca::SampleType::u16;
+    a.photo.bytes.resize(raw->sum.size() * sizeof(std::uint16_t));
+    auto* dst = reinterpret_cast<std::uint16_t*>(a.photo.bytes.data());
+    const double k = a.scale / raw->frames;
+    for (std::size_t i = 0; i < raw->sum.size(); ++i) dst[i] = static_cast<std::uint16_t>(std::min(65535.0, std::round(raw->sum[i] * k)));
+    raw->sum = {};
+    formats["raw"] = detail::locate_and_sample(a, p.sampling);
+  }
+  auto processed = average_sidecars(sidecars, p);
+  for (const auto& format : p.formats) {
+    if (format == "raw") continue;
+    auto it = processed.find(format);
+    if (it == processed.end()) {
+      throw Error(ErrorClass::hardware_fail, camera_name + " delivered no " + format + " files with its raws",
+                  "check the camera's image format (raw+jpeg+tiff), or ask only for the formats it writes");
+    }
+    formats[format] = detail::locate_and_sample(it->second, p.sampling);
+  }
+  co_return formats;
+}
+
+// One thread for chart work: a second campaign's photographs wait rather than take both cores
+// from the daemon and the simulated lab. Joined at exit.
+asio::thread_pool& chart_worker() {
+  static asio::thread_pool pool(1);
+  return pool;
+}
+
+}  // namespace
+
+std::shared_ptr<cam::CameraInstrument> select_camera(const InstrumentSet& instruments, const json& id_or_kind) {
+  if (!id_or_kind.is_string() || id_or_kind.get<std::string>().empty()) {
+    throw Error(ErrorClass::bad_parameter, "lab.camera.photograph_chart: camera must be an instrument id or a kind (dslr, genicam)");
+  }
+  const std::string want = id_or_kind.get<std::string>();
+  if (auto i = instruments.find(want)) {
+    if (auto c = std::dynamic_pointer_cast<cam::CameraInstrument>(i)) return c;
+    throw Error(ErrorClass::bad_parameter, "instrument '" + want + "' is not a camera", "name a camera's id or kind");
+  }
+  std::string cameras;
+  for (const auto& i : instruments.all()) {
+    auto c = std::dynamic_pointer_cast<cam::CameraInstrument>(i);
+    if (!c) continue;
+    if (cam::to_string(c->camera().identity().kind) == want) return c;
+    cameras += (cameras.empty() ? "" : ", ") + c->id() + " (" + std::string(cam::to_string(c->camera().identity().kind)) + ")";
+  }
+  throw Error(ErrorClass::not_found, "no camera has the id or kind '" + want + "'",
+              cameras.empty() ? "add a camera to colorlabd's configuration, or run the simulated lab"
+                              : "the configured cameras are " + cameras);
+}
+
+asio::awaitable<json> photograph_chart(cam::CameraInstrument& instrument, const json& options) {
+  const PhotographOptions p = parse(options);
+  auto& camera = instrument.camera();
+  const bool tiff = wants(p, "tiff8") || wants(p, "tiff16");
+  const bool processed = tiff || wants(p, "jpeg");
+  const auto want = tiff ? cam::ImageFormat::raw_jpeg_tiff : processed ? cam::ImageFormat::raw_and_jpeg : cam::ImageFormat::raw;
+  const auto offered = camera.limits().image_formats;
+  const auto before = camera.settings().image_format;
+  if (processed && std::find(offered.begin(), offered.end(), want) == offered.end()) {
+    throw Error(ErrorClass::unsupported,
+                camera.name() + " cannot deliver " + std::string(cam::to_string(want)) + " (chapter 7's processed test cases)",
+                "ask for formats = {\"raw\"} from this camera, or convert its raws with a raw converter on the bench");
+  }
+  auto set_format = [&](cam::ImageFormat f) -> asio::awaitable<void> {
+    cam::CameraSettings s;
+    s.image_format = f;
+    auto error = co_await cam::async_configure(camera, s, asio::use_awaitable);
+    if (error) throw *error;
+  };
+  if (!offered.empty() && before != want) co_await set_format(want);
+
+  auto raw = std::make_shared<RawSum>();
+  // Runs on the camera's decode thread, frame by frame: the raw series never exists in memory.
+  auto sink = [raw](const cam::RawImage& image) {
+    auto& r = *raw;
+    if (r.sum.empty()) {
+      r.width = static_cast<int>(image.width);
+      r.height = static_cast<int>(image.height);
+      r.sum.assign(image.width * image.height, 0);
+      r.cfa = image.cfa;
+      r.black = image.black_level[0];
+      r.bits = significant_bits(image);
+    } else if (static_cast<int>(image.width) != r.width || static_cast<int>(image.height) != r.height) {
+      throw Error(ErrorClass::bad_data, "frame " + std::to_string(image.frame_index) + " is " + std::to_string(image.width) + "×" +
+                                            std::to_string(image.height) + ", the first was " + std::to_string(r.width) + "×" +
+                                            std::to_string(r.height));
+    }
+    for (std::size_t y = 0; y < image.height; ++y) {
+      auto row = image.row(y);
+      auto* s = r.sum.data() + y * image.width;
+      for (std::size_t x = 0; x < image.width; ++x) s[x] += row[x];
+    }
+    ++r.frames;
+  };
+  cam::CaptureReport report =
+      co_await cam::async_capture(camera, static_cast<std::size_t>(p.frames), sink, asio::use_awaitable);
+  // Leave the camera as the campaign had it (a later frame-average need not download sidecars).
+  if (before && *before != want) co_await set_format(*before);
+  if (!report.complete()) {
+    if (report.error) throw *report.error;
+    throw Error(ErrorClass::hardware_fail, "the camera delivered " + std::to_string(report.delivered) + " of " +
+                                               std::to_string(report.requested) + " frames");
+  }
+  std::vector<std::filesystem::path> sidecars;
+  for (const auto& f : report.saved_files) {
+    std::string ext = f.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    if (ext == ".jpg" || ext == ".jpeg" || ext == ".tif" || ext == ".tiff") sidecars.push_back(f);
+  }
+  json formats = co_await asio::co_spawn(chart_worker(), sample_all(raw, std::move(sidecars), p, camera.name()),
+                                         asio::use_awaitable);
+  co_return json{{"instrument", instrument.id()},
+                 {"chart", std::string(ca::to_string(p.sampling.chart))},
+                 {"frames", p.frames},
+                 {"formats", formats}};
+}
+
+}  // namespace colorlab::campaigns

@@ -1,0 +1,50 @@
+#pragma once
+// The chart photograph's pixels, averaged over the frames of one series per image format, and their
+// chart location and patch values. Internal to chart_photograph.cpp; runs off the daemon's io thread.
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "colorlab/analysis/chart_layout.hpp"
+#include "colorlab/analysis/chart_photo.hpp"
+
+namespace colorlab::campaigns::detail {
+
+// Averages are kept as 16-bit samples scaled by `scale` (2^(16 − significant bits)), so averaging N
+// 12-bit raws or 8-bit JPEGs keeps its sub-count precision in a photo the locator reads; values are
+// divided by `scale` again when reported.
+struct AveragedPhoto {
+  std::string format;  // "raw", "tiff16", "tiff8", "jpeg"
+  int frames = 0;
+  analysis::Photo photo;
+  double scale = 1;
+  int bits = 16;                              // significant bits before scaling
+  double black_level = 0;                     // raw only, unscaled counts
+  std::optional<analysis::CfaPattern> cfa;    // raw only
+  std::vector<std::string> files;             // the frames' files, for the record
+};
+
+struct SamplingOptions {
+  analysis::ChartType chart = analysis::ChartType::sg140;
+  double sample_fraction = 0.6;
+  double min_confidence = 0.6;
+};
+
+// Sums of the camera's own processed files (JPEG, TIFF) of one format; throws Error(bad_data) when
+// the frames differ in size or kind.
+AveragedPhoto average_files(const std::string& format, const std::vector<std::filesystem::path>& files);
+// The TIFFs of a series by sample type: "tiff8" and "tiff16".
+std::map<std::string, AveragedPhoto> average_tiffs(const std::vector<std::filesystem::path>& files);
+
+// Locates the chart (colorlab_chart_locate, as `colorlab analyze locate-chart`) and samples every
+// patch: {format, frames, files, width, height, bits, black_subtracted, confidence, rotation_deg,
+// corners, patches_detected, reprojection_rms_px, check, ids, values = [[r, g, b], …]}.
+// Throws the locator's typed Error, with the format named.
+nlohmann::json locate_and_sample(const AveragedPhoto& averaged, const SamplingOptions& options);
+
+}  // namespace colorlab::campaigns::detail
