@@ -6,7 +6,7 @@
 -- ΔE00. The selected model is returned, so it is stored with the run.
 return {
   description = "Camera characterization (chapter 7): chart photographs as RAW, TIFF 16/8 and JPEG against a chart-read run, fitted and cross-validated",
-  needs = { "camera", "lamps", "luminance_meter" },
+  needs = { "camera", "lamps", "dimmer", "luminance_meter" },
   parameters = {
     reference_run = { type = "string", description = "id of a finished chart-read run of the same chart (the reference L*a*b*)" },
     frames = { type = "integer", default = 25, min = 1, max = 256, unit = "frames", description = "frames averaged per format" },
@@ -16,6 +16,7 @@ return {
     chart = { type = "string", values = { "sg", "cc24" }, default = "sg", description = "the chart in the cabinet" },
     camera = { type = "string", default = "dslr", description = "the camera's instrument id or kind (dslr, genicam)" },
     lamp = { type = "string", default = "D65", description = "the cabinet lamp to photograph under; empty = leave the cabinet as it is" },
+    dimmer_percent = { type = "number", default = 100, min = 1, max = 100, unit = "%", description = "the cabinet's dimmer level" },
     cv = { type = "string", default = "loo", description = "cross-validation: loo, or kN for N folds" },
     load_timeout_s = { type = "number", default = 600, min = 0, max = 86400, unit = "s",
                        description = "how long to wait for the operator to confirm the chart before photographing anyway" },
@@ -44,6 +45,7 @@ return {
       }
       lab.log("meter: " .. aim.answer)
       lab.lamps.select(p.lamp)
+      lab.dimmer.set(p.dimmer_percent)  -- the widget may have been left dark
       lab.wait_stable()  -- a warming lamp would tint the first formats differently from the last
     end
     lab.progress(0.1, "photographing")
