@@ -206,11 +206,7 @@ asio::awaitable<RunOutcome> run_campaign_script(ScriptRunSetup setup, Lab& lab, 
               if (!storage_suspended) {
                 storage_suspended = true;
                 log::warning(script.name, std::string("suspended: storage: ") + refused->what());
-                try {
-                  sink.suspended(std::string("storage: ") + refused->what(), *refused);
-                } catch (const Error&) {
-                  // The same full disk refuses the status: the log line above is all there is.
-                }
+                sink.suspended(std::string("storage: ") + refused->what(), *refused);
               }
               co_await lab.wait_retry(control);
             }

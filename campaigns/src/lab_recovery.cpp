@@ -37,7 +37,10 @@ std::optional<std::string> Lab::suspend_cause(const Error& e) {
   switch (e.cls()) {
     case ErrorClass::no_comms:
     case ErrorClass::timeout:
-    case ErrorClass::coms_fail: return std::string("instrument");
+    case ErrorClass::coms_fail:
+    // An instrument that needs a person (a meter switched off or out of remote mode) is waited for
+    // like one that is gone: it is reconnected once it answers again.
+    case ErrorClass::needs_operator: return std::string("instrument");
     default: return std::nullopt;
   }
 }

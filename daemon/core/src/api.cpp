@@ -135,7 +135,12 @@ HttpResponse post_execution(ApiContext& ctx, const HttpRequest& req) {
 HttpResponse get_execution(ApiContext& ctx, const std::string& id) {
   auto e = ctx.store.execution(id);
   if (!e) throw Error(ErrorClass::not_found, "no execution with id '" + id + "'");
-  return HttpResponse::json(200, e->to_json());
+  json j = e->to_json();
+  if (auto why = ctx.executions.live_suspension(id)) {
+    j["status"] = "suspended";
+    j["reason"] = *why;
+  }
+  return HttpResponse::json(200, j);
 }
 
 json discovered_json(const drivers::DiscoveredInstrument& d) {

@@ -22,6 +22,9 @@ using Request = campaigns::ExecutionControl::Request;
 struct Executions::Active {
   store::ExecutionRecord record;
   campaigns::ExecutionControl control;
+  // Why the execution is waiting out a condition right now; kept here too because a full disk
+  // refuses to store it.
+  std::optional<std::string> suspension;
 };
 
 namespace {
@@ -30,8 +33,10 @@ namespace {
 class StoreSink final : public campaigns::ExecutionSink {
  public:
   StoreSink(store::Store& store, const store::ExecutionRecord& record, const campaigns::InstrumentSet& instruments,
-            std::function<void(const std::string&)> status, json snapshot, bool replace_serials)
-      : store_(store),
+            std::function<void(const std::string&)> status, json snapshot, bool replace_serials,
+            std::optional<std::string>& suspension)
+      : suspension_(suspension),
+        store_(store),
         record_(record),
         instruments_(instruments),
         status_(std::move(status)),
@@ -59,13 +64,24 @@ class StoreSink final : public campaigns::ExecutionSink {
     if (status_) status_(record_.campaign + " " + record_.id.substr(0, 8) + ": " + text);
   }
   void suspended(const std::string& reason, const Error& cause) override {
+    suspension_ = reason;
     status_text("suspended: " + reason);
-    store_.set_execution_status(record_, ExecutionStatus::suspended, reason,
-                                json{{"suspended", true}, {"problem", protocol::problem_from_error(cause).to_json()}});
+    try {
+      store_.set_execution_status(record_, ExecutionStatus::suspended, reason,
+                                  json{{"suspended", true}, {"problem", protocol::problem_from_error(cause).to_json()}});
+    } catch (const Error& e) {
+      // A full disk refuses this too; the API still reports the suspension from memory.
+      log::warning("executions", record_.id + ": cannot store the suspension: " + e.what());
+    }
   }
   void resumed(const json& how) override {
+    suspension_.reset();
     status_text("condition cleared, going on");
-    store_.set_execution_status(record_, ExecutionStatus::running, "", json{{"resumed_after_suspension", how}});
+    try {
+      store_.set_execution_status(record_, ExecutionStatus::running, "", json{{"resumed_after_suspension", how}});
+    } catch (const Error& e) {
+      log::warning("executions", record_.id + ": cannot store the end of the suspension: " + e.what());
+    }
   }
 
  private:
@@ -91,6 +107,7 @@ class StoreSink final : public campaigns::ExecutionSink {
     return snapshot_;
   }
 
+  std::optional<std::string>& suspension_;
   store::Store& store_;
   const store::ExecutionRecord& record_;
   const campaigns::InstrumentSet& instruments_;
@@ -236,7 +253,7 @@ void Executions::launch(store::ExecutionRecord record, std::shared_ptr<const cam
             // An operator resuming a paused run has looked at the lab: accept the units as they are.
             setup.verify_serials = !accept_units;
           }
-          StoreSink sink(store_, record, instruments_, status_text_, snapshot, resumed && accept_units);
+          StoreSink sink(store_, record, instruments_, status_text_, snapshot, resumed && accept_units, active->suspension);
           outcome = co_await campaigns::run_campaign_script(std::move(setup), lab_, sink, active->control);
         } catch (const Error& e) {
           outcome.kind = campaigns::RunOutcome::Kind::failed;
@@ -290,6 +307,12 @@ void Executions::launch(store::ExecutionRecord record, std::shared_ptr<const cam
         maybe_done();
       },
       asio::detached);
+}
+
+std::optional<std::string> Executions::live_suspension(const std::string& id) const {
+  auto it = active_.find(id);
+  if (it == active_.end()) return std::nullopt;
+  return it->second->suspension;
 }
 
 store::ExecutionRecord Executions::require(const std::string& id) {

@@ -45,6 +45,8 @@ class Executions {
   void shutdown(std::function<void()> done);
 
   std::size_t running() const { return active_.size(); }
+  // The condition a running execution is waiting out, if any (also when the disk could not store it).
+  std::optional<std::string> live_suspension(const std::string& id) const;
 
  private:
   struct Active;

@@ -1,0 +1,190 @@
+// Suspend, not fail: each cause injected into a running execution — an instrument that stops
+// answering (the simulator's LS-110 goes silent), a lamp that goes out (the simulator's cabinet
+// drops D65 for a while), a disk that fills (a size-limited state directory) — suspends it with the
+// right reason; it goes on by itself once the condition has cleared, and the run equals an
+// undisturbed one: every step once, in order, every reading within the simulator's noise.
+#include <sys/mount.h>
+
+#include <cmath>
+#include <fstream>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "colorlab/sim/control_channel.hpp"
+#include "resume_support.hpp"
+
+using namespace colorlab;
+using namespace colorlab::testing;
+using nlohmann::json;
+
+namespace {
+
+constexpr double kTimeScale = 100;
+// Lab seconds: 0.2 s of wall time at the time scale (the engine's floor).
+const char* kSuspendConfig = "[campaigns]\nsuspend_retry_s = 20\nsuspend_settle_s = 20\n";
+
+std::filesystem::path control_socket(const DaemonProcess& daemon) {
+  json endpoint = json::parse(std::ifstream(daemon.state_dir() / "colorlabd.endpoint"));
+  return endpoint.at("simulator_control").get<std::string>();
+}
+
+json control(const DaemonProcess& daemon, const json& command) {
+  json answer = sim::send_control_command(control_socket(daemon), command);
+  EXPECT_TRUE(answer.value("ok", false)) << answer.dump();
+  return answer;
+}
+
+std::size_t measurements_of(const client::ApiClient& api, const json& execution) {
+  return api.get("/v1/runs/" + execution["run_id"].get<std::string>())["measurements"].size();
+}
+
+void wait_for_measurements(const client::ApiClient& api, const json& execution, std::size_t n) {
+  for (int i = 0; i < 600 && measurements_of(api, execution) < n; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  ASSERT_GE(measurements_of(api, execution), n) << "the campaign did not get going";
+}
+
+// Polls until the execution is suspended; returns its reason ("" if it never was).
+std::string wait_suspended(const client::ApiClient& api, const json& execution, std::chrono::seconds timeout) {
+  auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (std::chrono::steady_clock::now() < deadline) {
+    json e = api.get("/v1/executions/" + execution["id"].get<std::string>());
+    if (e["status"] == "suspended") return e.value("reason", std::string("(no reason)"));
+    EXPECT_NE(e["status"], "finished_error") << e.dump(2);
+    if (e["status"] == "finished_error") return "";
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return "";
+}
+
+// Every step exactly once, in order, each reading within 4 σ of the LS-110's noise (plus the 1 % a
+// lamp may still be below full output when the stability criterion accepts it) of the spot's truth.
+void expect_undisturbed(const json& run, const std::string& prefix, int first, int count, double truth, double sigma) {
+  ASSERT_EQ(run["measurements"].size(), static_cast<std::size_t>(count));
+  for (int i = 0; i < count; ++i) {
+    const auto& m = run["measurements"][static_cast<std::size_t>(i)];
+    EXPECT_EQ(m["step"], prefix + std::to_string(first + i));
+    EXPECT_NEAR(m["value"].get<double>(), truth, 4 * sigma + 0.01 * truth) << m["step"];
+  }
+}
+
+TEST(SuspendNotFail, AnInstrumentThatStopsAnsweringSuspendsTheRunUntilItIsBack) {
+  TempDir dir;
+  DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), kTimeScale, 3, kSuspendConfig));
+  auto api = api_for(daemon);
+  auto e = api.post("/v1/executions", {{"campaign", "luminance-spot"}, {"params", {{"readings", 40}, {"interval_s", 5}}}});
+  wait_for_measurements(api, e, 5);
+  control(daemon, {{"cmd", "fault"}, {"instrument", "ls110"}, {"faults", {{"silent", true}}}});
+  std::string reason = wait_suspended(api, e, std::chrono::seconds(60));
+  EXPECT_EQ(reason.rfind("instrument: ", 0), 0u) << reason;
+  // Still suspended while the meter stays silent: the run neither fails nor skips ahead.
+  std::this_thread::sleep_for(std::chrono::seconds(1));
+  EXPECT_EQ(api.get("/v1/executions/" + e["id"].get<std::string>())["status"], "suspended");
+  auto stored = measurements_of(api, e);
+  control(daemon, {{"cmd", "fault"}, {"instrument", "ls110"}, {"faults", {{"silent", false}}}});
+  auto done = wait_terminal(api, e["id"]);
+  ASSERT_EQ(done["status"], "finished_ok") << done.dump(2);
+  EXPECT_LT(stored, 40u) << "the fault came too late to interrupt anything";
+  json truth = control(daemon, {{"cmd", "truth"}});
+  expect_undisturbed(api.get("/v1/runs/" + e["run_id"].get<std::string>()), "reading/", 0, 40,
+                     truth["ls110"]["luminance"], truth["ls110"]["noise_sigma"]);
+  // The suspension and its end are in the event log.
+  bool suspended = false, resumed = false;
+  json log = api.get("/v1/events?topic=execution&limit=300");
+  for (const auto& ev : log["items"]) {
+    suspended = suspended || ev["payload"].value("suspended", false);
+    resumed = resumed || ev["payload"].contains("resumed_after_suspension");
+  }
+  EXPECT_TRUE(suspended) << log.dump();
+  EXPECT_TRUE(resumed);
+  daemon.kill9();
+}
+
+constexpr const char* kSteadyReadings = R"(return {
+  description = "readings under D65, one every 10 s",
+  needs = { "luminance_meter", "lamps" },
+  parameters = { readings = { type = "integer", default = 30, min = 1, max = 1000 } },
+  run = function(p)
+    lab.lamps.select("D65")
+    lab.dimmer.set(100)
+    lab.wait_stable()
+    for i = 1, p.readings do
+      local r = lab.meter.measure()
+      lab.record("r/" .. i, { quantity = "luminance", value = r.luminance, unit = r.unit, instrument = r.instrument })
+      lab.wait(10)
+    end
+    return {}
+  end,
+})";
+
+TEST(SuspendNotFail, ALampThatGoesOutSuspendsTheRunUntilItIsBackAndStable) {
+  TempDir dir;
+  DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), kTimeScale, 3, kSuspendConfig));
+  std::filesystem::create_directories(dir / "state" / "campaigns");
+  std::ofstream(dir / "state" / "campaigns" / "steady.lua") << kSteadyReadings;
+  auto api = api_for(daemon);
+  auto e = api.post("/v1/executions", {{"campaign", "steady"}, {"params", {{"readings", 30}}}});
+  wait_for_measurements(api, e, 4);
+  // Out for 200 lab seconds; it relights cold and must warm up again before readings go on.
+  control(daemon, {{"cmd", "fault"}, {"instrument", "cabinet"}, {"faults", {{"lamp_dropout", {{"lamp", "D65"}, {"seconds", 200}}}}}});
+  std::string reason = wait_suspended(api, e, std::chrono::seconds(30));
+  EXPECT_EQ(reason.rfind("lamp: ", 0), 0u) << reason;
+  auto done = wait_terminal(api, e["id"], std::chrono::seconds(120));
+  ASSERT_EQ(done["status"], "finished_ok") << done.dump(2);
+  json truth = control(daemon, {{"cmd", "truth"}});
+  // No reading in the dark and none of a lamp still warming up: all equal the warm lamp's truth.
+  expect_undisturbed(api.get("/v1/runs/" + e["run_id"].get<std::string>()), "r/", 1, 30, truth["ls110"]["luminance"],
+                     truth["ls110"]["noise_sigma"]);
+  daemon.kill9();
+}
+
+// The state directory on its own small tmpfs, so the test can fill it without touching the machine.
+class SmallStateDir {
+ public:
+  explicit SmallStateDir(const std::filesystem::path& path) : path_(path) {
+    std::filesystem::create_directories(path_);
+    mounted_ = ::mount("tmpfs", path_.c_str(), "tmpfs", 0, "size=24m") == 0;
+  }
+  ~SmallStateDir() {
+    if (mounted_) ::umount2(path_.c_str(), MNT_DETACH);
+  }
+  bool mounted() const { return mounted_; }
+
+ private:
+  std::filesystem::path path_;
+  bool mounted_ = false;
+};
+
+// Writes until the file system refuses; returns the filler's path.
+std::filesystem::path fill(const std::filesystem::path& dir) {
+  auto path = dir / "filler";
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  std::vector<char> block(64 * 1024, 'x');
+  while (f && std::fwrite(block.data(), 1, block.size(), f) == block.size() && std::fflush(f) == 0) {
+  }
+  if (f) std::fclose(f);
+  return path;
+}
+
+TEST(SuspendNotFail, AFullDiskSuspendsTheRunAndNothingIsLost) {
+  TempDir dir;
+  SmallStateDir state(dir / "state");
+  if (!state.mounted()) GTEST_SKIP() << "needs CAP_SYS_ADMIN to mount a size-limited tmpfs for the state directory";
+  DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), kTimeScale, 3, kSuspendConfig));
+  auto api = api_for(daemon);
+  auto e = api.post("/v1/executions", {{"campaign", "luminance-spot"}, {"params", {{"readings", 60}, {"interval_s", 5}}}});
+  wait_for_measurements(api, e, 3);
+  auto filler = fill(dir / "state");
+  std::string reason = wait_suspended(api, e, std::chrono::seconds(60));
+  EXPECT_EQ(reason.rfind("storage: ", 0), 0u) << reason;
+  std::filesystem::remove(filler);
+  auto done = wait_terminal(api, e["id"]);
+  ASSERT_EQ(done["status"], "finished_ok") << done.dump(2);
+  json truth = control(daemon, {{"cmd", "truth"}});
+  expect_undisturbed(api.get("/v1/runs/" + e["run_id"].get<std::string>()), "reading/", 0, 60,
+                     truth["ls110"]["luminance"], truth["ls110"]["noise_sigma"]);
+  daemon.kill9();
+  EXPECT_EQ(integrity_check(daemon.state_dir()), "ok");
+}
+
+}  // namespace
