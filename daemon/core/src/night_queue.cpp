@@ -17,9 +17,8 @@ using store::QueueItemState;
 
 namespace {
 
-std::string short_id(const std::string& id) { return id.substr(0, 8); }
-
-std::string describe_item(const QueueItem& item) { return "item " + short_id(item.id) + " (" + item.campaign + ")"; }
+// The whole id: a UUIDv7's leading digits are its timestamp, alike for items queued together.
+std::string describe_item(const QueueItem& item) { return "item " + item.id + " (" + item.campaign + ")"; }
 
 }  // namespace
 
