@@ -8,6 +8,7 @@
 #include "colorlab/client/api_client.hpp"
 #include "colorlab/core/error.hpp"
 #include "colorlab/protocol/states.hpp"
+#include "client_support.hpp"
 #include "format.hpp"
 
 namespace colorlab::cli {
@@ -15,31 +16,6 @@ namespace colorlab::cli {
 using nlohmann::json;
 
 namespace {
-
-client::ApiClient make_client(const GlobalOptions& g) {
-  client::Endpoint e;
-  if (!g.socket.empty()) {
-    e.unix_socket = g.socket;
-  } else {
-    e = client::Endpoint::from_url(g.url);
-  }
-  return client::ApiClient(e);
-}
-
-void print(const GlobalOptions& g, const json& j, std::string (*human)(const json&)) {
-  if (g.json) {
-    std::cout << j.dump(2) << "\n";
-  } else {
-    std::cout << human(j);
-  }
-}
-
-// key=value → JSON value: numbers and booleans as such, everything else a string.
-json parse_param_value(const std::string& text) {
-  auto j = json::parse(text, nullptr, false);
-  if (!j.is_discarded() && (j.is_number() || j.is_boolean() || j.is_array() || j.is_object())) return j;
-  return text;
-}
 
 struct RunOptions {
   std::string campaign;
@@ -51,14 +27,7 @@ struct RunOptions {
 
 int run_campaign(const GlobalOptions& g, const RunOptions& o) {
   auto api = make_client(g);
-  json params = json::object();
-  for (const auto& p : o.params) {
-    auto eq = p.find('=');
-    if (eq == std::string::npos || eq == 0) {
-      throw Error(ErrorClass::bad_parameter, "--param '" + p + "' is not KEY=VALUE");
-    }
-    params[p.substr(0, eq)] = parse_param_value(p.substr(eq + 1));
-  }
+  json params = parse_params(o.params);
   std::map<std::string, std::string> headers;
   if (!o.idempotency_key.empty()) headers["Idempotency-Key"] = o.idempotency_key;
   json execution = api.post("/v1/executions", {{"campaign", o.campaign}, {"params", params}}, headers);

@@ -138,4 +138,51 @@ std::string format_requests(const json& list) {
   return out;
 }
 
+std::string format_queue_item(const json& q) {
+  std::ostringstream o;
+  o << str(q, "id") << "  " << str(q, "campaign") << "  " << str(q, "state");
+  if (q.contains("position") && q["position"].is_number()) o << " at position " << q["position"].dump();
+  o << "  on failure: " << str(q, "on_failure");
+  if (q.contains("params") && !q["params"].empty()) o << "  params " << q["params"].dump();
+  if (q.contains("execution_id") && !q["execution_id"].is_null()) o << "\n    execution " << str(q, "execution_id");
+  if (!q.value("reason", std::string()).empty()) o << "\n    " << q["reason"].get<std::string>();
+  o << "\n";
+  return o.str();
+}
+
+std::string format_queue(const json& queue) {
+  std::ostringstream o;
+  o << "queue " << str(queue, "state");
+  if (!queue.value("reason", std::string()).empty()) o << " — " << queue["reason"].get<std::string>();
+  if (queue.value("autostart", false)) o << "  (autostart)";
+  o << "\n";
+  const auto& current = queue["current"];
+  if (current.is_object()) {
+    o << "  now  " << str(current, "id") << "  " << str(current, "campaign") << "  execution "
+      << str(current, "execution_id") << " " << str(current, "execution_status") << "\n";
+  }
+  if (queue.contains("waiting_for") && !queue["waiting_for"].is_null()) {
+    o << "  waiting for execution " << str(queue, "waiting_for") << " to end\n";
+  }
+  bool any = false;
+  for (const auto& q : queue["items"]) {
+    if (q.value("state", std::string()) != "queued") continue;
+    any = true;
+    o << "  " << str(q, "position") << "    " << str(q, "id") << "  " << str(q, "campaign") << "  on failure: "
+      << str(q, "on_failure");
+    if (!q["params"].empty()) o << "  " << q["params"].dump();
+    o << "\n";
+  }
+  if (!any) o << "  nothing queued\n";
+  if (queue.contains("history") && !queue["history"].empty()) {
+    o << "recent:\n";
+    for (const auto& q : queue["history"]) {
+      o << "  " << str(q, "id") << "  " << str(q, "campaign") << "  " << str(q, "state") << "  " << str(q, "updated_at");
+      if (!q.value("reason", std::string()).empty()) o << "  (" << q["reason"].get<std::string>() << ")";
+      o << "\n";
+    }
+  }
+  return o.str();
+}
+
 }  // namespace colorlab::cli

@@ -14,5 +14,7 @@ std::string format_run(const nlohmann::json& run);
 std::string format_execution(const nlohmann::json& execution);
 std::string format_request(const nlohmann::json& request);
 std::string format_requests(const nlohmann::json& list);
+std::string format_queue(const nlohmann::json& queue);
+std::string format_queue_item(const nlohmann::json& item);
 
 }  // namespace colorlab::cli

@@ -7,6 +7,7 @@
 #include "colorlab/client/api_client.hpp"
 #include "colorlab/core/error.hpp"
 #include "commands.hpp"
+#include "queue_commands.hpp"
 #ifdef COLORLAB_HAVE_ANALYZE
 #include "colorlab/cli/analyze_command.hpp"
 #endif
@@ -20,6 +21,7 @@ int main(int argc, char** argv) {
   app.add_option("--socket", global.socket, "daemon Unix socket (instead of --url)")->envname("COLORLAB_SOCKET");
   app.add_flag("--json", global.json, "print JSON instead of text");
   colorlab::cli::add_daemon_commands(app, global);
+  colorlab::cli::add_queue_commands(app, global);
 #ifdef COLORLAB_HAVE_ANALYZE
   colorlab::cli::add_analyze_command(app);
 #endif

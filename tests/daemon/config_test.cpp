@@ -68,3 +68,21 @@ TEST(DaemonConfig, ErrorsNameFileAndLine) {
   std::ofstream(dir / "noport.toml") << "[[instrument]]\nid = \"x\"\nkind = \"ls110\"\n";
   EXPECT_THROW(load_config(dir / "noport.toml"), Error);
 }
+
+TEST(DaemonConfig, QueueAutostartIsOffUnlessSaidAndOtherQueueKeysAreRefused) {
+  colorlab::testing::TempDir dir;
+  std::ofstream(dir / "none.toml") << "listen = \"127.0.0.1:1\"\n";
+  EXPECT_FALSE(load_config(dir / "none.toml").queue.autostart);
+  std::ofstream(dir / "on.toml") << "[queue]\nautostart = true\n";
+  EXPECT_TRUE(load_config(dir / "on.toml").queue.autostart);
+  std::ofstream(dir / "typo.toml") << "[queue]\nautostart = \"yes\"\n";
+  EXPECT_THROW(load_config(dir / "typo.toml"), Error);
+  std::ofstream(dir / "unknown.toml") << "[queue]\n\nretries = 2\n";
+  try {
+    load_config(dir / "unknown.toml");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown.toml:3"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("queue.retries"), std::string::npos) << e.what();
+  }
+}

@@ -127,4 +127,6 @@ nlohmann::json ApiClient::post(const std::string& target, const nlohmann::json& 
   return expect_json(request("POST", target, body.dump(), headers));
 }
 
+nlohmann::json ApiClient::del(const std::string& target) const { return expect_json(request("DELETE", target)); }
+
 }  // namespace colorlab::client

@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include "colorlab/core/error.hpp"
+#include "colorlab/daemon/queue_api.hpp"
 #include "colorlab/protocol/api.hpp"
 #include "colorlab/protocol/problem.hpp"
 
@@ -52,7 +53,7 @@ unsigned page_limit(const HttpRequest& req) {
 HttpResponse get_root(ApiContext& ctx) {
   json features = json::array({"instruments", "ports", "events", "campaigns", "lua-campaigns", "executions",
                                "execution-control", "resume-after-restart", "runs", "run-script", "problem+json",
-                               "cursor-paging", "idempotency-key", "operator-requests"});
+                               "cursor-paging", "idempotency-key", "operator-requests", "queue"});
   return HttpResponse::json(200, {{"server", "colorlabd"},
                                   {"server_version", COLORLAB_VERSION},
                                   {"api_version", protocol::kApiVersion},
@@ -252,6 +253,7 @@ HttpResponse handle_api(ApiContext& ctx, const HttpRequest& req) {
         }
       }
     }
+    if (auto queue = handle_queue_api(ctx, req)) return *queue;
     if (p == prefix + "/runs") {
       if (req.method != "GET") return method_not_allowed(req, "GET");
       return get_runs(ctx, req);

@@ -138,6 +138,19 @@ DaemonConfig load_config(const std::filesystem::path& file) {
           bad(file, cnode.source(), "unknown key 'campaigns." + ck + "'");
         }
       }
+    } else if (k == "queue") {
+      auto t = node.as_table();
+      if (!t) bad(file, node.source(), "[queue] must be a table");
+      for (const auto& [qkey, qnode] : *t) {
+        std::string qk(qkey.str());
+        if (qk == "autostart") {
+          auto v = qnode.value<bool>();
+          if (!v) bad(file, qnode.source(), "queue.autostart must be true or false");
+          c.queue.autostart = *v;
+        } else {
+          bad(file, qnode.source(), "unknown key 'queue." + qk + "'");
+        }
+      }
     } else if (k == "instrument") {
       auto arr = node.as_array();
       if (!arr) bad(file, node.source(), "instruments are [[instrument]] tables");

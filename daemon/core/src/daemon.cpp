@@ -20,6 +20,7 @@
 #include "colorlab/daemon/embedded_sim.hpp"
 #include "colorlab/daemon/executions.hpp"
 #include "colorlab/daemon/simulator_hands.hpp"
+#include "colorlab/daemon/night_queue.hpp"
 #include "store_run_reader.hpp"
 #include "colorlab/daemon/systemd_notify.hpp"
 #include "colorlab/drivers/discovery_monitor.hpp"
@@ -41,6 +42,7 @@ struct Daemon::Impl {
   std::unique_ptr<SimulatorHands> hands;
   std::unique_ptr<StoreRunReader> run_reader;  // lab.runs.* (characterize-camera's reference)
   std::unique_ptr<Executions> executions;
+  std::unique_ptr<NightQueue> queue;
   std::unique_ptr<ApiContext> api;
   std::unique_ptr<http::Server> server;
   std::unique_ptr<drivers::Discovery> discovery;
@@ -154,9 +156,11 @@ Daemon::Daemon(DaemonConfig config) : impl_(std::make_unique<Impl>()) {
   d.executions = std::make_unique<Executions>(d.io, *d.store, *d.catalogue, d.instruments, *d.lab,
                                               ExecutionOptions{cc.max_resume_attempts},
                                               [&d](const std::string& text) { d.notifier.status(text); });
+  d.queue = std::make_unique<NightQueue>(d.io, *d.store, *d.executions, *d.catalogue, *d.lab,
+                                         QueueOptions{d.config.queue.autostart});
   d.api = std::make_unique<ApiContext>(ApiContext{*d.store, d.instruments, *d.catalogue, *d.executions,
                                                   d.config.simulator.enabled, now_iso8601(), d.discovery.get(), "",
-                                                  &d.desk});
+                                                  &d.desk, d.queue.get()});
 
   http::ServerOptions so;
   so.tcp_host = d.config.listen_host;
@@ -211,6 +215,8 @@ int Daemon::run() {
   // Executions left by a previous process (crash, power cut, shutdown) continue by themselves.
   // After discovery's first scan, so instruments are already connecting when a resume needs them.
   d.executions->resume_unfinished();
+  // Then the queue: it follows the item whose execution was just resumed instead of starting it again.
+  d.queue->start_up();
 
   asio::signal_set signals(d.io, SIGINT, SIGTERM);
   signals.async_wait([&](boost::system::error_code ec, int sig) {
@@ -219,6 +225,7 @@ int Daemon::run() {
     d.notifier.stopping();
     d.server->stop();
     d.monitor->stop();
+    d.queue->shutdown();  // starts nothing more; stays started in the store for the next daemon
     // Running steps finish (or their waits are cut short), then the instruments go to a safe state.
     d.executions->shutdown([&d] {
       asio::co_spawn(

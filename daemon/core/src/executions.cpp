@@ -10,6 +10,7 @@
 #include "colorlab/campaigns/engine.hpp"
 #include "colorlab/core/error.hpp"
 #include "colorlab/core/log.hpp"
+#include "colorlab/daemon/campaign_request.hpp"
 #include "colorlab/protocol/problem.hpp"
 
 namespace colorlab::daemon {
@@ -151,15 +152,7 @@ Executions::~Executions() = default;
 store::ExecutionRecord Executions::start(const std::string& campaign_name, const json& params,
                                          const std::optional<std::string>& idempotency_key) {
   if (shutting_down_) throw Error(ErrorClass::conflict, "colorlabd is shutting down", "start the campaign after it restarts");
-  catalogue_.refresh();
-  auto script = catalogue_.find(campaign_name);
-  if (!script) {
-    std::string names;
-    for (const auto& c : catalogue_.all()) names += (names.empty() ? "" : ", ") + c->name;
-    throw Error(ErrorClass::not_found, "no campaign named '" + campaign_name + "'", "campaigns: " + names);
-  }
-  json normalized = script->validate(params);
-  lab_.check_needs(script->needs);
+  auto [script, normalized] = validate_campaign_request(catalogue_, lab_, campaign_name, params);
 
   store::NewRun run;
   run.campaign = campaign_name;

@@ -86,6 +86,35 @@ CREATE TABLE journal (
 ) WITHOUT ROWID;
 CREATE INDEX executions_unfinished ON executions(status) WHERE status IN ('waiting', 'running', 'paused', 'suspended');
 )sql",
+    // 2 -> 3: the night's queue: executions waiting their turn, each with its on-failure policy,
+    // and whether the queue runs (one row), so both outlive the daemon.
+    R"sql(
+CREATE TABLE queue_items (
+  id              TEXT PRIMARY KEY,                -- UUIDv7
+  position        INTEGER,                         -- 1..N among the queued items; NULL once it left the queue
+  campaign        TEXT NOT NULL,
+  params          TEXT NOT NULL,                   -- JSON, validated at enqueue, defaults filled in
+  on_failure      TEXT NOT NULL CHECK (on_failure IN ('stop', 'continue')),
+  state           TEXT NOT NULL CHECK (state IN ('queued', 'running', 'done', 'failed', 'skipped', 'removed')),
+  execution_id    TEXT REFERENCES executions(id),  -- once started
+  reason          TEXT NOT NULL DEFAULT '',        -- why it failed, was skipped or removed
+  idempotency_key TEXT UNIQUE,                     -- a retried enqueue returns the same item
+  created_at      TEXT NOT NULL,
+  updated_at      TEXT NOT NULL,
+  started_at      TEXT,
+  finished_at     TEXT
+);
+CREATE INDEX queue_items_pending ON queue_items(state, position) WHERE state IN ('queued', 'running');
+CREATE TABLE queue_state (
+  id          INTEGER PRIMARY KEY CHECK (id = 1),  -- exactly one row
+  started     INTEGER NOT NULL,                    -- 1: starts the next item whenever the lab is free
+  halted      INTEGER NOT NULL,                    -- 1: an item failed with on_failure = stop
+  reason      TEXT NOT NULL,                       -- why it stopped
+  updated_at  TEXT NOT NULL
+);
+INSERT INTO queue_state (id, started, halted, reason, updated_at)
+  VALUES (1, 0, 0, '', strftime('%Y-%m-%dT%H:%M:%fZ', 'now'));
+)sql",
 };
 
 int read_pragma_int(Database& db, const char* pragma) {

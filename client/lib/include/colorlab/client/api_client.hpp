@@ -49,6 +49,7 @@ class ApiClient {
   nlohmann::json get(const std::string& target) const;
   nlohmann::json post(const std::string& target, const nlohmann::json& body,
                       const std::map<std::string, std::string>& headers = {}) const;
+  nlohmann::json del(const std::string& target) const;  // DELETE
 
   const Endpoint& endpoint() const { return endpoint_; }
 

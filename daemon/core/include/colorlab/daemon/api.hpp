@@ -13,6 +13,8 @@
 
 namespace colorlab::daemon {
 
+class NightQueue;
+
 struct ApiContext {
   store::Store& store;
   const campaigns::InstrumentSet& instruments;
@@ -23,6 +25,7 @@ struct ApiContext {
   const drivers::Discovery* discovery = nullptr;
   std::string hotplug_status;
   campaigns::OperatorDesk* desk = nullptr;
+  NightQueue* queue = nullptr;  // /v1/queue (queue_api.cpp)
 };
 
 http::HttpResponse handle_api(ApiContext& ctx, const http::HttpRequest& req);

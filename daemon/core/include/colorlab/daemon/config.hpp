@@ -35,6 +35,11 @@ struct CampaignConfig {
   double time_scale = 1;             // lab seconds per wall second for an external simulated lab
 };
 
+// [queue]: the night's queue (docs/campaigns.md, "A night's queue").
+struct QueueConfig {
+  bool autostart = false;  // start the queue with the daemon (unless a failed item halted it)
+};
+
 struct DaemonConfig {
   std::filesystem::path state_dir = "./colorlab-state";
   std::string listen_host = "127.0.0.1";
@@ -43,6 +48,7 @@ struct DaemonConfig {
   std::vector<drivers::InstrumentConfig> instruments;
   SimulatorConfig simulator;
   CampaignConfig campaigns;
+  QueueConfig queue;
 
   std::filesystem::path database_path() const;
   std::filesystem::path socket_path() const;

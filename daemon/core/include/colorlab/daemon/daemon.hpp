@@ -1,5 +1,5 @@
 #pragma once
-// colorlabd assembled: store, instruments, campaigns, executions, HTTP server, systemd.
+// colorlabd assembled: store, instruments, campaigns, executions, the night's queue, HTTP server, systemd.
 // Everything runs on one io_context thread; SQLite and the drivers are used from it only.
 #include <memory>
 #include <string>

@@ -175,6 +175,8 @@ class Store {
   int interrupted_at_open() const { return interrupted_at_open_; }
 
  private:
+  // The queue's rows live in their own file and share this connection (one writer, one thread).
+  friend class QueueStore;
   RunRecord read_run(Statement& st);
   ExecutionRecord read_execution(Statement& st);
 

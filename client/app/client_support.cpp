@@ -1,0 +1,52 @@
+#include "client_support.hpp"
+
+#include <iostream>
+
+#include "colorlab/core/error.hpp"
+
+namespace colorlab::cli {
+
+using nlohmann::json;
+
+client::ApiClient make_client(const GlobalOptions& g) {
+  client::Endpoint e;
+  if (!g.socket.empty()) {
+    e.unix_socket = g.socket;
+  } else {
+    e = client::Endpoint::from_url(g.url);
+  }
+  return client::ApiClient(e);
+}
+
+void print(const GlobalOptions& g, const json& j, std::string (*human)(const json&)) {
+  if (g.json) {
+    std::cout << j.dump(2) << "\n";
+  } else {
+    std::cout << human(j);
+  }
+}
+
+namespace {
+
+// key=value → JSON value: numbers and booleans as such, everything else a string.
+json parse_param_value(const std::string& text) {
+  auto j = json::parse(text, nullptr, false);
+  if (!j.is_discarded() && (j.is_number() || j.is_boolean() || j.is_array() || j.is_object())) return j;
+  return text;
+}
+
+}  // namespace
+
+json parse_params(const std::vector<std::string>& entries) {
+  json params = json::object();
+  for (const auto& p : entries) {
+    auto eq = p.find('=');
+    if (eq == std::string::npos || eq == 0) {
+      throw Error(ErrorClass::bad_parameter, "--param '" + p + "' is not KEY=VALUE");
+    }
+    params[p.substr(0, eq)] = parse_param_value(p.substr(eq + 1));
+  }
+  return params;
+}
+
+}  // namespace colorlab::cli

@@ -1,0 +1,78 @@
+#pragma once
+// The night's queue (issue 9; Bluesky's queue server, daemon-design-notes §2.4): executions that
+// wait their turn, stored so that the queue outlives the daemon. While the queue is started it
+// starts the next item whenever no execution is unfinished (a paused or suspended run holds the
+// lab as much as a running one), follows the item's execution through the store to its end, and
+// applies the item's on-failure policy. It starts each execution under an idempotency key made
+// from the item's id, so a daemon killed at any moment neither loses an item nor starts one twice:
+// after a restart the engine resumes the running item's execution and the queue simply follows it.
+#include <chrono>
+#include <optional>
+#include <string>
+
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/steady_timer.hpp>
+#include <nlohmann/json.hpp>
+
+#include "colorlab/campaigns/catalogue.hpp"
+#include "colorlab/campaigns/lab.hpp"
+#include "colorlab/daemon/executions.hpp"
+#include "colorlab/store/queue.hpp"
+#include "colorlab/store/store.hpp"
+
+namespace colorlab::daemon {
+
+struct QueueOptions {
+  bool autostart = false;  // [queue] autostart: start the queue with the daemon
+  // How often the store is looked at for the running item's end. Executions end at most a few
+  // times a night; a quarter second costs one indexed read and keeps the lab idle only briefly.
+  std::chrono::milliseconds poll_interval{250};
+};
+
+class NightQueue {
+ public:
+  NightQueue(boost::asio::io_context& io, store::Store& store, Executions& executions,
+             campaigns::ScriptCatalogue& catalogue, const campaigns::Lab& lab, QueueOptions options);
+
+  // At daemon start, after Executions::resume_unfinished: adopts executions a killed daemon
+  // started but did not record, applies autostart, and begins following the lab.
+  void start_up();
+  // SIGTERM: starts nothing more. The queue stays started in the store, so the next daemon goes on.
+  void shutdown();
+
+  // Validated exactly as Executions::start validates (400/404 before anything is stored).
+  store::QueueStore::Enqueued enqueue(const std::string& campaign, const nlohmann::json& params,
+                                      store::OnFailure on_failure, const std::optional<std::string>& idempotency_key);
+  store::QueueItem remove(const std::string& id);
+  store::QueueItem move(const std::string& id, std::int64_t position);
+  store::QueueItem item(const std::string& id);
+  // start: runs items from the next queued one on (clears a halt). stop: starts no further item;
+  // the running one goes on to its end.
+  void start();
+  void stop();
+
+  // {state: running|stopping|stopped, reason, halted, autostart, current, waiting_for, items, history}
+  nlohmann::json describe(unsigned history_limit);
+
+ private:
+  void schedule();
+  void poke();
+  void step();
+  // Ends the running item once its execution has ended; true while it still holds the queue.
+  bool follow_running();
+  void start_next();
+  void after_failure(const store::QueueItem& item);
+
+  boost::asio::io_context& io_;
+  store::Store& store_;
+  store::QueueStore queue_;
+  Executions& executions_;
+  campaigns::ScriptCatalogue& catalogue_;
+  const campaigns::Lab& lab_;
+  QueueOptions options_;
+  boost::asio::steady_timer timer_;
+  std::optional<std::string> waiting_for_;  // an execution not from the queue that holds the lab
+  bool stopped_ = true;
+};
+
+}  // namespace colorlab::daemon

@@ -1,0 +1,210 @@
+#include "colorlab/daemon/night_queue.hpp"
+
+#include <boost/asio/post.hpp>
+
+#include "colorlab/core/error.hpp"
+#include "colorlab/core/log.hpp"
+#include "colorlab/daemon/campaign_request.hpp"
+#include "colorlab/protocol/states.hpp"
+
+namespace colorlab::daemon {
+
+namespace asio = boost::asio;
+using nlohmann::json;
+using protocol::ExecutionStatus;
+using store::QueueItem;
+using store::QueueItemState;
+
+namespace {
+
+// The whole id: a UUIDv7's leading digits are its timestamp, alike for items queued together.
+std::string describe_item(const QueueItem& item) { return "item " + item.id + " (" + item.campaign + ")"; }
+
+}  // namespace
+
+NightQueue::NightQueue(asio::io_context& io, store::Store& store, Executions& executions,
+                       campaigns::ScriptCatalogue& catalogue, const campaigns::Lab& lab, QueueOptions options)
+    : io_(io),
+      store_(store),
+      queue_(store),
+      executions_(executions),
+      catalogue_(catalogue),
+      lab_(lab),
+      options_(options),
+      timer_(io) {}
+
+void NightQueue::start_up() {
+  int adopted = queue_.adopt_started_executions();
+  if (adopted > 0) log::info("queue", std::to_string(adopted) + " item(s) found already started by the previous process");
+  auto status = queue_.status();
+  if (!status.started && options_.autostart) {
+    // A queue halted by a failed item waits for a person even with autostart: starting it again
+    // unattended would defeat the item's on_failure = stop.
+    if (status.halted) {
+      log::warning("queue", "not started despite [queue] autostart: " + status.reason + " (colorlab queue start)");
+    } else {
+      queue_.set_status(true, false, "started with colorlabd ([queue] autostart)");
+    }
+  }
+  auto pending = queue_.pending();
+  log::info("queue", std::string(queue_.status().started ? "started" : "stopped") + ", " +
+                         std::to_string(pending.size()) + " item(s) pending");
+  stopped_ = false;
+  poke();
+  schedule();
+}
+
+void NightQueue::shutdown() {
+  stopped_ = true;
+  timer_.cancel();
+}
+
+void NightQueue::schedule() {
+  if (stopped_) return;
+  timer_.expires_after(options_.poll_interval);
+  timer_.async_wait([this](boost::system::error_code ec) {
+    if (ec || stopped_) return;
+    step();
+    schedule();
+  });
+}
+
+// A change a client made is acted on at once rather than at the next poll.
+void NightQueue::poke() {
+  asio::post(io_, [this] {
+    if (!stopped_) step();
+  });
+}
+
+void NightQueue::step() {
+  try {
+    if (follow_running()) return;
+    start_next();
+  } catch (const Error& e) {
+    // Storage trouble: nothing was half done (every change is one transaction); look again later.
+    log::warning("queue", std::string("cannot advance the queue: ") + e.what());
+  }
+}
+
+bool NightQueue::follow_running() {
+  bool holds = false;
+  for (const auto& item : queue_.pending()) {
+    if (item.state != QueueItemState::running) break;  // running items come first
+    std::optional<store::ExecutionRecord> execution;
+    if (item.execution_id) execution = store_.execution(*item.execution_id);
+    if (!execution) {
+      auto failed = queue_.finish(item.id, QueueItemState::failed, "its execution is missing from the store");
+      after_failure(failed);
+      continue;
+    }
+    if (!protocol::is_terminal(execution->status)) {
+      holds = true;  // running, or paused / suspended: it holds the queue until it ends
+      continue;
+    }
+    if (execution->status == ExecutionStatus::finished_ok) {
+      queue_.finish(item.id, QueueItemState::done, "");
+      log::info("queue", describe_item(item) + " done");
+      continue;
+    }
+    std::string why = "execution " + execution->id + " " + std::string(protocol::to_string(execution->status)) +
+                      (execution->reason.empty() ? "" : ": " + execution->reason);
+    auto failed = queue_.finish(item.id, QueueItemState::failed, why);
+    log::warning("queue", describe_item(item) + " failed: " + why);
+    after_failure(failed);
+  }
+  return holds;
+}
+
+void NightQueue::after_failure(const QueueItem& item) {
+  if (item.on_failure != store::OnFailure::stop) return;
+  std::string why = describe_item(item) + " " + std::string(store::to_string(item.state)) + " (" + item.reason +
+                    "); its on_failure is stop";
+  queue_.set_status(false, true, why);
+  log::warning("queue", "halted: " + why + "; colorlab queue start goes on with the next item");
+}
+
+void NightQueue::start_next() {
+  if (!queue_.status().started) return;
+  // The lab has one set of instruments: any unfinished execution, from the queue or not, holds it.
+  auto unfinished = store_.unfinished_executions();
+  if (!unfinished.empty()) {
+    waiting_for_ = unfinished.front().id;
+    return;
+  }
+  waiting_for_.reset();
+  // An item whose execution a killed daemon started but never recorded is that execution's, not a new one.
+  if (queue_.adopt_started_executions() > 0) return;
+  auto next = queue_.next_queued();
+  if (!next) return;
+  try {
+    auto execution = executions_.start(next->campaign, next->params, store::queue_execution_key(next->id));
+    queue_.mark_running(next->id, execution.id);
+    log::info("queue", describe_item(*next) + " started as execution " + execution.id);
+  } catch (const Error& e) {
+    if (e.cls() == ErrorClass::io_error) throw;  // the disk, not the item: try again at the next poll
+    // The script was removed or edited since the item was queued, or an instrument it needs is gone.
+    std::string why = std::string("could not start: ") + e.what() + (e.hint().empty() ? "" : " (" + e.hint() + ")");
+    auto skipped = queue_.finish(next->id, QueueItemState::skipped, why);
+    log::warning("queue", describe_item(*next) + " skipped: " + why);
+    after_failure(skipped);
+  }
+}
+
+store::QueueStore::Enqueued NightQueue::enqueue(const std::string& campaign, const json& params,
+                                                store::OnFailure on_failure,
+                                                const std::optional<std::string>& idempotency_key) {
+  auto request = validate_campaign_request(catalogue_, lab_, campaign, params);
+  auto enqueued = queue_.enqueue({campaign, request.params, on_failure, idempotency_key});
+  if (enqueued.created) poke();
+  return enqueued;
+}
+
+QueueItem NightQueue::remove(const std::string& id) { return queue_.remove(id); }
+
+QueueItem NightQueue::move(const std::string& id, std::int64_t position) { return queue_.move(id, position); }
+
+QueueItem NightQueue::item(const std::string& id) {
+  auto q = queue_.item(id);
+  if (!q) throw Error(ErrorClass::not_found, "no queue item with id '" + id + "'", "colorlab queue list shows the queue");
+  return *q;
+}
+
+void NightQueue::start() {
+  auto status = queue_.status();
+  if (!status.started) queue_.set_status(true, false, "started by a client");
+  poke();
+}
+
+void NightQueue::stop() {
+  auto status = queue_.status();
+  if (status.started) queue_.set_status(false, false, "stopped by a client");
+}
+
+json NightQueue::describe(unsigned history_limit) {
+  auto status = queue_.status();
+  json items = json::array();
+  json current = nullptr;
+  for (const auto& item : queue_.pending()) {
+    json j = item.to_json();
+    if (item.state == QueueItemState::running && current.is_null()) {
+      auto execution = item.execution_id ? store_.execution(*item.execution_id) : std::nullopt;
+      j["execution_status"] = execution ? json(protocol::to_string(execution->status)) : json(nullptr);
+      current = j;
+    }
+    items.push_back(j);
+  }
+  json history = json::array();
+  for (const auto& item : queue_.history(history_limit)) history.push_back(item.to_json());
+  std::string state = status.started ? "running" : current.is_null() ? "stopped" : "stopping";
+  return {{"state", state},
+          {"reason", status.reason},
+          {"halted", status.halted},
+          {"autostart", options_.autostart},
+          {"updated_at", status.updated_at},
+          {"current", current},
+          {"waiting_for", status.started && current.is_null() && waiting_for_ ? json(*waiting_for_) : json(nullptr)},
+          {"items", items},
+          {"history", history}};
+}
+
+}  // namespace colorlab::daemon

@@ -1,0 +1,130 @@
+#include "colorlab/daemon/queue_api.hpp"
+
+#include <variant>
+
+#include <nlohmann/json.hpp>
+
+#include "colorlab/core/error.hpp"
+#include "colorlab/daemon/night_queue.hpp"
+#include "colorlab/protocol/api.hpp"
+
+namespace colorlab::daemon {
+
+using http::HttpRequest;
+using http::HttpResponse;
+using nlohmann::json;
+
+namespace {
+
+constexpr unsigned kDefaultHistory = 20;
+
+HttpResponse method_not_allowed(const HttpRequest& req, const std::string& allowed) {
+  auto r = HttpResponse::problem(405, "method-not-allowed", "Method not allowed",
+                                 req.method + " is not allowed on " + req.path, "allowed: " + allowed);
+  r.headers["Allow"] = allowed;
+  return r;
+}
+
+// The JSON object a POST carries, or the problem to answer with.
+std::variant<json, HttpResponse> json_body(const HttpRequest& req, const std::string& example) {
+  auto ct = req.header("content-type").value_or("");
+  if (ct.rfind("application/json", 0) != 0) {
+    return HttpResponse::problem(415, "unsupported-media-type", "Unsupported media type",
+                                 req.method + " " + req.path + " takes application/json, got '" + ct + "'");
+  }
+  json body = json::parse(req.body, nullptr, false);
+  if (body.is_discarded()) return HttpResponse::problem(400, "bad-json", "Malformed JSON", "the request body is not valid JSON");
+  if (!body.is_object()) {
+    return HttpResponse::problem(400, "bad-request", "Invalid request", "the body must be a JSON object", "e.g. " + example);
+  }
+  return body;
+}
+
+unsigned history_limit(const HttpRequest& req) {
+  auto it = req.query.find("history");
+  if (it == req.query.end()) return kDefaultHistory;
+  try {
+    std::size_t used = 0;
+    long v = std::stol(it->second, &used);
+    if (used != it->second.size() || v < 0 || v > static_cast<long>(protocol::kMaxPageLimit)) throw std::out_of_range("history");
+    return static_cast<unsigned>(v);
+  } catch (const std::exception&) {
+    throw Error(ErrorClass::bad_parameter, "history must be an integer from 0 to " + std::to_string(protocol::kMaxPageLimit),
+                "how many ended items to list, most recent first");
+  }
+}
+
+HttpResponse item_response(int status, const store::QueueItem& item) {
+  auto r = HttpResponse::json(status, item.to_json());
+  r.headers["Location"] = std::string(protocol::kPrefix) + "/queue/" + item.id;
+  return r;
+}
+
+HttpResponse post_item(NightQueue& queue, const HttpRequest& req) {
+  const std::string example = R"({"campaign": "luminance-spot", "params": {"readings": 3}, "on_failure": "continue"})";
+  auto parsed = json_body(req, example);
+  if (auto* problem = std::get_if<HttpResponse>(&parsed)) return *problem;
+  const json& body = std::get<json>(parsed);
+  if (!body.contains("campaign") || !body["campaign"].is_string()) {
+    throw Error(ErrorClass::bad_parameter, "the body needs a string 'campaign'", "e.g. " + example);
+  }
+  json params = body.value("params", json::object());
+  if (!params.is_object()) throw Error(ErrorClass::bad_parameter, "'params' must be an object", "e.g. " + example);
+  auto on_failure = store::OnFailure::stop;
+  if (body.contains("on_failure")) {
+    if (!body["on_failure"].is_string()) throw Error(ErrorClass::bad_parameter, "'on_failure' must be \"stop\" or \"continue\"");
+    on_failure = store::on_failure_from_string(body["on_failure"].get<std::string>());
+  }
+  auto enqueued = queue.enqueue(body["campaign"].get<std::string>(), params, on_failure, req.header("idempotency-key"));
+  // A retried POST with the same Idempotency-Key answers with the item it created the first time.
+  return item_response(enqueued.created ? 201 : 200, enqueued.item);
+}
+
+HttpResponse post_move(NightQueue& queue, const HttpRequest& req, const std::string& id) {
+  auto parsed = json_body(req, R"({"position": 1})");
+  if (auto* problem = std::get_if<HttpResponse>(&parsed)) return *problem;
+  const json& body = std::get<json>(parsed);
+  if (!body.contains("position") || !body["position"].is_number_integer()) {
+    throw Error(ErrorClass::bad_parameter, "the body needs an integer 'position'", "1 runs next, e.g. {\"position\": 1}");
+  }
+  return item_response(200, queue.move(id, body["position"].get<std::int64_t>()));
+}
+
+}  // namespace
+
+std::optional<HttpResponse> handle_queue_api(ApiContext& ctx, const HttpRequest& req) {
+  const std::string base = std::string(protocol::kPrefix) + "/queue";
+  const std::string& p = req.path;
+  if (p != base && p.rfind(base + "/", 0) != 0) return std::nullopt;
+  if (!ctx.queue) throw Error(ErrorClass::internal, "the night's queue is not running in this daemon");
+  NightQueue& queue = *ctx.queue;
+
+  if (p == base || p == base + "/") {
+    if (req.method == "GET") return HttpResponse::json(200, queue.describe(history_limit(req)));
+    if (req.method == "POST") return post_item(queue, req);
+    return method_not_allowed(req, "GET, POST");
+  }
+  std::string rest = p.substr(base.size() + 1);
+  if (rest == "start" || rest == "stop") {
+    if (req.method != "POST") return method_not_allowed(req, "POST");
+    if (rest == "start") {
+      queue.start();
+    } else {
+      queue.stop();
+    }
+    return HttpResponse::json(200, queue.describe(kDefaultHistory));
+  }
+  auto slash = rest.find('/');
+  if (slash == std::string::npos) {
+    if (req.method == "GET") return item_response(200, queue.item(rest));
+    if (req.method == "DELETE") return item_response(200, queue.remove(rest));
+    return method_not_allowed(req, "GET, DELETE");
+  }
+  if (slash > 0 && rest.substr(slash + 1) == "move") {
+    if (req.method != "POST") return method_not_allowed(req, "POST");
+    return post_move(queue, req, rest.substr(0, slash));
+  }
+  return std::nullopt;  // handle_api answers 404 with its hint
+}
+
+}  // namespace colorlab::daemon
