@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "colorlab/client/api_client.hpp"
 #include "colorlab/testing/process.hpp"
 #include "lab_fixture.hpp"
 
@@ -80,19 +81,37 @@ TEST(ThinPath, MeterOverRangeBecomesATypedErrorWithAHint) {
   EXPECT_EQ(lab.cli({"run", "luminance-spot"}).exit_code, 0);
 }
 
-TEST(ThinPath, SilentMeterNeedsAnOperatorAndNeverHangs) {
+// A silent meter is a condition an unattended night waits out (docs/campaigns.md, "suspend, not
+// fail"): the run is suspended within the driver's timeouts with the typed reason and the operator's
+// hint, the instrument shows what it needs — never a hang, never a silently stuck "running".
+TEST(ThinPath, SilentMeterSuspendsTheRunWithTheOperatorsHintAndNeverHangs) {
   LabFixture lab(20, "{ reply_timeout_ms = 300, attempts = 2 }");
   lab.sim_control({{"cmd", "fault"}, {"instrument", "ls110"}, {"faults", {{"silent", true}}}});
   auto start = std::chrono::steady_clock::now();
-  auto r = lab.cli({"--json", "run", "luminance-spot"}, std::chrono::seconds(30));
+  json execution = lab.cli_json({"run", "--detach", "luminance-spot"});
+  colorlab::client::ApiClient api(colorlab::client::Endpoint::from_url(lab.url()));
+  json e;
+  while (std::chrono::steady_clock::now() - start < std::chrono::seconds(30)) {
+    e = api.get("/v1/executions/" + execution["id"].get<std::string>());
+    if (e["status"] == "suspended") break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
   auto took = std::chrono::steady_clock::now() - start;
-  EXPECT_EQ(r.exit_code, 3) << r.err;
-  EXPECT_LT(took, std::chrono::seconds(20)) << "a silent meter must end in an error, not a hang";
-  json run = json::parse(r.out);
-  EXPECT_EQ(run["error"]["code"], "needs_operator");
-  EXPECT_NE(run["error"]["hint"].get<std::string>().find("holding F"), std::string::npos) << run["error"].dump();
+  ASSERT_EQ(e["status"], "suspended") << e.dump(2);
+  EXPECT_LT(took, std::chrono::seconds(20)) << "a silent meter must be reported, not hang the run";
+  EXPECT_EQ(e["reason"].get<std::string>().rfind("instrument: ", 0), 0u) << e.dump();
+  json problem, log;
+  for (int i = 0; i < 50 && problem.is_null(); ++i) {
+    log = api.get("/v1/events?topic=execution&limit=300");
+    for (const auto& ev : log["items"]) {
+      if (ev["payload"].value("suspended", false)) problem = ev["payload"]["problem"];
+    }
+    if (problem.is_null()) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  EXPECT_EQ(problem["code"], "needs_operator") << log.dump();
+  EXPECT_NE(problem.value("hint", std::string()).find("holding F"), std::string::npos) << problem.dump();
   json instruments = lab.cli_json({"instruments"});
-  EXPECT_EQ(instruments["items"][0]["state"], "needs_operator");
+  EXPECT_NE(instruments["items"][0]["state"], "ready");
   EXPECT_TRUE(instruments["items"][0].contains("problem"));
 }
 
