@@ -49,7 +49,10 @@ return {
       lab.wait_stable()  -- a warming lamp would tint the first formats differently from the last
     end
     lab.progress(0.1, "photographing")
-    local shots = lab.camera.photograph_chart { frames = p.frames, chart = p.chart, formats = p.formats, camera = p.camera }
+    -- The reference's luminances let the locator tell patches as dark as the chart's surround (no edge of their
+    -- own) from a covered chart.
+    local shots = lab.camera.photograph_chart { frames = p.frames, chart = p.chart, formats = p.formats, camera = p.camera,
+                                                reference = ref }
     local out = { reference_run = p.reference_run, chart = p.chart, frames = p.frames, lamp = p.lamp,
                   instrument = shots.instrument, formats = {} }
     local best_format, best_cv
@@ -59,7 +62,7 @@ return {
         quantity = "chart_location", value = f.confidence, unit = "confidence", instrument = shots.instrument,
         data = { format = format, corners = f.corners, rotation_deg = f.rotation_deg, patches_detected = f.patches_detected,
                  reprojection_rms_px = f.reprojection_rms_px, check = f.check, frames = f.frames, files = f.files,
-                 width = f.width, height = f.height },
+                 width = f.width, height = f.height, notes = f.notes },
       })
       local unit = format == "raw" and "DN above black" or (f.bits == 8 and "8-bit code" or "16-bit code")
       for i, id in ipairs(f.ids) do

@@ -1,6 +1,7 @@
 #include "colorlab/campaigns/chart_photograph.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <map>
 
 #include <boost/asio/co_spawn.hpp>
@@ -32,7 +33,7 @@ struct PhotographOptions {
 PhotographOptions parse(const json& o) {
   PhotographOptions p;
   auto bad = [](const std::string& what) { return Error(ErrorClass::bad_parameter, "lab.camera.photograph_chart: " + what); };
-  if (!o.is_object() && !(o.is_array() && o.empty())) throw bad("takes a table {frames=, chart=, formats=, camera=}");
+  if (!o.is_object() && !(o.is_array() && o.empty())) throw bad("takes a table {frames=, chart=, formats=, camera=, reference=}");
   if (!o.is_object()) return p;
   if (o.contains("frames")) {
     if (!o["frames"].is_number_integer() || o["frames"].get<int>() < 1 || o["frames"].get<int>() > 256) throw bad("frames must be an integer from 1 to 256");
@@ -59,6 +60,28 @@ PhotographOptions parse(const json& o) {
   };
   fraction("sample_fraction", p.sampling.sample_fraction);
   fraction("min_confidence", p.sampling.min_confidence);
+  if (o.contains("reference")) {
+    // lab.runs.chart_reference's table: each patch's Y, in the layout's order (unknown patches stay NaN).
+    const json& r = o["reference"];
+    if (!r.is_object() || !r.contains("ids") || !r.contains("XYZ") || !r["ids"].is_array() || !r["XYZ"].is_array() ||
+        r["ids"].size() != r["XYZ"].size()) {
+      throw bad("reference must be lab.runs.chart_reference's table {ids = {...}, XYZ = {{X, Y, Z}, ...}}");
+    }
+    const ca::ChartLayout& layout = ca::chart_layout(p.sampling.chart);
+    ca::ChartReference ref;
+    ref.luminance.assign(static_cast<std::size_t>(layout.size()), std::numeric_limits<double>::quiet_NaN());
+    std::size_t known = 0;
+    for (std::size_t i = 0; i < r["ids"].size(); ++i) {
+      const json& xyz = r["XYZ"][i];
+      if (!r["ids"][i].is_string() || !xyz.is_array() || xyz.size() != 3 || !xyz[1].is_number()) throw bad("reference patch " + std::to_string(i + 1) + " has no id and XYZ");
+      const auto it = std::find(layout.ids.begin(), layout.ids.end(), r["ids"][i].get<std::string>());
+      if (it == layout.ids.end()) continue;
+      ref.luminance[static_cast<std::size_t>(it - layout.ids.begin())] = xyz[1].get<double>();
+      ++known;
+    }
+    if (known == 0) throw bad("the reference names none of the " + layout.name + "'s patches: is it a read of another chart?");
+    p.sampling.reference = std::move(ref);
+  }
   return p;
 }
 

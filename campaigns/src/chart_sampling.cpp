@@ -88,6 +88,7 @@ json locate_and_sample(const AveragedPhoto& a, const SamplingOptions& options) {
   ca::LocateOptions lo;
   lo.sample_fraction = options.sample_fraction;
   lo.min_confidence = options.min_confidence;
+  lo.reference = options.reference;
   ca::ChartLocation loc;
   try {
     loc = ca::locate_chart(view, options.chart, lo);
@@ -133,7 +134,8 @@ json locate_and_sample(const AveragedPhoto& a, const SamplingOptions& options) {
                          {"gradient_y", loc.check.gradient_y}}},
               {"ids", ids},
               {"values", values},
-              {"detected", detected}};
+              {"detected", detected},
+              {"notes", loc.notes}};
 }
 
 }  // namespace colorlab::campaigns::detail

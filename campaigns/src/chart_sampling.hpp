@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "colorlab/analysis/chart_layout.hpp"
+#include "colorlab/analysis/chart_locate.hpp"
 #include "colorlab/analysis/chart_photo.hpp"
 
 namespace colorlab::campaigns::detail {
@@ -33,6 +34,9 @@ struct SamplingOptions {
   analysis::ChartType chart = analysis::ChartType::sg140;
   double sample_fraction = 0.6;
   double min_confidence = 0.6;
+  // The chart's patch luminances from a reference read (chart-read's XYZ): lets the locator tell patches that
+  // merely lack a luminance edge against the surround from a covered chart (chart_locate.hpp).
+  std::optional<analysis::ChartReference> reference;
 };
 
 // Sums of the camera's own processed files (JPEG, TIFF) of one format; throws Error(bad_data) when

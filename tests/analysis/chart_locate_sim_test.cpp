@@ -3,6 +3,7 @@
 // values equal to its noiseless ground truth within the noise of the sampled mean.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -112,6 +113,62 @@ TEST_P(SimulatedPhotos, PatchesWhereTheSimulatorPutThem) {
   }
   std::printf("[ %s ] worst centre error %.2f px, worst value error %.2f of its bound, confidence %.2f, rms %.2f px, neutrals %.2f %%\n",
               c.name, worst, worst_sigmas, loc.confidence, loc.reprojection_rms_px, loc.check.worst_disagreement * 100);
+}
+
+// The X-Rite SG's L2, L3, M2 and M3 are about as light as its surround: in a half-size raw they show no edges of
+// their own. With the chart's reference they read as expected and are no cover; a grey card over the same four
+// patches is still refused.
+TEST(SimulatedPhotosBlock, PatchesAsDarkAsTheSurroundAreNotACoverButACardIs) {
+  sim::SceneConfig sc;
+  sc.seed = 4;
+  sc.force_synthetic_chart = false;
+  sc.lamps_on_at_start = {sim::Lamp::d65};
+  auto scene = std::make_shared<sim::Scene>(sc, std::make_shared<sim::SimClock>());
+  cam::CameraConfig cc;
+  cc.width = 1752;
+  cc.height = 1168;
+  cc.pose = cam::random_chart_pose(7);  // the block shows no edges at this pose (and at 2 and 12)
+  const cam::CameraModel camera(scene, cc);
+  cam::CameraSettings settings;
+  settings.shutter_s = 1.0 / 30;
+  cam::RawFrame frame = camera.render(settings, 1);
+  LocateOptions o;
+  o.reference = reference_of(*scene);
+  const auto l = camera.lens();
+  o.lens = LensCalibration{l.fx, l.fy, l.cx, l.cy, l.k1, l.k2, 0, 0, 0};
+  const ChartLayout& L = chart_layout(ChartType::sg140);
+  const std::vector<std::string> block{"L2", "L3", "M2", "M3"};
+  const ChartLocation loc = locate_chart(raw_view(frame), ChartType::sg140, o);
+  EXPECT_GE(loc.confidence, 0.8);
+  bool noted = false;
+  for (const auto& n : loc.notes) {
+    std::printf("[ note ] %s\n", n.c_str());
+    noted = noted || n.find("L2, L3, M2, M3 show no edges of their own but read as the reference expects") != std::string::npos;
+  }
+  EXPECT_TRUE(noted) << "the block was detected: this test no longer exercises the edgeless block";
+  // Without the reference the SG's layout knows only its border: the block is refused as a cover.
+  EXPECT_THROW(locate_chart(raw_view(frame), ChartType::sg140, LocateOptions{.lens = o.lens}), Error);
+  // A card of the surround's mean level over the four patches and the surround between them.
+  int x0 = 1 << 30, y0 = 1 << 30, x1 = 0, y1 = 0;
+  for (const auto& id : block) {
+    const int k = static_cast<int>(std::find(L.ids.begin(), L.ids.end(), id) - L.ids.begin());
+    const auto r = camera.patch_region(k);
+    x0 = std::min(x0, r.x), y0 = std::min(y0, r.y), x1 = std::max(x1, r.x + r.width), y1 = std::max(y1, r.y + r.height);
+  }
+  const auto& c = loc.patches[static_cast<std::size_t>(std::find(L.ids.begin(), L.ids.end(), "L3") - L.ids.begin())];
+  for (int y = y0 - 6; y < y1 + 6; ++y)
+    for (int x = x0 - 6; x < x1 + 6; ++x) {
+      const int ch = (y % 2) * 2 + (x % 2) == 0 ? 0 : ((y % 2) && (x % 2)) ? 2 : 1;
+      frame.pixels[static_cast<std::size_t>(y) * frame.width + x] = static_cast<std::uint16_t>(c.value[static_cast<std::size_t>(ch)].value);
+    }
+  try {
+    const auto covered = locate_chart(raw_view(frame), ChartType::sg140, o);
+    for (const auto& n : covered.notes) std::printf("[ note ] %s\n", n.c_str());
+    ADD_FAILURE() << "a card over L2, L3, M2, M3 located with confidence " << covered.confidence;
+  } catch (const Error& e) {
+    EXPECT_EQ(e.cls(), ErrorClass::needs_operator) << e.what();
+    std::printf("[ card ] %s\n", e.what());
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Poses, SimulatedPhotos,

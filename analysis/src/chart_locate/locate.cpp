@@ -45,19 +45,73 @@ double luminance_agreement(const ChartLayout& L, const std::vector<double>& expe
   return log_agreement(got, want) + log_correlation(got, want);
 }
 
-// A 2×2 block of patches none of which shows its own edges: something covers the chart there.
-std::vector<std::string> covered_block(const ChartLayout& L, const std::vector<bool>& detected) {
+// Every 2×2 block of patches none of which shows its own edges (layout indices): something may cover the chart there.
+std::vector<std::array<int, 4>> undetected_blocks(const ChartLayout& L, const std::vector<bool>& detected) {
+  std::vector<std::array<int, 4>> out;
   for (int c = 0; c + 1 < L.columns; ++c)
     for (int r = 0; r + 1 < L.rows; ++r) {
-      std::vector<std::string> ids;
+      std::array<int, 4> block{};
+      int n = 0;
       for (int dc = 0; dc < 2; ++dc)
         for (int dr = 0; dr < 2; ++dr) {
           const int k = *L.index_at(c + dc, r + dr);
-          if (!detected[static_cast<std::size_t>(k)]) ids.push_back(L.ids[static_cast<std::size_t>(k)]);
+          if (!detected[static_cast<std::size_t>(k)]) block[static_cast<std::size_t>(n++)] = k;
         }
-      if (ids.size() == 4) return ids;
+      if (n == 4) out.push_back(block);
     }
-  return {};
+  return out;
+}
+
+// Whether an edgeless block is the chart itself, not a cover. Patches whose luminance is close to the surround's
+// show no luminance edge yet are there (the SG has such neighbours); a card, tape or finger makes the four read
+// alike. So, with expected luminances for all four (a reference read of this chart; the SG's layout alone knows
+// only its border), each must lie on the log–log line the detected patches fit between expected luminance and
+// working grey as well as the detected patches do (within their 99th percentile, at least a factor 1.25), and the
+// four expected levels must span more than twice that tolerance, so that no uniform cover could pass. Fills `why`
+// with the figures.
+bool block_reads_as_expected(const ChartLayout& L, const std::vector<double>& expected, const WorkingImage& work,
+                             const cv::Matx33d& h, const std::optional<LensCalibration>& lens, double pitch_px,
+                             const std::vector<bool>& detected, const std::array<int, 4>& block, std::string& why) {
+  for (int k : block)
+    if (!std::isfinite(expected[static_cast<std::size_t>(k)]) || !(expected[static_cast<std::size_t>(k)] > 0)) return false;
+  const double radius = pitch_px * L.patch_size / 6;
+  auto got_log = [&](int k) {
+    return std::log(working_luminance(work, grid_to_image(h, {L.centre_x(k), L.centre_y(k)}, lens), radius) + 1.0);
+  };
+  std::vector<double> a, b;
+  for (int k = 0; k < L.size(); ++k) {
+    const double e = expected[static_cast<std::size_t>(k)];
+    if (!detected[static_cast<std::size_t>(k)] || !std::isfinite(e) || !(e > 0)) continue;
+    a.push_back(got_log(k));
+    b.push_back(std::log(e));
+  }
+  if (a.size() < 12) return false;
+  const double n = static_cast<double>(a.size());
+  double ma = 0, mb = 0;
+  for (std::size_t k = 0; k < a.size(); ++k) ma += a[k], mb += b[k];
+  ma /= n, mb /= n;
+  double sab = 0, sbb = 0;
+  for (std::size_t k = 0; k < a.size(); ++k) sab += (a[k] - ma) * (b[k] - mb), sbb += (b[k] - mb) * (b[k] - mb);
+  if (!(sbb > 0)) return false;
+  const double slope = sab / sbb;
+  if (!(slope > 0)) return false;
+  std::vector<double> res;
+  for (std::size_t k = 0; k < a.size(); ++k) res.push_back(std::abs(a[k] - (ma + slope * (b[k] - mb))));
+  // As well as the patches that were seen read: all but their worst 1 % (saturated colours stray furthest from
+  // the reference's Y in a camera's R + 2G + B).
+  std::sort(res.begin(), res.end());
+  const double tol = std::max(std::log(1.25), res[res.size() * 99 / 100]);
+  double lo = 1e300, hi = -1e300, worst = 0;
+  for (int k : block) {
+    const double want = ma + slope * (std::log(expected[static_cast<std::size_t>(k)]) - mb);
+    lo = std::min(lo, want), hi = std::max(hi, want);
+    worst = std::max(worst, std::abs(got_log(k) - want));
+  }
+  std::ostringstream w;
+  w << "worst patch off its expected luminance by a factor " << std::exp(worst) << " (tolerance " << std::exp(tol)
+    << "), expected levels spanning a factor " << std::exp(hi - lo);
+  why = w.str();
+  return worst <= tol && hi - lo > 2 * tol;
 }
 
 }  // namespace
@@ -200,10 +254,19 @@ ChartLocation locate_chart(const PhotoView& photo, ChartType type, const LocateO
     lower(conf, clamp01(1 - (rel - 0.04) / 0.08), "the patches do not sit on a flat grid (rms " + std::to_string(loc.reprojection_rms_px) +
                                                      " px); is the lens distortion uncorrected?");
   }
-  const auto covered = covered_block(L, detected);
-  if (!covered.empty())
-    lower(conf, 0.1, "patches " + covered[0] + ", " + covered[1] + ", " + covered[2] + ", " + covered[3] +
-                         " show no edges of their own: is the chart partly covered?");
+  for (const auto& block : undetected_blocks(L, detected)) {
+    std::string names;
+    for (int k : block) names += (names.empty() ? "" : ", ") + L.ids[static_cast<std::size_t>(k)];
+    std::string why;
+    if (block_reads_as_expected(L, expected, work, H, o.lens, pitch_px, detected, block, why)) {
+      loc.notes.push_back("patches " + names + " show no edges of their own but read as the reference expects (" + why +
+                          "): too close to the surround's luminance for an edge, not covered");
+      continue;
+    }
+    lower(conf, 0.1, "patches " + names + " show no edges of their own: is the chart partly covered?" +
+                         (why.empty() ? std::string() : " (" + why + ")"));
+    break;
+  }
 
   loc.homography = to_array(H);
   for (int k = 0; k < 4; ++k) {

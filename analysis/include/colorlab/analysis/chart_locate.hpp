@@ -33,7 +33,9 @@ struct LensCalibration {
 // What the photographed chart's patches should look like, when the caller knows better than the layout
 // (a simulated chart, a chart measured with the spectrometer).
 struct ChartReference {
-  std::vector<double> luminance;                  // per patch in layout order, relative; NaN = unknown
+  // Per patch in layout order, relative; NaN = unknown. Also tells a 2×2 block of patches with no edges of their
+  // own (luminance close to the surround's) that reads as expected from a covered chart.
+  std::vector<double> luminance;
   std::vector<std::vector<int>> repeated_neutrals;  // replaces the layout's groups when non-empty
 };
 
