@@ -235,16 +235,22 @@ json rows_of(const Eigen::MatrixXd& m) {
   return out;
 }
 
+// The optional {window_rows =, window_cols =} argument at `index` (the chart's size in grid spots).
+analysis::UniformityOptions window_options(lua_State* L, int index, const char* what) {
+  analysis::UniformityOptions o;
+  json options = lua_gettop(L) >= index ? to_json(L, index, what) : json::object();
+  if (options.is_object()) {
+    o.window_rows = options.value("window_rows", o.window_rows);
+    o.window_cols = options.value("window_cols", o.window_cols);
+  }
+  return o;
+}
+
 // lab.analysis.uniformity(left_half_grid, {window_rows = 4, window_cols = 5}) → §6.2 (Tables 3–6).
 int analysis_uniformity(lua_State* L) {
   guarded(L, [&] {
     json grid = to_json(L, 1, "lab.analysis.uniformity's grid");
-    json options = lua_gettop(L) >= 2 ? to_json(L, 2, "lab.analysis.uniformity's options") : json::object();
-    analysis::UniformityOptions o;
-    if (options.is_object()) {
-      o.window_rows = options.value("window_rows", o.window_rows);
-      o.window_cols = options.value("window_cols", o.window_cols);
-    }
+    auto o = window_options(L, 2, "lab.analysis.uniformity's options");
     auto u = analysis::analyse_uniformity(matrix_from(grid, "lab.analysis.uniformity's grid"), o);
     json result{{"min", u.min},
                 {"max", u.max},
@@ -278,12 +284,7 @@ int analysis_compare_lamps(lua_State* L) {
   guarded(L, [&] {
     json names = to_json(L, 1, "lab.analysis.compare_lamps's names");
     json grids = to_json(L, 2, "lab.analysis.compare_lamps's grids");
-    json options = lua_gettop(L) >= 3 ? to_json(L, 3, "lab.analysis.compare_lamps's options") : json::object();
-    analysis::UniformityOptions o;
-    if (options.is_object()) {
-      o.window_rows = options.value("window_rows", o.window_rows);
-      o.window_cols = options.value("window_cols", o.window_cols);
-    }
+    auto o = window_options(L, 3, "lab.analysis.compare_lamps's options");
     if (!names.is_array() || !grids.is_array() || names.size() != grids.size() || names.empty()) {
       throw Error(ErrorClass::script_error, "lab.analysis.compare_lamps takes a list of lamp names and a list of as many grids");
     }
