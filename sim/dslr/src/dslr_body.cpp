@@ -6,6 +6,7 @@
 
 #include "colorlab/core/error.hpp"
 #include "colorlab/sim/camera/dng.hpp"
+#include "colorlab/sim/camera/eos20d.hpp"
 #include "colorlab/sim/camera/processed.hpp"
 
 namespace colorlab::sim::dslr {
@@ -14,15 +15,9 @@ using nlohmann::json;
 
 namespace {
 
-// The EOS 20D's choices as its firmware labels them (third stops).
-constexpr const char* kShutterLabels[] = {
-    "1/8000", "1/6400", "1/5000", "1/4000", "1/3200", "1/2500", "1/2000", "1/1600", "1/1250", "1/1000", "1/800",
-    "1/640",  "1/500",  "1/400",  "1/320",  "1/250",  "1/200",  "1/160",  "1/125",  "1/100",  "1/80",   "1/60",
-    "1/50",   "1/40",   "1/30",   "1/25",   "1/20",   "1/15",   "1/13",   "1/10",   "1/8",    "1/6",    "1/5",
-    "1/4",    "0.3",    "0.4",    "0.5",    "0.6",    "0.8",    "1",      "1.3",    "1.6",    "2",      "2.5",
-    "3.2",    "4",      "5",      "6",      "8",      "10",     "13",     "15",     "20",     "25",     "30"};
-constexpr int kIsos[] = {100, 200, 400, 800, 1600};
-constexpr double kApertures[] = {2.8, 3.2, 3.5, 4, 4.5, 5, 5.6, 6.3, 7.1, 8, 9, 10, 11, 13, 14, 16, 18, 20, 22};
+using camera::eos20d::kApertures;
+using camera::eos20d::kIsos;
+using camera::eos20d::kShutterLabels;
 constexpr const char* kFormats[] = {"raw", "raw+jpeg", "raw+jpeg+tiff"};
 
 double label_seconds(const std::string& label) {
