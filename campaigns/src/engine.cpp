@@ -241,7 +241,7 @@ asio::awaitable<RunOutcome> run_campaign_script(ScriptRunSetup setup, Lab& lab, 
                 }
                 if (!failure) break;
                 auto cause = Lab::suspend_cause(*failure);
-                if (!cause || control.requested() || !setup.suspend_on_conditions) throw *failure;
+                if (!cause || control.requested()) throw *failure;
                 std::string reason = *cause + ": " + failure->what();
                 log::warning(script.name, "suspended at " + call + ": " + reason);
                 sink.suspended(reason, *failure);

@@ -89,8 +89,6 @@ struct ScriptRunSetup {
   // (resuming it from the API accepts the unit: verify_serials = false).
   std::map<std::string, std::string> expected_serials;
   bool verify_serials = true;
-  // Wait out conditions that mend (instrument gone, lamp out, disk full) instead of failing.
-  bool suspend_on_conditions = true;
 };
 
 boost::asio::awaitable<RunOutcome> run_campaign_script(ScriptRunSetup setup, Lab& lab, ExecutionSink& sink,
