@@ -4,10 +4,15 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <optional>
+#include <string_view>
 
+#include "colorlab/analysis/blackbox.hpp"
 #include "colorlab/analysis/characterization.hpp"
 #include "colorlab/analysis/icc_profile.hpp"
 #include "colorlab/analysis/rgb_spaces.hpp"
+#include "colorlab/analysis/standard_data.hpp"
+#include "colorlab/core/data_paths.hpp"
 #include "colorlab/core/error.hpp"
 
 namespace colorlab::campaigns {
@@ -199,6 +204,215 @@ json adapted_mapping(const ca::ChartData& d, const ca::CvSpec& cv, double tolera
               {"candidates", candidates}};
 }
 
+
+// (d) §7.4: the camera as a black box. Spectral sensitivities s_c ≥ 0 are fitted so that
+// RAW_c = Σ s_c(λ) · reflectance(λ) · lamp(λ) reproduces the raw counts (analysis/blackbox.hpp: NNLS
+// under a prior learned from other cameras' measured curves when the shared data set has them, else
+// a second-difference penalty chosen by GCV). The dissertation compares the predicted counts with the
+// photograph's (Table 13); to set it beside the other approaches in ΔE00 the predicted counts go
+// through the raw's own mapping to L*a*b* (§7.3's selected method), fitted, like the sensitivities,
+// without the patches each fold holds out.
+
+// The CIE illuminant a cabinet lamp's spectrum is taken to be: the tables the simulated lab lights
+// its scene with (sim/scene lamps.cpp), from colord-data.
+std::optional<std::string> illuminant_of_lamp(std::string lamp) {
+  for (auto& c : lamp) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  static const std::map<std::string, std::string, std::less<>> table{
+      {"D65", "D65"}, {"D50", "D50"}, {"A", "A"}, {"TL84", "F11"}, {"F11", "F11"}, {"840", "F11"}, {"CWF", "F2"}, {"F2", "F2"}};
+  auto it = table.find(lamp);
+  if (it == table.end()) return std::nullopt;
+  return it->second;
+}
+
+// What the black box is fitted from; `missing` says why it cannot be, when it cannot.
+struct BlackBoxSetup {
+  std::string missing;
+  std::string lamp, illuminant, spd_source;
+  std::vector<double> wavelengths;
+  Eigen::MatrixXd radiance;  // n × bands in d's patch order: reflectance × the lamp's weight per band
+  std::optional<ca::SensitivityPrior> prior;
+  std::string prior_source;
+  std::vector<std::string> prior_excluded;
+};
+
+// The lamp's weight per band of the chart's grid: its SPD on its own (finer) grid, each sample
+// shared between the two neighbouring bands as linear interpolation of the reflectance shares it
+// (the adjoint of interpolating the reflectance onto the lamp's grid), so a fluorescent tube's
+// mercury lines between two 10 nm bands count in both. Peak 1 (the sensitivities absorb the scale).
+Eigen::RowVectorXd lamp_weights(const ca::SpectralSet& lamp, const std::vector<double>& grid) {
+  std::vector<double> inside;
+  std::vector<Eigen::Index> cols;
+  for (std::size_t k = 0; k < lamp.bands(); ++k) {
+    if (lamp.wavelengths[k] >= grid.front() - 1e-9 && lamp.wavelengths[k] <= grid.back() + 1e-9) {
+      inside.push_back(lamp.wavelengths[k]);
+      cols.push_back(static_cast<Eigen::Index>(k));
+    }
+  }
+  if (inside.size() < grid.size()) {
+    throw bad(lamp.names.front() + " does not cover the chart's spectra (" + std::to_string(grid.front()) + "–" +
+              std::to_string(grid.back()) + " nm) finely enough");
+  }
+  Eigen::VectorXd spd(static_cast<Eigen::Index>(inside.size()));
+  for (std::size_t j = 0; j < cols.size(); ++j) spd(static_cast<Eigen::Index>(j)) = lamp.values(0, cols[j]);
+  const Eigen::MatrixXd r = ca::resampling_matrix(grid, inside, ca::Interpolation::linear);
+  Eigen::RowVectorXd w = (r.transpose() * spd).transpose();
+  if (!(w.maxCoeff() > 0)) throw bad(lamp.names.front() + " is dark over the chart's spectra");
+  return w / w.maxCoeff();
+}
+
+BlackBoxSetup black_box_setup(const ca::ChartData& d, const json& camera, const json& reference, const json& options) {
+  BlackBoxSetup s;
+  const std::string format = camera.value("format", std::string("raw"));
+  if (format != "raw") {
+    s.missing = "the black box is fitted to linear counts: the raw only, not " + format;
+    return s;
+  }
+  if (!reference.contains("spectra") || !reference.contains("wavelengths") || reference["spectra"].size() != reference["ids"].size()) {
+    s.missing = "the reference has no spectra (a chart-read run stored before spectra were returned): run chart-read again";
+    return s;
+  }
+  s.lamp = options.value("lamp", std::string());
+  if (options.contains("illuminant") && options["illuminant"].is_string()) {
+    s.illuminant = options["illuminant"].get<std::string>();
+  } else if (auto il = illuminant_of_lamp(s.lamp)) {
+    s.illuminant = *il;
+  } else {
+    s.missing = s.lamp.empty() ? "no lamp named: the black box needs the light's spectrum (give lamp or illuminant)"
+                               : "no standard spectrum for lamp " + s.lamp + " (D65, A, TL84 = F11, CWF = F2): give illuminant";
+    return s;
+  }
+  const ca::SpectralSet spd = ca::load_illuminant(s.illuminant);
+  s.spd_source = spd.names.front() + " (" + spd.source + ")";
+
+  std::vector<double> grid = reference["wavelengths"].get<std::vector<double>>();
+  // The prior's curves span less than the chart's spectra (camspec: 400–720 nm); the fit uses the bands both have.
+  const std::string prior = options.value("prior", std::string("camspec"));
+  if (prior != "camspec" && prior != "none") throw Error(ErrorClass::bad_parameter, "lab.analysis.characterize: prior must be camspec or none");
+  std::optional<ca::SpectralSet> curves;
+  if (prior == "camspec") {
+    if (auto file = paths::shared_data_file("camera_ssf_camspec_jiang2013_28cams_10nm_400_720.csv")) {
+      curves = ca::read_spectra(*file);
+      s.prior_source = file->string();
+    }
+  }
+  std::vector<std::size_t> bands;
+  for (std::size_t k = 0; k < grid.size(); ++k) {
+    if (!curves || (grid[k] >= curves->wavelengths.front() - 1e-9 && grid[k] <= curves->wavelengths.back() + 1e-9)) bands.push_back(k);
+  }
+  for (auto k : bands) s.wavelengths.push_back(grid[k]);
+  if (s.wavelengths.size() < 3) throw bad("the reference's spectra and the prior's curves share fewer than 3 wavelengths");
+  if (curves) {
+    if (options.contains("prior_exclude")) s.prior_excluded = options["prior_exclude"].get<std::vector<std::string>>();
+    s.prior = ca::learn_sensitivity_prior(*curves, s.wavelengths, s.prior_excluded);
+  }
+
+  const Eigen::RowVectorXd lamp = lamp_weights(spd, grid);
+  std::map<std::string, std::size_t> row;
+  for (std::size_t i = 0; i < reference["ids"].size(); ++i) row[reference["ids"][i].get<std::string>()] = i;
+  s.radiance.resize(static_cast<Eigen::Index>(d.size()), static_cast<Eigen::Index>(bands.size()));
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    const json& values = reference["spectra"][row.at(d.ids[i])];
+    if (values.size() != grid.size()) throw bad("the reference spectrum of " + d.ids[i] + " has " + std::to_string(values.size()) + " bands, not " + std::to_string(grid.size()));
+    for (std::size_t j = 0; j < bands.size(); ++j) {
+      const double v = values[bands[j]].get<double>();
+      // A reflectance reads a little below 0 in the noise of a black patch; the model's light is never negative.
+      s.radiance(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = std::max(0.0, v) * lamp(static_cast<Eigen::Index>(bands[j]));
+    }
+  }
+  return s;
+}
+
+// Table 13: |predicted − measured| per channel, in counts and in % of the raw's full scale.
+json residual_table(const Eigen::MatrixXd& residuals, double full_scale) {
+  json out = json::object();
+  for (int c = 0; c < 3; ++c) {
+    std::vector<double> a;
+    for (Eigen::Index i = 0; i < residuals.rows(); ++i) a.push_back(std::abs(residuals(i, c)));
+    const ca::Summary sum = ca::summarize(a);
+    out[std::string(1, "RGB"[c])] = {{"mean", sum.mean}, {"median", sum.median}, {"max", sum.max}, {"stdev", sum.stdev},
+                                     {"mean_pct", 100 * sum.mean / full_scale}, {"max_pct", 100 * sum.max / full_scale}};
+  }
+  return out;
+}
+
+Eigen::MatrixXd rows_of(const Eigen::MatrixXd& m, const std::vector<std::size_t>& rows) {
+  Eigen::MatrixXd out(static_cast<Eigen::Index>(rows.size()), m.cols());
+  for (std::size_t j = 0; j < rows.size(); ++j) out.row(static_cast<Eigen::Index>(j)) = m.row(static_cast<Eigen::Index>(rows[j]));
+  return out;
+}
+
+ca::FitTarget target_from_string(const std::string& name) {
+  for (auto t : {ca::FitTarget::xyz_then_lab, ca::FitTarget::lab_direct, ca::FitTarget::xyz_lightness_weighted}) {
+    if (name == ca::to_string(t)) return t;
+  }
+  throw Error(ErrorClass::bad_parameter, "lab.analysis.characterize: unknown mapping target " + name);
+}
+
+json black_box(const ca::ChartData& d, const BlackBoxSetup& s, const std::string& method, ca::FitTarget target,
+               const ca::CvSpec& cv, double full_scale) {
+  ca::BlackBoxOptions bo;
+  bo.full_scale = full_scale;
+  bo.prior = s.prior;
+  ca::FitOptions fo;
+  fo.target = target;
+  const ca::BlackBoxModel model = ca::fit_blackbox(s.radiance, d.rgb, bo);
+  const Eigen::MatrixXd predicted = model.predict(s.radiance);
+  const auto training = ca::evaluate(ca::fit_method(method, d, fo).apply(predicted), d.lab);
+
+  Eigen::MatrixXd held_counts(d.rgb.rows(), 3), held_lab(d.rgb.rows(), 3);
+  for (const auto& held : folds(d.size(), cv)) {
+    std::vector<std::size_t> keep;
+    for (std::size_t i = 0; i < d.size(); ++i) {
+      if (std::find(held.begin(), held.end(), i) == held.end()) keep.push_back(i);
+    }
+    const Eigen::MatrixXd counts = ca::fit_blackbox(rows_of(s.radiance, keep), rows_of(d.rgb, keep), bo).predict(rows_of(s.radiance, held));
+    const Eigen::MatrixXd lab = ca::fit_method(method, d.subset(keep), fo).apply(counts);
+    for (std::size_t j = 0; j < held.size(); ++j) {
+      held_counts.row(static_cast<Eigen::Index>(held[j])) = counts.row(static_cast<Eigen::Index>(j));
+      held_lab.row(static_cast<Eigen::Index>(held[j])) = lab.row(static_cast<Eigen::Index>(j));
+    }
+  }
+  const auto cross = ca::evaluate(held_lab, d.lab);
+
+  // The curves as published ones are given: relative, the green peak 1.
+  const double peak = model.sensitivities.row(1).maxCoeff() > 0 ? model.sensitivities.row(1).maxCoeff() : 1;
+  json curves{{"wavelengths", s.wavelengths}, {"normalised_to", "green peak = 1"}};
+  for (int c = 0; c < 3; ++c) {
+    const Eigen::VectorXd curve = model.sensitivities.row(c).transpose() / peak;
+    const std::string name(1, "RGB"[c]);
+    curves[name] = std::vector<double>(curve.data(), curve.data() + curve.size());
+    if (model.with_prior) {
+      // The 95 % credible band (docs/ACCURACY.md §3: calibrated pooled over cameras, not per curve).
+      const auto band = ca::credible_band(curve, model.sensitivity_sdev.row(c).transpose() / peak);
+      curves[name + "_low"] = std::vector<double>(band.lower.data(), band.lower.data() + band.lower.size());
+      curves[name + "_high"] = std::vector<double>(band.upper.data(), band.upper.data() + band.upper.size());
+    }
+  }
+  json regularisation = model.with_prior
+                            ? json{{"kind", "prior from other cameras' measured curves"}, {"source", s.prior_source},
+                                   {"cameras", s.prior->cameras}, {"excluded", s.prior_excluded}, {"lambda", model.lambda}}
+                            : json{{"kind", "second-difference smoothness, weight by GCV"}, {"lambda", model.lambda}};
+  return json{{"training", stats_json(training)},
+              {"cv", stats_json(cross)},
+              {"fitted", true},
+              {"kind", "spectral sensitivities (NNLS) → counts → the raw's mapping → L*a*b*"},
+              {"lamp", s.lamp},
+              {"illuminant", s.illuminant},
+              {"spd", s.spd_source},
+              {"spd_note", "the lamp's spectrum is assumed to be the standard illuminant's, not measured"},
+              {"mapping", {{"method", method}, {"target", ca::to_string(target)}}},
+              {"full_scale", full_scale},
+              {"residuals", {{"unit", "counts"}, {"training", residual_table(predicted - d.rgb, full_scale)},
+                             {"cv", residual_table(held_counts - d.rgb, full_scale)}}},
+              {"regularisation", regularisation},
+              {"sensitivities", curves}};
+}
+
+int camera_bits(const json& camera) {
+  const bool raw = camera.value("format", std::string("raw")) == "raw";
+  return camera.value("bits", raw ? 16 : 8);
+}
+
 }  // namespace
 
 json characterize(const json& camera, const json& reference, const json& options_in) {
@@ -212,7 +426,7 @@ json characterize(const json& camera, const json& reference, const json& options
   }
   const std::string format = camera.is_object() ? camera.value("format", std::string("raw")) : "raw";
   const bool raw = format == "raw";
-  const int bits = camera.is_object() ? camera.value("bits", raw ? 16 : 8) : 16;
+  const int bits = camera.is_object() ? camera_bits(camera) : 16;
   const ca::CvSpec cv = ca::CvSpec::parse(options.value("cv", std::string("loo")));
   const double tolerance = options.value("tolerance_de00", 0.1);
   const std::string space_name = options.value("colour_space", std::string("adobe_rgb"));
@@ -231,6 +445,14 @@ json characterize(const json& camera, const json& reference, const json& options
   approaches["icc_profile"] = icc_profile(d, gamma, cv);
   json selected;
   approaches["adapted_mapping"] = adapted_mapping(d, cv, tolerance, selected);
+  json not_fitted = json::object();
+  const BlackBoxSetup setup = black_box_setup(d, camera, reference, options);
+  if (setup.missing.empty()) {
+    approaches["black_box"] = black_box(d, setup, selected["method"], target_from_string(selected["target"]), cv,
+                                        std::ldexp(1.0, bits) - 1);
+  } else if (raw) {
+    not_fitted["black_box"] = setup.missing;
+  }
   std::string best;
   double best_cv = std::numeric_limits<double>::infinity();
   for (const auto& [name, a] : approaches.items()) {
@@ -239,8 +461,20 @@ json characterize(const json& camera, const json& reference, const json& options
       best = name;
     }
   }
-  return json{{"format", format}, {"patches", d.size()}, {"cv", cv.name()}, {"approaches", approaches},
-              {"best_approach", best}, {"selected", selected}, {"unit", "ΔE00"}};
+  return json{{"format", format},     {"patches", d.size()},   {"cv", cv.name()},
+              {"approaches", approaches}, {"best_approach", best}, {"selected", selected},
+              {"not_fitted", not_fitted}, {"unit", "ΔE00"}};
+}
+
+json characterize_black_box(const json& camera, const json& reference, const json& options) {
+  if (!options.is_object() || !options.contains("mapping")) {
+    throw Error(ErrorClass::bad_parameter, "characterize_black_box: options need mapping = {method, target}");
+  }
+  const ca::ChartData d = match(camera, reference, {});
+  const BlackBoxSetup setup = black_box_setup(d, camera, reference, options);
+  if (!setup.missing.empty()) throw Error(ErrorClass::bad_parameter, "characterize_black_box: " + setup.missing);
+  return black_box(d, setup, options["mapping"]["method"], target_from_string(options["mapping"]["target"]),
+                   ca::CvSpec::parse(options.value("cv", std::string("loo"))), std::ldexp(1.0, camera_bits(camera)) - 1);
 }
 
 }  // namespace colorlab::campaigns

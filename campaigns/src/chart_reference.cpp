@@ -1,5 +1,8 @@
 #include "colorlab/campaigns/run_reader.hpp"
 
+#include <optional>
+#include <utility>
+
 #include "colorlab/core/error.hpp"
 
 namespace colorlab::campaigns {
@@ -21,8 +24,12 @@ json chart_reference(RunReader& runs, const std::string& run_id) {
     throw Error(ErrorClass::conflict, "lab.runs.chart_reference: chart-read run " + run_id + " is " + run->status + ", not finished_ok",
                 "let the chart read finish (or resume it), or run chart-read again");
   }
-  json ids = json::array(), lab = json::array(), xyz = json::array();
+  json ids = json::array(), lab = json::array(), xyz = json::array(), spectra = json::array();
   std::string illuminant, observer;
+  // The reflectance spectra, when every patch has one on one grid (§7.4's black box needs them).
+  std::optional<std::pair<double, double>> grid;  // first_nm, step_nm
+  std::size_t bands = 0;
+  bool spectral = true;
   for (const auto& m : run->measurements) {
     if (m.step.rfind("patch/", 0) != 0) continue;
     const json& d = m.data;
@@ -33,6 +40,17 @@ json chart_reference(RunReader& runs, const std::string& run_id) {
     ids.push_back(d["id"]);
     lab.push_back(d["Lab"]);
     xyz.push_back(d["XYZ"]);
+    if (spectral && d.contains("values") && d["values"].is_array() && d.contains("first_nm") && d.contains("step_nm")) {
+      const std::pair<double, double> g{d["first_nm"].get<double>(), d["step_nm"].get<double>()};
+      if (!grid) {
+        grid = g;
+        bands = d["values"].size();
+      }
+      if (g != *grid || d["values"].size() != bands) spectral = false;
+      spectra.push_back(d["values"]);
+    } else {
+      spectral = false;
+    }
     illuminant = d.value("illuminant", illuminant);
     observer = d.value("observer", observer);
   }
@@ -40,14 +58,21 @@ json chart_reference(RunReader& runs, const std::string& run_id) {
     throw Error(ErrorClass::bad_data, "lab.runs.chart_reference: chart-read run " + run_id + " holds no patches",
                 "run chart-read again");
   }
-  return json{{"run_id", run->id},
-              {"chart", run->params.value("chart", std::string("sg"))},
-              {"illuminant", illuminant},
-              {"observer", observer},
-              {"simulated", run->simulated},
-              {"ids", ids},
-              {"Lab", lab},
-              {"XYZ", xyz}};
+  json out{{"run_id", run->id},
+           {"chart", run->params.value("chart", std::string("sg"))},
+           {"illuminant", illuminant},
+           {"observer", observer},
+           {"simulated", run->simulated},
+           {"ids", ids},
+           {"Lab", lab},
+           {"XYZ", xyz}};
+  if (spectral && grid && bands >= 3) {
+    json wavelengths = json::array();
+    for (std::size_t k = 0; k < bands; ++k) wavelengths.push_back(grid->first + grid->second * static_cast<double>(k));
+    out["wavelengths"] = wavelengths;
+    out["spectra"] = spectra;
+  }
+  return out;
 }
 
 }  // namespace colorlab::campaigns

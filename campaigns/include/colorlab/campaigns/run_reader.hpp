@@ -36,8 +36,9 @@ class RunReader {
 };
 
 // lab.runs.chart_reference(run_id): the reference colours of a finished chart-read run,
-// {run_id, chart, illuminant, observer, simulated, ids, Lab = [[L, a, b], …], XYZ = [[X, Y, Z], …]}
-// in the run's patch order. Error(not_found) for an unknown run, Error(bad_parameter) for a run of
+// {run_id, chart, illuminant, observer, simulated, ids, Lab = [[L, a, b], …], XYZ = [[X, Y, Z], …],
+// wavelengths = [nm, …], spectra = [[reflectance per band], …]} in the run's patch order; wavelengths
+// and spectra only when every patch was stored with its spectrum on one grid (older runs were not). Error(not_found) for an unknown run, Error(bad_parameter) for a run of
 // another campaign, Error(conflict) for one that did not finish.
 nlohmann::json chart_reference(RunReader& runs, const std::string& run_id);
 
