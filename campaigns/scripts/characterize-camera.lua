@@ -1,9 +1,11 @@
 -- Camera characterization (dissertation chapter 7): the chart photographed in the cabinet as RAW,
 -- 16-bit TIFF, 8-bit TIFF and JPEG, N frames averaged per format; each patch's value from the
 -- chart's known layout once the chart is located in the photograph; the reference colours from a
--- chart-read run; then the camera's colour space (§7.1), an ICC profile (§7.2) and the adapted
--- polynomial/spline mappings with model selection (§7.3), each with training and cross-validated
--- ΔE00. The selected model is returned, so it is stored with the run.
+-- chart-read run; then the camera's colour space (§7.1), an ICC profile (§7.2), the adapted
+-- polynomial/spline mappings with model selection (§7.3) and, on the raw, the camera as a black box
+-- (§7.4: spectral sensitivities from the chart-read's spectra under the lamp's standard spectrum),
+-- each with training and cross-validated ΔE00. The selected model is returned, so it is stored with
+-- the run.
 return {
   description = "Camera characterization (chapter 7): chart photographs as RAW, TIFF 16/8 and JPEG against a chart-read run, fitted and cross-validated",
   needs = { "camera", "lamps", "dimmer", "luminance_meter" },
@@ -18,6 +20,8 @@ return {
     lamp = { type = "string", default = "D65", description = "the cabinet lamp to photograph under; empty = leave the cabinet as it is" },
     dimmer_percent = { type = "number", default = 100, min = 1, max = 100, unit = "%", description = "the cabinet's dimmer level" },
     cv = { type = "string", default = "loo", description = "cross-validation: loo, or kN for N folds" },
+    prior_exclude = { type = "array", items = "string", default = {}, max_items = 28,
+                      description = "camspec cameras the black box's prior leaves out (the camera under test, to judge its curves against its published ones)" },
     load_timeout_s = { type = "number", default = 600, min = 0, max = 86400, unit = "s",
                        description = "how long to wait for the operator to confirm the chart before photographing anyway" },
   },
@@ -50,9 +54,9 @@ return {
     end
     lab.progress(0.1, "photographing")
     -- The reference's luminances let the locator tell patches as dark as the chart's surround (no edge of their
-    -- own) from a covered chart.
+    -- own) from a covered chart. (Only ids and XYZ: the spectra would swell the call's journal entry.)
     local shots = lab.camera.photograph_chart { frames = p.frames, chart = p.chart, formats = p.formats, camera = p.camera,
-                                                reference = ref }
+                                                reference = { ids = ref.ids, XYZ = ref.XYZ } }
     local out = { reference_run = p.reference_run, chart = p.chart, frames = p.frames, lamp = p.lamp,
                   instrument = shots.instrument, formats = {} }
     local best_format, best_cv
@@ -72,7 +76,8 @@ return {
         })
       end
       lab.progress(0.1 + 0.9 * (k - 0.5) / #p.formats, "fitting " .. format)
-      local c = lab.analysis.characterize(f, ref, { cv = p.cv })
+      -- The black box (raw only) takes the lamp's spectrum to be its standard illuminant's.
+      local c = lab.analysis.characterize(f, ref, { cv = p.cv, lamp = p.lamp, prior_exclude = p.prior_exclude })
       for name, approach in pairs(c.approaches) do
         lab.record("characterization/" .. format .. "/" .. name, {
           quantity = "delta_e00_cv_mean", value = approach.cv.mean, unit = "ΔE00", instrument = shots.instrument,
@@ -83,7 +88,7 @@ return {
       if best_cv == nil or chosen < best_cv then best_format, best_cv = format, chosen end
       out.formats[format] = { confidence = f.confidence, rotation_deg = f.rotation_deg, corners = f.corners,
                               check = f.check, approaches = c.approaches, best_approach = c.best_approach,
-                              selected = c.selected }
+                              selected = c.selected, not_fitted = c.not_fitted }
     end
     -- The model to use from now on: the adapted mapping of the format that cross-validates best.
     out.selected = { format = best_format, cv_mean_de00 = best_cv, model = out.formats[best_format].selected }

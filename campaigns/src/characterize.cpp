@@ -302,7 +302,13 @@ BlackBoxSetup black_box_setup(const ca::ChartData& d, const json& camera, const 
   for (auto k : bands) s.wavelengths.push_back(grid[k]);
   if (s.wavelengths.size() < 3) throw bad("the reference's spectra and the prior's curves share fewer than 3 wavelengths");
   if (curves) {
-    if (options.contains("prior_exclude")) s.prior_excluded = options["prior_exclude"].get<std::vector<std::string>>();
+    // An empty Lua table arrives as an object.
+    if (options.contains("prior_exclude") && options["prior_exclude"].is_array()) {
+      for (const auto& name : options["prior_exclude"]) {
+        if (!name.is_string()) throw Error(ErrorClass::bad_parameter, "lab.analysis.characterize: prior_exclude must list camera names");
+        s.prior_excluded.push_back(name);
+      }
+    }
     s.prior = ca::learn_sensitivity_prior(*curves, s.wavelengths, s.prior_excluded);
   }
 
@@ -357,7 +363,17 @@ json black_box(const ca::ChartData& d, const BlackBoxSetup& s, const std::string
   fo.target = target;
   const ca::BlackBoxModel model = ca::fit_blackbox(s.radiance, d.rgb, bo);
   const Eigen::MatrixXd predicted = model.predict(s.radiance);
-  const auto training = ca::evaluate(ca::fit_method(method, d, fo).apply(predicted), d.lab);
+  const ca::Characterization mapping = ca::fit_method(method, d, fo);
+  const auto training = ca::evaluate(mapping.apply(predicted), d.lab);
+  // A fold's mapping: the method refitted without the fold; a spline at the λ chosen on every patch,
+  // as the adapted mapping's own leave-one-out does (spline_report), and not searched again per fold
+  // (a λ search per patch costs a hundred times the fit).
+  auto refit_mapping = [&](const ca::ChartData& train) {
+    if (!mapping.spline()) return ca::fit_method(method, train, fo);
+    ca::SplineOptions so = ca::spline_options(method, fo);
+    so.smoothing = mapping.spline()->smoothing();
+    return ca::Characterization(ca::fit_spline(train, so));
+  };
 
   Eigen::MatrixXd held_counts(d.rgb.rows(), 3), held_lab(d.rgb.rows(), 3);
   for (const auto& held : folds(d.size(), cv)) {
@@ -366,7 +382,7 @@ json black_box(const ca::ChartData& d, const BlackBoxSetup& s, const std::string
       if (std::find(held.begin(), held.end(), i) == held.end()) keep.push_back(i);
     }
     const Eigen::MatrixXd counts = ca::fit_blackbox(rows_of(s.radiance, keep), rows_of(d.rgb, keep), bo).predict(rows_of(s.radiance, held));
-    const Eigen::MatrixXd lab = ca::fit_method(method, d.subset(keep), fo).apply(counts);
+    const Eigen::MatrixXd lab = refit_mapping(d.subset(keep)).apply(counts);
     for (std::size_t j = 0; j < held.size(); ++j) {
       held_counts.row(static_cast<Eigen::Index>(held[j])) = counts.row(static_cast<Eigen::Index>(j));
       held_lab.row(static_cast<Eigen::Index>(held[j])) = lab.row(static_cast<Eigen::Index>(j));
