@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdlib>
 
 #include "colorlab/core/error.hpp"
@@ -60,6 +61,7 @@ struct Lab::Impl {
   std::shared_ptr<RelayBoard> relay_board;
   std::unique_ptr<RelaySocketServer> relay;
   std::vector<std::shared_ptr<boost::asio::steady_timer>> dropouts;
+  json drifts = json::object();  // lamp → the drift last commanded
   int aim_row = 0, aim_col = 0;
 
   // Lamp dropout: the lamp goes dark for `seconds` of simulated time, then relights (and warms up
@@ -80,6 +82,47 @@ struct Lab::Impl {
       });
     }
     return {{"lamp", to_string(lamp)}, {"seconds", seconds}, {"was_on", was_on}};
+  }
+
+  // Lamp drift: the lamp's output moves by `rate_pct_per_min` % of normal per simulated minute for `seconds`,
+  // then holds there (`then` = "hold", an overheated or aged tube at its new equilibrium) or comes back at the
+  // same rate ("return", the overheating clears). Rate 0 clears a drift.
+  json lamp_drift(const json& spec) {
+    if (!spec.is_object()) {
+      throw Error(ErrorClass::bad_parameter,
+                  "lamp_drift must be {\"lamp\":NAME,\"rate_pct_per_min\":R,\"seconds\":S,\"then\":\"hold\"|\"return\"}");
+    }
+    Lamp lamp = lamp_from_string(spec.value("lamp", std::string()));
+    const double rate = spec.value("rate_pct_per_min", 0.0), seconds = spec.value("seconds", 0.0);
+    const std::string then = spec.value("then", std::string("hold"));
+    if (then != "hold" && then != "return") throw Error(ErrorClass::bad_parameter, "lamp_drift.then must be \"hold\" or \"return\"");
+    if (!(seconds >= 0) || !(std::abs(rate) <= 100)) {
+      throw Error(ErrorClass::bad_parameter, "lamp_drift needs seconds >= 0 and a rate of at most 100 %/min either way");
+    }
+    LampDrift drift{clock->now(), rate / 100.0 / 60.0, seconds, then == "return"};
+    scene->set_lamp_drift(lamp, drift);
+    drifts[std::string(to_string(lamp))] = {{"rate_pct_per_min", rate}, {"seconds", seconds}, {"then", then}, {"start_s", drift.start_s}};
+    return {{"lamp", to_string(lamp)}, {"rate_pct_per_min", rate}, {"seconds", seconds}, {"then", then}, {"start_s", drift.start_s}};
+  }
+
+  // The cabinet's faults, which may ride along in any instrument's fault command: done, answered, removed.
+  void cabinet_faults(json& faults, json& answer) {
+    if (!faults.is_object()) return;
+    if (faults.contains("lamp_dropout")) answer["lamp_dropout"] = lamp_dropout(faults["lamp_dropout"]);
+    if (faults.contains("lamp_drift")) answer["lamp_drift"] = lamp_drift(faults["lamp_drift"]);
+    faults.erase("lamp_dropout");
+    faults.erase("lamp_drift");
+  }
+
+  // Ground truth of the drifts started: each lamp's drift as commanded and its output factor now.
+  json drift_truth() const {
+    json out = json::object();
+    for (const auto& [lamp, spec] : drifts.items()) {
+      json t = spec;
+      t["factor"] = scene->drift_factor(lamp_from_string(lamp));
+      out[lamp] = t;
+    }
+    return out;
   }
 
   json spectrolino_truth() const {
@@ -319,6 +362,10 @@ json Lab::control(const json& command) {
       json warmup = json::object();
       for (auto l : d.scene->lamps_on()) warmup[std::string(to_string(l))] = d.scene->warmup_factor(l);
       t["warmup"] = warmup;  // 1 = fully warm
+      t["drift"] = d.drift_truth();  // per lamp a drift was started on: the command and its factor now (1 = none)
+      json output = json::object();
+      for (auto l : d.scene->lamps_on()) output[std::string(to_string(l))] = d.scene->output_factor(l);
+      t["output"] = output;  // warm-up × drift: each lit lamp's output relative to normal
       if (d.dslr) t["dslr"] = d.dslr->truth();
       if (d.relay) {
         t["relay"] = {{"board_id", d.relay_board->board_id()}, {"mask", d.relay_board->mask()},
@@ -343,10 +390,12 @@ json Lab::control(const json& command) {
       std::string id = command.value("instrument", std::string());
       json faults = command.value("faults", json::object());
       json answer{{"ok", true}};
-      if (faults.is_object() && faults.contains("lamp_dropout")) {
-        answer["lamp_dropout"] = d.lamp_dropout(faults["lamp_dropout"]);
-        faults.erase("lamp_dropout");
-        if (id == "cabinet") return answer;
+      if (id == "cabinet" || (faults.is_object() && (faults.contains("lamp_dropout") || faults.contains("lamp_drift")))) {
+        d.cabinet_faults(faults, answer);
+        if (id == "cabinet") {
+          if (!faults.empty()) throw Error(ErrorClass::bad_parameter, "unknown cabinet fault '" + faults.begin().key() + "'", "lamp_dropout, lamp_drift");
+          return answer;
+        }
       }
       if (d.ls110 && id == d.config.ls110.id) {
         d.ls110->set_faults(faults.get<Ls110Faults>());
@@ -384,7 +433,7 @@ json Lab::control(const json& command) {
         return answer;
       }
       throw Error(ErrorClass::not_found, "no simulated instrument '" + id + "' takes faults",
-                  "use an id from the announcement, or \"cabinet\" for lamp_dropout alone");
+                  "use an id from the announcement, or \"cabinet\" for lamp_dropout or lamp_drift alone");
     }
     if (cmd == "place") {
       if (!d.spectrolino || command.value("instrument", d.config.spectrolino.id) != d.config.spectrolino.id) {

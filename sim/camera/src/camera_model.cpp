@@ -397,8 +397,8 @@ void CameraModel::render_into(RawFrame& out, const CameraSettings& settings, std
 
   std::array<float, 5> warm{};
   for (std::size_t li = 0; li < pre->lamps.size(); ++li)
-    warm[li] = static_cast<float>(impl_->scene->warmup_factor(pre->lamps[li]));
-  // Warm-up is continuous; quantising it to 1e-4 keeps frames during a warm-up cheap and changes nothing visible.
+    warm[li] = static_cast<float>(impl_->scene->output_factor(pre->lamps[li]));
+  // Warm-up (and drift) is continuous; quantising it to 1e-4 keeps frames during a warm-up cheap and changes nothing visible.
   for (float& w : warm) w = std::round(w * 1e4f) / 1e4f;
   const auto mom = impl_->moments_for(pre, warm);
   const float white = static_cast<float>(out.white_level);
@@ -473,7 +473,7 @@ std::vector<std::array<double, 3>> CameraModel::ground_truth(const CameraSetting
     for (std::size_t c = 0; c < 3; ++c) {
       double e = pre->dark_e;
       for (std::size_t li = 0; li < pre->lamps.size(); ++li)
-        e += impl_->scene->warmup_factor(pre->lamps[li]) * pre->truth_e[li][static_cast<std::size_t>(m)][c];
+        e += impl_->scene->output_factor(pre->lamps[li]) * pre->truth_e[li][static_cast<std::size_t>(m)][c];
       out[static_cast<std::size_t>(m)][c] = std::min(256.0 + pre->gain * e, 4095.0);
     }
   return out;
@@ -526,7 +526,7 @@ std::array<double, 3> CameraModel::as_shot_neutral() const {
   const Spectrum white{380.0, 350.0, {1.0, 1.0}};
   std::array<double, 3> rgb{};
   for (Lamp l : lamps) {
-    const double k = impl_->scene->lamp_floor_luminance(l, dimmer, fx, fy) * impl_->scene->warmup_factor(l);
+    const double k = impl_->scene->lamp_floor_luminance(l, dimmer, fx, fy) * impl_->scene->output_factor(l);
     const Spectrum rad = impl_->scene->lamp_radiance_per_cd(l, white);
     for (std::size_t c = 0; c < 3; ++c) {
       double sum = 0;

@@ -73,6 +73,7 @@ struct Scene::Impl {
   mutable std::mutex mutex;
   std::array<bool, 5> on{};
   std::array<double, 5> switched_on_at{};
+  std::array<LampDrift, 5> drift{};
   double dimmer = 100.0;
   std::uint64_t version = 0;
 
@@ -86,7 +87,15 @@ struct Scene::Impl {
     if (!(dt < std::numeric_limits<double>::infinity())) return 1.0;
     return 1.0 - (1.0 - start) * std::exp(-std::max(dt, 0.0) / tau);
   }
+  double output_locked(Lamp l, double now) const { return warmup_locked(l, now) * drift[index(l)].factor_at(now); }
 };
+
+double LampDrift::factor_at(double t) const {
+  if (!(duration_s > 0) || rate_per_s == 0 || !(t > start_s)) return 1.0;
+  double dt = t - start_s;
+  if (returns && dt > duration_s) dt = std::max(0.0, 2.0 * duration_s - dt);
+  return std::max(0.0, 1.0 + rate_per_s * std::min(dt, duration_s));
+}
 
 Scene::Scene(SceneConfig config, std::shared_ptr<const SimClock> clock) : impl_(std::make_unique<Impl>()) {
   if (!clock) throw Error(ErrorClass::bad_parameter, "Scene needs a SimClock");
@@ -159,6 +168,28 @@ double Scene::warmup_factor(Lamp lamp) const {
   return impl_->warmup_locked(lamp, now);
 }
 
+void Scene::set_lamp_drift(Lamp lamp, const LampDrift& drift) {
+  if (!std::isfinite(drift.start_s) || !std::isfinite(drift.rate_per_s) || !std::isfinite(drift.duration_s) ||
+      drift.duration_s < 0) {
+    throw Error(ErrorClass::bad_parameter, "a lamp drift needs a finite start and rate and a duration >= 0");
+  }
+  std::lock_guard lock(impl_->mutex);
+  impl_->drift[index(lamp)] = drift;
+  ++impl_->version;
+}
+
+double Scene::drift_factor(Lamp lamp) const {
+  const double now = impl_->clock->now();
+  std::lock_guard lock(impl_->mutex);
+  return impl_->drift[index(lamp)].factor_at(now);
+}
+
+double Scene::output_factor(Lamp lamp) const {
+  const double now = impl_->clock->now();
+  std::lock_guard lock(impl_->mutex);
+  return impl_->output_locked(lamp, now);
+}
+
 std::uint64_t Scene::state_version() const {
   std::lock_guard lock(impl_->mutex);
   return impl_->version;
@@ -183,7 +214,7 @@ double Scene::floor_luminance_at(double x_mm, double y_mm) const {
   double sum = 0.0;
   for (Lamp l : all_lamps) {
     if (!impl_->on[index(l)]) continue;
-    sum += impl_->fields[index(l)].at(x_mm, y_mm, impl_->dimmer) * impl_->warmup_locked(l, now);
+    sum += impl_->fields[index(l)].at(x_mm, y_mm, impl_->dimmer) * impl_->output_locked(l, now);
   }
   return sum;
 }
@@ -208,7 +239,7 @@ Spectrum Scene::spectral_radiance(double x_mm, double y_mm, const Spectrum& refl
     const std::size_t i = index(l);
     if (!impl_->on[i]) continue;
     // Scale the relative SPD so that the grey floor (reflectance 0.30) has the field's luminance.
-    const double floor_l = impl_->fields[i].at(x_mm, y_mm, impl_->dimmer) * impl_->warmup_locked(l, now);
+    const double floor_l = impl_->fields[i].at(x_mm, y_mm, impl_->dimmer) * impl_->output_locked(l, now);
     const double k = floor_l / (max_luminous_efficacy * floor_reflectance() * impl_->lamp_y[i]);
     const auto& s = impl_->lamp_on_grid[i].values;
     for (std::size_t j = 0; j < radiance_samples; ++j) out.values[j] += k * s[j];

@@ -166,6 +166,41 @@ TEST(SimWarmUp, DriftFollowsSimulatedTime) {
   EXPECT_NEAR(scene.warmup_factor(Lamp::cwf), 1.0, 1e-3);
 }
 
+TEST(SimLampDrift, RampsForItsDurationThenHoldsOrReturns) {
+  const LampDrift hold{100.0, -0.001, 60.0, false};  // −0.1 % per simulated second (−6 %/min) for a minute
+  EXPECT_DOUBLE_EQ(hold.factor_at(50.0), 1.0);
+  EXPECT_NEAR(hold.factor_at(130.0), 0.97, 1e-12);
+  EXPECT_NEAR(hold.factor_at(160.0), 0.94, 1e-12);
+  EXPECT_NEAR(hold.factor_at(5000.0), 0.94, 1e-12);  // a tube at its new equilibrium stays there
+  LampDrift back = hold;
+  back.returns = true;
+  EXPECT_NEAR(back.factor_at(190.0), 0.97, 1e-12);  // comes back at the same rate …
+  EXPECT_DOUBLE_EQ(back.factor_at(220.0), 1.0);      // … and is normal again after as long again
+  EXPECT_DOUBLE_EQ(back.factor_at(5000.0), 1.0);
+  EXPECT_DOUBLE_EQ((LampDrift{0.0, -0.1, 100.0, false}.factor_at(50.0)), 0.0);  // never below dark
+  EXPECT_DOUBLE_EQ((LampDrift{0.0, 0.0, 100.0, false}.factor_at(50.0)), 1.0);
+}
+
+TEST(SimLampDrift, EveryReadingOfTheSceneSeesIt) {
+  SceneConfig cfg = synthetic_config();
+  cfg.lamps_on_at_start = {Lamp::d65};
+  auto clock = std::make_shared<SimClock>(1.0);
+  Scene scene(cfg, clock);
+  const double steady = scene.floor_luminance(0, 10);
+  const auto [x, y] = Scene::floor_spot_position_mm(0, 10);
+  const double white_y = scene.white_radiance(x, y).values[40];
+  // Started 30 s ago at −0.1 %/s for a minute: 3 % down now (the clock moves microseconds meanwhile).
+  scene.set_lamp_drift(Lamp::d65, LampDrift{clock->now() - 30.0, -0.001, 60.0, false});
+  EXPECT_NEAR(scene.drift_factor(Lamp::d65), 0.97, 1e-4);
+  EXPECT_NEAR(scene.output_factor(Lamp::d65), 0.97, 1e-4);
+  EXPECT_NEAR(scene.floor_luminance(0, 10) / steady, 0.97, 1e-4);
+  EXPECT_NEAR(scene.white_radiance(x, y).values[40] / white_y, 0.97, 1e-4);
+  EXPECT_DOUBLE_EQ(scene.drift_factor(Lamp::tl84), 1.0);
+  scene.set_lamp_drift(Lamp::d65, LampDrift{});  // cleared
+  EXPECT_DOUBLE_EQ(scene.floor_luminance(0, 10), steady);
+  EXPECT_THROW(scene.set_lamp_drift(Lamp::d65, LampDrift{0.0, -0.001, -1.0, false}), colorlab::Error);
+}
+
 TEST(SimField, SeedsGiveDifferentButDeterministicCabinets) {
   const Scene a(synthetic_config(3), std::make_shared<SimClock>());
   const Scene b(synthetic_config(3), std::make_shared<SimClock>());

@@ -142,6 +142,30 @@ TEST(SimSerialPty, LampDropoutSeenInEmission) {
   EXPECT_GT(measure_y(c), 0.8 * lit);  // relit, still warming up
 }
 
+TEST(SimSerialPty, LampDriftThroughTheControlChannelWithItsTruth) {
+  SimProcess sim(kLab);
+  const double before = sim.control({{"cmd", "truth"}})["ls110"]["luminance"].get<double>();
+  // −30 %/min for 10 simulated seconds (1 s real at time scale 10), then back at the same rate.
+  auto r = sim.control({{"cmd", "fault"}, {"instrument", "cabinet"},
+                        {"faults", {{"lamp_drift", {{"lamp", "D65"}, {"rate_pct_per_min", -30}, {"seconds", 10}, {"then", "return"}}}}}});
+  ASSERT_TRUE(r["ok"].get<bool>()) << r.dump();
+  EXPECT_EQ(r["lamp_drift"]["then"], "return");
+  sleep_s(1.5);  // 15 simulated seconds: 5 % down at 10 s, 2.5 % down now
+  auto t = sim.control({{"cmd", "truth"}});
+  const double factor = t["drift"]["D65"]["factor"].get<double>();
+  EXPECT_GT(factor, 0.95);
+  EXPECT_LT(factor, 0.99);
+  // Warm from the start: its output is the drift alone (read a few microseconds apart: 0.5 %/s moves 1e-6 in 0.2 ms).
+  EXPECT_NEAR(t["output"]["D65"].get<double>(), factor, 1e-5);
+  EXPECT_NEAR(t["ls110"]["luminance"].get<double>(), before * factor, 1e-3 * before);
+  sleep_s(1.0);  // past 20 simulated seconds: normal again
+  t = sim.control({{"cmd", "truth"}});
+  EXPECT_DOUBLE_EQ(t["drift"]["D65"]["factor"].get<double>(), 1.0);
+  EXPECT_NEAR(t["ls110"]["luminance"].get<double>(), before, 1e-9 * before);
+  EXPECT_FALSE(sim.control({{"cmd", "fault"}, {"instrument", "cabinet"}, {"faults", {{"lamp_drift", {{"lamp", "D65"}, {"then", "later"}}}}}})["ok"].get<bool>());
+  EXPECT_FALSE(sim.control({{"cmd", "fault"}, {"instrument", "cabinet"}, {"faults", {{"lamp_flicker", true}}}})["ok"].get<bool>());
+}
+
 TEST(SimSerialPty, DmxWidgetDrivesTheScene) {
   SimProcess sim(kLab);
   SerialClient c(sim.port("dmx"), 115200);

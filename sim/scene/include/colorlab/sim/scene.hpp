@@ -67,6 +67,21 @@ struct SceneConfig {
   double dimmer_percent_at_start = 100.0;
 };
 
+// A lamp whose light output drifts (docs/simulator.md, "Cabinet" faults). From `start_s` (simulated seconds)
+// its output changes linearly by `rate_per_s` (a fraction of its normal output per simulated second;
+// negative = dimmer) for `duration_s`; then it holds that level (`returns` false: a tube that has settled at
+// a new thermal equilibrium, or aged) or comes back at the same rate and is normal again after another
+// `duration_s` (`returns` true: the overheating clears). The drift follows simulated time whether the lamp
+// is lit or not, and multiplies whatever the warm-up gives.
+struct LampDrift {
+  double start_s = 0;
+  double rate_per_s = 0;
+  double duration_s = 0;
+  bool returns = false;
+  // Output multiplier at simulated time t (1 before the start; never below 0).
+  double factor_at(double t) const;
+};
+
 struct ChartPatch {
   std::string name;       // "A1".."N10"
   int column = 0;         // 0..13 (A..N)
@@ -101,12 +116,18 @@ class Scene {
   static double dimmer_output(double percent);
   // Multiplier in (0,1] from warm-up since the lamp was last switched on (1 when off or warm).
   double warmup_factor(Lamp lamp) const;
+  // Starts (or replaces) a drift of the lamp's output; a zero rate or duration clears it.
+  void set_lamp_drift(Lamp lamp, const LampDrift& drift);
+  // Multiplier of the lamp's output from its drift now (1 = none, or over and returned).
+  double drift_factor(Lamp lamp) const;
+  // The lamp's output relative to normal now: warm-up × drift (what every instrument sees).
+  double output_factor(Lamp lamp) const;
   // Monotonic counter bumped by every lamp/dimmer change (lets renderers cache per state).
   std::uint64_t state_version() const;
 
   // ---- luminance field (LS-110 reads these) ----
-  // True floor luminance in cd/m² at grid spot (row 0..7 front first, col 0..19), current lamps, dimmer and
-  // warm-up, no noise. Throws Error(bad_parameter) for spots off the grid.
+  // True floor luminance in cd/m² at grid spot (row 0..7 front first, col 0..19), current lamps, dimmer,
+  // warm-up and drift, no noise. Throws Error(bad_parameter) for spots off the grid.
   double floor_luminance(int row, int col) const;
   // The same at any floor point (mm).
   double floor_luminance_at(double x_mm, double y_mm) const;
@@ -120,12 +141,12 @@ class Scene {
   // Relative SPD of a lamp (colord CIE tables on their 5 nm grid, UV a near-UV band), peak-normalised to 1.
   const Spectrum& lamp_spectrum(Lamp lamp) const;
   // Spectral radiance (W·sr⁻¹·m⁻²·nm⁻¹, 380–730 nm, 5 nm) leaving a Lambertian surface with the given
-  // reflectance at floor point (x, y) under the current lamps, dimmer and warm-up.
+  // reflectance at floor point (x, y) under the current lamps, dimmer, warm-up and drift.
   Spectrum spectral_radiance(double x_mm, double y_mm, const Spectrum& reflectance) const;
   // Spectral irradiance-like quantity per unit reflectance: spectral_radiance of a perfect white.
   Spectrum white_radiance(double x_mm, double y_mm) const;
   // Spectral radiance (380–730 nm, 5 nm) of a surface with this reflectance lit by one lamp at the strength
-  // that gives the grey floor a luminance of 1 cd/m²: multiply by lamp_floor_luminance × warmup_factor.
+  // that gives the grey floor a luminance of 1 cd/m²: multiply by lamp_floor_luminance × output_factor.
   Spectrum lamp_radiance_per_cd(Lamp lamp, const Spectrum& reflectance) const;
   // Truth for colorimetry: a chart patch's CIE 1931 XYZ (absolute, Y in cd/m²) under the current lamps at its
   // place in the cabinet, and its L*a*b* relative to a perfect white at the same place.

@@ -90,7 +90,7 @@ class CameraModel {
   std::uint64_t seed() const;
   const CameraConfig& config() const;
 
-  // Renders frame `frame_index` under the scene's current lamps, dimmer and warm-up. Thread-safe.
+  // Renders frame `frame_index` under the scene's current lamps, dimmer, warm-up and drift. Thread-safe.
   // Throws Error(bad_parameter) for non-positive f-number/shutter or ISO outside 50..3200.
   RawFrame render(const CameraSettings& settings, std::uint64_t frame_index) const;
   // Same, reusing `out`'s buffer.
