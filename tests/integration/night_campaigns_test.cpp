@@ -42,14 +42,6 @@ struct SceneTruth {
   }
 };
 
-json run_to_end(const client::ApiClient& api, const std::string& campaign, const json& params,
-                std::chrono::seconds timeout = std::chrono::seconds(120)) {
-  auto e = api.post("/v1/executions", {{"campaign", campaign}, {"params", params}});
-  auto done = wait_terminal(api, e["id"], timeout);
-  EXPECT_EQ(done["status"], "finished_ok") << done.dump(2);
-  return api.get("/v1/runs/" + e["run_id"].get<std::string>());
-}
-
 const json kGridParams = {{"rows", 4}, {"cols", 5}, {"lamps", {"D65", "TL84"}}, {"dimmer_levels", {100, 40}}};
 
 TEST(NightCampaigns, CabinetGridMatchesTheSimulatorsFloorAndItsAnalyses) {
@@ -209,68 +201,28 @@ TEST(NightCampaigns, OperatorRequestAnsweredThroughTheApiAndOneLeftToItsDefault)
   daemon.kill9();
 }
 
-// kill -9 at random moments: the execution completes by itself after each restart, the database is
-// whole, and the stored steps are exactly the uninterrupted run's, with readings that agree within
-// the simulator's noise.
-void kill_and_compare(const std::string& campaign, const json& params, double time_scale, int max_delay_ms,
-                      double relative_tolerance, double absolute_tolerance, int seeds) {
-  std::vector<std::string> reference_steps;
-  std::map<std::string, double> reference_values;
-  {
-    TempDir dir;
-    DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), time_scale, kSeed));
-    auto run = run_to_end(api_for(daemon), campaign, params);
-    for (const auto& m : run["measurements"]) {
-      reference_steps.push_back(m["step"]);
-      reference_values[m["step"]] = m["value"].get<double>();
-    }
-    daemon.kill9();
-  }
-  ASSERT_FALSE(reference_steps.empty());
-  int kills_done = 0;
-  for (int seed = 1; seed <= seeds; ++seed) {
-    TempDir dir;
-    DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), time_scale, kSeed));
-    auto api = api_for(daemon);
-    auto e = api.post("/v1/executions", {{"campaign", campaign}, {"params", params}});
-    std::mt19937 rng(static_cast<unsigned>(seed * 104729));
-    for (int k = 0; k < 2; ++k) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(std::uniform_int_distribution<int>(50, max_delay_ms)(rng)));
-      auto before = api.get("/v1/executions/" + e["id"].get<std::string>());
-      if (before["status"] != "running" && before["status"] != "waiting") break;
-      daemon.kill9();
-      ++kills_done;
-      EXPECT_EQ(integrity_check(daemon.state_dir()), "ok");
-      daemon.start();
-      api = api_for(daemon);
-    }
-    auto done = wait_terminal(api, e["id"], std::chrono::seconds(180));
-    ASSERT_EQ(done["status"], "finished_ok") << campaign << " seed " << seed << ": " << done.dump(2);
-    json run = api.get("/v1/runs/" + e["run_id"].get<std::string>());
-    std::vector<std::string> steps;
-    for (const auto& m : run["measurements"]) {
-      steps.push_back(m["step"]);
-      double ref = reference_values[m["step"]];
-      EXPECT_NEAR(m["value"].get<double>(), ref, relative_tolerance * std::abs(ref) + absolute_tolerance) << m["step"];
-    }
-    EXPECT_EQ(steps, reference_steps) << campaign << " seed " << seed;
-    daemon.kill9();
-    EXPECT_EQ(integrity_check(daemon.state_dir()), "ok");
-  }
-  EXPECT_GT(kills_done, 0) << "every run finished before its first kill: the test proved nothing";
-}
-
+// kill -9 at random moments (kill_and_compare, resume_support.hpp).
 TEST(NightCampaigns, CabinetGridSurvivesKillNine) {
   // Luminances agree within the LS-110's noise and the warm-up residual the criterion allows (see above).
-  kill_and_compare("cabinet-grid", {{"rows", 2}, {"cols", 3}, {"lamps", {"D65", "TL84"}}, {"dimmer_levels", {100, 40}}},
-                   300, 2500, 0.03, 0, 3);
+  KillNineCase c;
+  c.campaign = "cabinet-grid";
+  c.seed = kSeed;
+  c.params = {{"rows", 2}, {"cols", 3}, {"lamps", {"D65", "TL84"}}, {"dimmer_levels", {100, 40}}};
+  c.time_scale = 300;
+  c.tolerance = [](const json&, double ref) { return 0.03 * std::abs(ref); };
+  kill_and_compare(c);
 }
 
 TEST(NightCampaigns, ChartReadSurvivesKillNine) {
   // L* of a re-read patch agrees within the Spectrolino's noise: per band 0.05 % + 0.1 % of the value,
   // so Y of the darkest patch (≈ 0.007) is known to ≈ 1.6e-4 and L* = 903.3 Y there to ≈ 0.15; two
   // independent readings differ by up to 4·√2·0.15 ≈ 0.85 L*, and the 0.1 % gain adds 0.3 % of L*.
-  kill_and_compare("chart-read", json::object(), 100, 3000, 0.003, 0.85, 3);
+  KillNineCase c;
+  c.campaign = "chart-read";
+  c.seed = kSeed;
+  c.max_delay_ms = 3000;
+  c.tolerance = [](const json&, double ref) { return 0.003 * std::abs(ref) + 0.85; };
+  kill_and_compare(c);
 }
 
 }  // namespace

@@ -3,7 +3,11 @@
 #include <sqlite3.h>
 
 #include <fstream>
+#include <map>
+#include <random>
 #include <thread>
+
+#include <gtest/gtest.h>
 
 #include "colorlab/protocol/states.hpp"
 
@@ -50,6 +54,80 @@ std::string integrity_check(const std::filesystem::path& state_dir) {
   }
   sqlite3_close(db);
   return result;
+}
+
+nlohmann::json run_to_end(const client::ApiClient& api, const std::string& campaign, const nlohmann::json& params,
+                          std::chrono::seconds timeout) {
+  auto e = api.post("/v1/executions", {{"campaign", campaign}, {"params", params}});
+  auto done = wait_terminal(api, e["id"], timeout);
+  EXPECT_EQ(done["status"], "finished_ok") << done.dump(2);
+  return api.get("/v1/runs/" + e["run_id"].get<std::string>());
+}
+
+namespace {
+
+struct KillNineDaemon {
+  TempDir dir;
+  DaemonProcess daemon;
+  explicit KillNineDaemon(const KillNineCase& c)
+      : daemon(dir / "state", [&] {
+          auto config = write_daemon_config(dir.path(), c.time_scale, c.seed);
+          if (!c.lab_toml.empty()) std::ofstream(dir / "lab.toml") << c.lab_toml;
+          return config;
+        }()) {}
+  nlohmann::json params(const KillNineCase& c) const {
+    nlohmann::json p = c.params;
+    if (c.prepare) p.update(c.prepare(api_for(daemon)));
+    return p;
+  }
+};
+
+}  // namespace
+
+void kill_and_compare(const KillNineCase& c) {
+  std::vector<std::string> reference_steps;
+  std::map<std::string, double> reference_values;
+  {
+    KillNineDaemon d(c);
+    auto run = run_to_end(api_for(d.daemon), c.campaign, d.params(c), c.timeout);
+    for (const auto& m : run["measurements"]) {
+      reference_steps.push_back(m["step"]);
+      reference_values[m["step"]] = m["value"].get<double>();
+    }
+    d.daemon.kill9();
+  }
+  ASSERT_FALSE(reference_steps.empty());
+  int kills_done = 0;
+  for (int seed = 1; seed <= c.runs; ++seed) {
+    KillNineDaemon d(c);
+    auto& daemon = d.daemon;
+    auto api = api_for(daemon);
+    auto e = api.post("/v1/executions", {{"campaign", c.campaign}, {"params", d.params(c)}});
+    std::mt19937 rng(static_cast<unsigned>(seed * 104729));
+    for (int k = 0; k < 2; ++k) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(std::uniform_int_distribution<int>(50, c.max_delay_ms)(rng)));
+      auto before = api.get("/v1/executions/" + e["id"].get<std::string>());
+      if (before["status"] != "running" && before["status"] != "waiting") break;
+      daemon.kill9();
+      ++kills_done;
+      EXPECT_EQ(integrity_check(daemon.state_dir()), "ok");
+      daemon.start();
+      api = api_for(daemon);
+    }
+    auto done = wait_terminal(api, e["id"], c.timeout);
+    ASSERT_EQ(done["status"], "finished_ok") << c.campaign << " seed " << seed << ": " << done.dump(2);
+    auto run = api.get("/v1/runs/" + e["run_id"].get<std::string>());
+    std::vector<std::string> steps;
+    for (const auto& m : run["measurements"]) {
+      steps.push_back(m["step"]);
+      const double ref = reference_values[m["step"]];
+      EXPECT_NEAR(m["value"].get<double>(), ref, c.tolerance(m, ref)) << c.campaign << " seed " << seed << ": " << m["step"];
+    }
+    EXPECT_EQ(steps, reference_steps) << c.campaign << " seed " << seed;
+    daemon.kill9();
+    EXPECT_EQ(integrity_check(daemon.state_dir()), "ok");
+  }
+  EXPECT_GT(kills_done, 0) << "every run finished before its first kill: the test proved nothing";
 }
 
 }  // namespace colorlab::testing

@@ -2,7 +2,9 @@
 // Shared by the resume tests: a colorlabd with its embedded simulated lab on a fresh state
 // directory, and the checks every kill -9 test makes.
 #include <chrono>
+#include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -24,5 +26,29 @@ nlohmann::json wait_terminal(const client::ApiClient& api, const std::string& ex
                              std::chrono::seconds timeout = std::chrono::seconds(90));
 // PRAGMA integrity_check of the daemon's database (the daemon must be stopped): "ok" or what is wrong.
 std::string integrity_check(const std::filesystem::path& state_dir);
+
+// Starts the campaign, waits for it (expecting finished_ok) and returns its run with the measurements.
+nlohmann::json run_to_end(const client::ApiClient& api, const std::string& campaign, const nlohmann::json& params,
+                          std::chrono::seconds timeout = std::chrono::seconds(120));
+
+// kill -9 at random moments of a campaign on the embedded simulated lab: the execution completes by
+// itself after each restart, the database is whole, and the stored steps are exactly those of an
+// uninterrupted run on a fresh daemon, each value within `tolerance` of that run's.
+struct KillNineCase {
+  std::string campaign;
+  nlohmann::json params = nlohmann::json::object();
+  double time_scale = 100;
+  std::uint64_t seed = 5;
+  int max_delay_ms = 2500;  // each of (at most) two kills per run comes 50..max_delay_ms after the previous event
+  int runs = 3;             // interrupted runs, each on a fresh daemon with its own random moments
+  std::string lab_toml;     // the simulated lab's configuration, when not write_daemon_config's
+  // On each fresh daemon before the campaign starts (not interrupted): parameters to add, e.g. the id of
+  // a chart-read run the campaign reads.
+  std::function<nlohmann::json(const client::ApiClient&)> prepare;
+  // How far a measurement's value may lie from the uninterrupted run's value of the same step.
+  std::function<double(const nlohmann::json& measurement, double reference_value)> tolerance;
+  std::chrono::seconds timeout = std::chrono::seconds(180);
+};
+void kill_and_compare(const KillNineCase& c);
 
 }  // namespace colorlab::testing
