@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <utility>
 
 #include <boost/asio/steady_timer.hpp>
 #include <boost/asio/use_awaitable.hpp>
@@ -91,7 +92,8 @@ StabilityCriterion StabilityCriterion::from_json(const json& j, const StabilityC
 }
 
 Lab::Lab(asio::any_io_executor executor, const InstrumentSet& instruments, LabOptions options)
-    : executor_(std::move(executor)), instruments_(instruments), options_(options) {
+    : executor_(std::move(executor)), instruments_(instruments), options_(options),
+      light_(options.suspend.drift_tolerance_pct) {
   if (!(options_.time_scale > 0)) options_.time_scale = 1;
 }
 
@@ -269,7 +271,10 @@ asio::awaitable<void> Lab::switch_lamps(std::vector<std::string> on) {
   auto lamps = co_await acquire<drivers::LampController>("lamps");
   auto before = lamps->lamps_on();
   co_await lamps->set_lamps(on);
-  if (before != on) stable_light_.reset();
+  if (before != on) {
+    stable_light_.reset();
+    light_.forget();
+  }
   for (const auto& l : on) {
     if (std::find(before.begin(), before.end(), l) == before.end()) known_warm_.erase(l);
   }
@@ -278,12 +283,24 @@ asio::awaitable<void> Lab::switch_lamps(std::vector<std::string> on) {
   }
 }
 
+void Lab::follow_execution(const ExecutionControl& control) {
+  if (control.execution_id == light_execution_) return;
+  // Another execution: the meter may have been aimed anew in between, and no suspension of its own is pending.
+  light_execution_ = control.execution_id;
+  light_.forget();
+  resumed_note_.reset();
+}
+
 asio::awaitable<json> Lab::perform(const std::string& call, const json& args, const ExecutionControl& control) {
+  follow_execution(control);
   if (call == "meter.measure") {
     auto meter = co_await acquire<drivers::LuminanceMeter>("luminance_meter");
     auto r = co_await meter->measure_luminance();
     check_dropout(r.luminance, r.unit);
-    co_return json{{"luminance", r.luminance}, {"unit", r.unit}, {"instrument", meter->id()}, {"raw", r.raw_reply}};
+    check_drift(r.luminance, r.unit);
+    json result{{"luminance", r.luminance}, {"unit", r.unit}, {"instrument", meter->id()}, {"raw", r.raw_reply}};
+    if (resumed_note_) result["resumed_after"] = *std::exchange(resumed_note_, std::nullopt);
+    co_return result;
   }
   if (call == "wait_stable") {
     auto c = StabilityCriterion::from_json(args.empty() ? json::object() : args[0], options_.warmup);
@@ -292,6 +309,7 @@ asio::awaitable<json> Lab::perform(const std::string& call, const json& args, co
     if (auto lamps = find_role<drivers::LampController>("lamps")) {
       for (const auto& l : lamps->lamps_on()) known_warm_.insert(l);
     }
+    if (resumed_note_) r["resumed_after"] = *std::exchange(resumed_note_, std::nullopt);
     co_return r;
   }
   if (call == "lamps.select") {
@@ -424,6 +442,9 @@ asio::awaitable<json> Lab::perform(const std::string& call, const json& args, co
   }
   if (call == "operator.request") {
     json answer = co_await operator_request(args[0], control);
+    // Whoever answered may have moved the meter (aiming it is what most requests are about): readings
+    // from here on are not comparable with those before.
+    light_.moved();
     co_return answer;
   }
   if (call == "wait") {
@@ -439,6 +460,7 @@ asio::awaitable<json> Lab::perform(const std::string& call, const json& args, co
 }
 
 asio::awaitable<json> Lab::restore(const LabState& desired, const ExecutionControl& control) {
+  follow_execution(control);
   json done = json::array();
   std::shared_ptr<drivers::XyTable> table;
   if (desired.table_used) {
@@ -501,7 +523,10 @@ asio::awaitable<json> Lab::restore(const LabState& desired, const ExecutionContr
     // What the simulated lab's "hands" did (the meter's aim) died with the old simulator.
     for (const auto& [action, details] : desired.done_by_hands) {
       auto redone = co_await hands_->perform(action, details);
-      if (redone) done.push_back(json{{"operator_action", action}, {"details", details}});
+      if (redone) {
+        done.push_back(json{{"operator_action", action}, {"details", details}});
+        light_.moved();  // the meter was aimed again after the lamps were found stable
+      }
     }
   }
   if (!desired.camera_settings.is_null()) {

@@ -1,5 +1,6 @@
 // Suspend, not fail: which failures an unattended night waits out, and how it knows they are over.
 #include <algorithm>
+#include <cstdio>
 
 #include <boost/asio/steady_timer.hpp>
 #include <boost/asio/use_awaitable.hpp>
@@ -62,12 +63,42 @@ asio::awaitable<void> Lab::sleep_wall(std::chrono::steady_clock::duration d, con
   }
 }
 
-void Lab::note_stable(double luminance) {
+std::vector<std::string> Lab::lit_lamps() const {
+  auto lamps = find_role<drivers::LampController>("lamps");
+  return lamps ? lamps->lamps_on() : std::vector<std::string>{};
+}
+
+Lab::StableLight Lab::light_now(double luminance) const {
   StableLight s;
   s.luminance = luminance;
   s.dimmer_percent = dimmer_percent_;
-  if (auto lamps = find_role<drivers::LampController>("lamps")) s.lamps = lamps->lamps_on();
-  stable_light_ = s;
+  s.lamps = lit_lamps();
+  return s;
+}
+
+void Lab::note_stable(double luminance) {
+  stable_light_ = light_now(luminance);
+  light_.stable(stable_light_->lamps, dimmer_percent_, luminance);
+}
+
+void Lab::check_drift(double luminance, const std::string& unit) {
+  auto drift = light_.check(lit_lamps(), dimmer_percent_, luminance);
+  if (!drift) return;
+  std::string lit;
+  for (const auto& l : drift->lamps) lit += (lit.empty() ? "" : "+") + l;
+  char text[256];
+  std::snprintf(text, sizeof text,
+                "the light drifted: %.5g %s where %.5g was read under %s at %g %% at this aim since the lamps were found "
+                "stable (%+.1f %%, more than the %g %% allowed)",
+                luminance, unit.c_str(), drift->expected, lit.c_str(), dimmer_percent_, drift->change_pct,
+                light_.tolerance_pct());
+  ErrorInfo info;
+  info.cls = ErrorClass::needs_operator;
+  info.message = text;
+  info.hint = "a lamp is drifting (overheating, ageing, a failing ballast); the execution waits until the light is "
+              "stable again";
+  info.device_code = "lamp:drift";
+  throw Error(std::move(info));
 }
 
 void Lab::check_dropout(double luminance, const std::string& unit) const {
@@ -100,26 +131,46 @@ asio::awaitable<json> Lab::await_recovery(const std::string& call, const Error& 
                                      std::chrono::duration<double>(p.max_s / options_.time_scale));
   int checks = 0;
   const auto reference = stable_light_;  // the light before it went
+  // What this aim, these lamps and this dimmer level read before the condition (a drift's yardstick).
+  const auto lamps_before = lit_lamps();
+  const auto expected_before = light_.expected(lamps_before, dimmer_percent_);
   for (;;) {
     if (std::chrono::steady_clock::now() > give_up) throw cause;
     co_await sleep_wall(wall(p.retry_s), control);
     ++checks;
     try {
       if (is_lamp_condition(cause)) {
-        // The light is back when it is stable again (a relit tube warms up first) …
+        // The light is back when it is stable again (a relit tube warms up first, a drifting one stops) …
         json stable = co_await wait_stable(options_.warmup, control);
+        const double level = stable["luminance"].get<double>();
         // A lamp still out is "stable" too, at darkness: held to the light before the dropout.
         if (reference) {
           stable_light_ = reference;
-          check_dropout(stable["luminance"].get<double>(), stable.value("unit", std::string("cd/m2")));
+          check_dropout(level, stable.value("unit", std::string("cd/m2")));
         }
-        note_stable(stable["luminance"].get<double>());
-        // … and still there after the settle time.
+        // A lamp that settled at a new level is not out: the new level is the yardstick from now on, and how
+        // far it moved goes with the resumption.
+        stable_light_ = light_now(level);
+        light_.settle_at(stable_light_->lamps, dimmer_percent_, level);
+        // … and still there after the settle time: stable again (a straight-line fit over a window centred
+        // on a drift's turning point reads as stable once), not dark, and not moved on from where it settled.
         co_await sleep_wall(wall(p.settle_s), control);
-        auto meter = co_await acquire<drivers::LuminanceMeter>("luminance_meter");
-        auto r = co_await meter->measure_luminance();
-        check_dropout(r.luminance, r.unit);
-        co_return json{{"condition", "lamp"}, {"checks", checks}, {"luminance", r.luminance}};
+        json again = co_await wait_stable(options_.warmup, control);
+        const double now = again["luminance"].get<double>();
+        const std::string unit = again.value("unit", std::string("cd/m2"));
+        check_dropout(now, unit);
+        check_drift(now, unit);
+        stable_light_ = light_now(now);
+        light_.settle_at(stable_light_->lamps, dimmer_percent_, now);
+        json how{{"condition", "lamp"},      {"cause", cause.info().device_code}, {"checks", checks},
+                 {"luminance", now},         {"stable_level", now},               {"lamps", stable_light_->lamps},
+                 {"dimmer_percent", dimmer_percent_}};
+        if (expected_before && *expected_before > 0 && stable_light_->lamps == lamps_before) {
+          how["level_before"] = *expected_before;
+          how["change_pct"] = (now / *expected_before - 1) * 100;
+        }
+        resumed_note_ = how;
+        co_return how;
       }
       auto capability = capability_for(call);
       std::shared_ptr<drivers::Instrument> instrument;

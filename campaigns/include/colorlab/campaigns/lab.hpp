@@ -19,6 +19,7 @@
 #include "colorlab/campaigns/control.hpp"
 #include "colorlab/campaigns/instrument_set.hpp"
 #include "colorlab/campaigns/lab_state.hpp"
+#include "colorlab/campaigns/light_reference.hpp"
 #include "colorlab/campaigns/operator_desk.hpp"
 #include "colorlab/campaigns/run_reader.hpp"
 #include "colorlab/core/error.hpp"
@@ -42,6 +43,11 @@ struct SuspendPolicy {
   double max_s = 8 * 3600;
   // A reading below this fraction of what the last stable reading predicts means a lamp went out.
   double dropout_fraction = 0.2;
+  // A reading that differs by more than this from the reading at the same aim, lamps and dimmer level since
+  // the lamps were found stable means a lamp drifted. Above what the same light can read: the LS-110's
+  // repeatability (4 σ of two readings ≈ 0.6 %) plus what a lamp accepted as stable may still rise (≤ 1 %
+  // with a 0.5 %/60 s criterion and a 2-minute warm-up); below what a §6.2 map must not mix silently.
+  double drift_tolerance_pct = 3;
 };
 
 struct LabOptions {
@@ -92,6 +98,13 @@ class Lab {
   double time_scale() const { return options_.time_scale; }
 
  private:
+  // The last stable reading and the light it was taken under: the yardstick for a lamp dropout.
+  struct StableLight {
+    double luminance = 0;
+    std::vector<std::string> lamps;
+    double dimmer_percent = 100;
+  };
+
   template <class T>
   std::shared_ptr<T> role(const std::string& name) const;  // or Error{not_found}
   template <class T>
@@ -110,7 +123,15 @@ class Lab {
   // Throws Error{needs_operator, "lamp:dropout"} when `luminance` is far below what the last stable
   // reading under the same lamps predicts at the current dimmer level.
   void check_dropout(double luminance, const std::string& unit) const;
+  // Throws Error{needs_operator, "lamp:drift"} when `luminance` differs from the reading at this aim, lamps
+  // and dimmer level since the lamps were found stable by more than SuspendPolicy::drift_tolerance_pct.
+  void check_drift(double luminance, const std::string& unit);
+  // The lamps lit now were found stable with this reading: the yardstick for a dropout and for a drift.
   void note_stable(double luminance);
+  StableLight light_now(double luminance) const;
+  // A call of another execution than the last: forgets what the light reference and a suspension held.
+  void follow_execution(const ExecutionControl& control);
+  std::vector<std::string> lit_lamps() const;
 
   boost::asio::any_io_executor executor_;
   const InstrumentSet& instruments_;
@@ -118,13 +139,13 @@ class Lab {
   // Lamps this process has seen lit and stable since it last switched them: a resume in the same
   // process need not wait for them again; a fresh process knows nothing and waits.
   std::set<std::string> known_warm_;
-  // The last stable reading and the light it was taken under: the yardstick for a lamp dropout.
-  struct StableLight {
-    double luminance = 0;
-    std::vector<std::string> lamps;
-    double dimmer_percent = 100;
-  };
   std::optional<StableLight> stable_light_;
+  // The yardstick for a drift: per dimmer level at the meter's present aim.
+  LightReference light_;
+  // What the last suspension for the light found (the level it settled at and how far it moved): added to
+  // the result of the call made again, so a script knows its readings before it may be off.
+  std::optional<nlohmann::json> resumed_note_;
+  std::string light_execution_;  // whose readings light_ holds
   double dimmer_percent_ = 100;
   OperatorDesk* desk_ = nullptr;
   OperatorHands* hands_ = nullptr;
