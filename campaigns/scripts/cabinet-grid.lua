@@ -8,6 +8,13 @@
 -- fewest lamp warm-ups; `colorlab run --dry-run` shows what each costs. Lamps and dimmer levels are
 -- visited in alternating order, so the lamp lit at the end of one spot is the first at the next and
 -- need not warm up again.
+--
+-- A lamp that drifts: at each spot a lamp's levels are bracketed by a second reading at its first level
+-- (drift_check), which the lab holds to the first; a light that moved by more than the lab's drift
+-- tolerance suspends the execution until it is stable again. A lamp's readings at a spot are recorded
+-- only once the bracket closed: when the lab had to wait for the light meanwhile (the reading comes back
+-- with `resumed_after`), they are taken again, and the change is listed in the result's
+-- `light_changes`, so maps measured before and after a lamp settled at a new level are not mixed silently.
 local function grid_key(lamp, level, r, c)
   return string.format("L/%s/D%g/r%dc%d", lamp, level, r, c)
 end
@@ -38,6 +45,8 @@ return {
                  description = "settling after each dimmer change (lab seconds)" },
     aim_timeout_s = { type = "number", default = 1800, min = 0, max = 86400, unit = "s",
                       description = "how long to wait for the operator to aim the meter before skipping the spot" },
+    drift_check = { type = "boolean", default = true,
+                    description = "read each lamp's first level again after its other levels at a spot, so a drifting lamp suspends the run and the spot is read again" },
   },
   run = function(p)
     local spots = {}
@@ -74,28 +83,60 @@ return {
       end
     end
 
-    local function measure(spot, lamp, level)
+    local light_changes = {}
+
+    -- One level: the dimmer, then the readings. Returns them and what the lab reported of a suspension.
+    local function read_level(level)
       lab.dimmer.set(level, { settle_s = p.settle_s })
-      local sum, raw = 0, {}
-      local instrument
+      local raw, instrument, resumed = {}, nil, nil
       for i = 1, p.readings do
         local m = lab.meter.measure()
-        sum = sum + m.luminance
         raw[#raw + 1] = m.luminance
         instrument = m.instrument
+        resumed = m.resumed_after or resumed
       end
-      local mean = sum / p.readings
-      lab.record(grid_key(lamp, level, spot.r, spot.c), {
-        quantity = "luminance", value = mean, unit = "cd/m2", instrument = instrument,
-        data = { row = spot.r, col = spot.c, lamp = lamp, dimmer_percent = level, readings = raw },
-      })
-      values[lamp] = values[lamp] or {}
-      values[lamp][level] = values[lamp][level] or {}
-      values[lamp][level][spot.r] = values[lamp][level][spot.r] or {}
-      values[lamp][level][spot.r][spot.c] = mean
-      done = done + 1
-      recorded = recorded + 1
-      lab.progress(done / total, string.format("%s %g%% row %d col %d", lamp, level, spot.r + 1, spot.c + 1))
+      return raw, instrument, resumed
+    end
+
+    -- A lamp's levels at a spot, bracketed by its first level read again; read anew (at most three times)
+    -- when the lab waited for the light in between, then recorded.
+    local function measure(spot, lamp, levels)
+      local taken
+      for attempt = 1, 3 do
+        taken = {}
+        local resumed = nil
+        for _, level in ipairs(levels) do
+          local raw, instrument, r = read_level(level)
+          taken[#taken + 1] = { level = level, raw = raw, instrument = instrument }
+          resumed = r or resumed
+        end
+        if p.drift_check and #levels > 1 then
+          local _, _, r = read_level(levels[1])
+          resumed = r or resumed
+        end
+        if not resumed then break end
+        light_changes[#light_changes + 1] = {
+          lamp = lamp, row = spot.r, col = spot.c, attempt = attempt, cause = resumed.cause,
+          dimmer_percent = resumed.dimmer_percent, change_pct = resumed.change_pct,
+          level_before = resumed.level_before, stable_level = resumed.stable_level,
+        }
+      end
+      for _, t in ipairs(taken) do
+        local sum = 0
+        for _, v in ipairs(t.raw) do sum = sum + v end
+        local mean = sum / #t.raw
+        lab.record(grid_key(lamp, t.level, spot.r, spot.c), {
+          quantity = "luminance", value = mean, unit = "cd/m2", instrument = t.instrument,
+          data = { row = spot.r, col = spot.c, lamp = lamp, dimmer_percent = t.level, readings = t.raw },
+        })
+        values[lamp] = values[lamp] or {}
+        values[lamp][t.level] = values[lamp][t.level] or {}
+        values[lamp][t.level][spot.r] = values[lamp][t.level][spot.r] or {}
+        values[lamp][t.level][spot.r][spot.c] = mean
+        done = done + 1
+        recorded = recorded + 1
+        lab.progress(done / total, string.format("%s %g%% row %d col %d", lamp, t.level, spot.r + 1, spot.c + 1))
+      end
     end
 
     if p.order == "spot-major" then
@@ -106,7 +147,7 @@ return {
             local levels = p.dimmer_levels
             if lit == lamp then levels = reversed(levels) end
             light(lamp, levels[1])
-            for _, level in ipairs(levels) do measure(spot, lamp, level) end
+            measure(spot, lamp, levels)
           end
         else
           skipped = skipped + 1
@@ -119,7 +160,7 @@ return {
         for k, spot in ipairs(spots) do
           if aim(spot) then
             local levels = (k % 2 == 1) and p.dimmer_levels or reversed(p.dimmer_levels)
-            for _, level in ipairs(levels) do measure(spot, lamp, level) end
+            measure(spot, lamp, levels)
           else
             skipped = skipped + 1
             done = done + #p.dimmer_levels
@@ -185,7 +226,7 @@ return {
       order = p.order, rows = p.rows, cols = p.cols, unit = "cd/m2",
       grid_values = recorded, spots_skipped = skipped, operator_aims = aims, lamp_warmups = warmups,
       window = window, uniformity = maps, dimmer_proportionality = dimmer, lamps = lamps_compared,
-      incomplete = incomplete,
+      incomplete = incomplete, light_changes = light_changes,
     }
   end,
 }

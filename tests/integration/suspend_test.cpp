@@ -1,8 +1,9 @@
 // Suspend, not fail: each cause injected into a running execution — an instrument that stops
 // answering (the simulator's LS-110 goes silent), a lamp that goes out (the simulator's cabinet
-// drops D65 for a while), a disk that fills (a size-limited state directory) — suspends it with the
-// right reason; it goes on by itself once the condition has cleared, and the run equals an
-// undisturbed one: every step once, in order, every reading within the simulator's noise.
+// drops D65 for a while), a lamp that drifts (D65's output sags and comes back), a disk that fills (a
+// size-limited state directory) — suspends it with the right reason; it goes on by itself once the
+// condition has cleared, and the run equals an undisturbed one: every step once, in order, every
+// reading within the simulator's noise.
 #include <sys/mount.h>
 
 #include <cmath>
@@ -135,6 +136,79 @@ TEST(SuspendNotFail, ALampThatGoesOutSuspendsTheRunUntilItIsBackAndStable) {
   // No reading in the dark and none of a lamp still warming up: all equal the warm lamp's truth.
   expect_undisturbed(api.get("/v1/runs/" + e["run_id"].get<std::string>()), "r/", 1, 30, truth["ls110"]["luminance"],
                      truth["ls110"]["noise_sigma"]);
+  daemon.kill9();
+}
+
+// The cabinet grid, reduced: one row of four spots, D65 at two dimmer levels, a minute of settling after
+// each dimmer change so that a lamp's bracket at a spot (its first level, the other, the first again)
+// spans two lab minutes.
+const json kDriftGrid = {{"rows", 1}, {"cols", 4}, {"lamps", {"D65"}}, {"dimmer_levels", {100, 50}}, {"settle_s", 60}};
+
+TEST(SuspendNotFail, ALampThatDriftsMidGridSuspendsItUntilTheLightIsStableAndTheSpotIsReadAgain) {
+  TempDir dir;
+  DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), kTimeScale, 3, kSuspendConfig));
+  auto api = api_for(daemon);
+  auto e = api.post("/v1/executions", {{"campaign", "cabinet-grid"}, {"params", kDriftGrid}});
+  // The first spot is stored (committed as the second spot's aim is asked for): the drift starts while the
+  // meter is aimed at the second spot, before any of its readings.
+  wait_for_measurements(api, e, 2);
+  // An overheating tube: −3 % of its output per lab minute for four minutes, then back at the same rate.
+  // The bracket at the second spot (two minutes) sees about 6 % and suspends the run; the light is stable
+  // again only once it has come back (eight minutes), and the spot is read again.
+  json drift = control(daemon, {{"cmd", "fault"}, {"instrument", "cabinet"},
+                                {"faults", {{"lamp_drift", {{"lamp", "D65"}, {"rate_pct_per_min", -3}, {"seconds", 240}, {"then", "return"}}}}}});
+  EXPECT_EQ(measurements_of(api, e), 2u) << "the drift came too late: the second spot was read before it";
+  std::string reason = wait_suspended(api, e, std::chrono::seconds(30));
+  EXPECT_EQ(reason.rfind("lamp: ", 0), 0u) << reason;
+  EXPECT_NE(reason.find("the light drifted"), std::string::npos) << reason;
+  EXPECT_NE(reason.find("[device lamp:drift]"), std::string::npos) << reason;
+  auto done = wait_terminal(api, e["id"], std::chrono::seconds(60));
+  ASSERT_EQ(done["status"], "finished_ok") << done.dump(2);
+
+  // The resumption says what the light did: the cause, the level it settled at and how far that is from
+  // what the spot's first reading at that dimmer level was.
+  json how;
+  json log = api.get("/v1/events?topic=execution&limit=300");
+  for (const auto& ev : log["items"]) {
+    if (ev["payload"].contains("resumed_after_suspension")) how = ev["payload"]["resumed_after_suspension"];
+  }
+  ASSERT_TRUE(how.is_object()) << log.dump();
+  EXPECT_EQ(how["cause"], "lamp:drift");
+  EXPECT_EQ(how["lamps"], json::array({"D65"}));
+  ASSERT_TRUE(how.contains("change_pct")) << how.dump();
+  EXPECT_NEAR(how["change_pct"].get<double>(),
+              (how["stable_level"].get<double>() / how["level_before"].get<double>() - 1) * 100, 1e-9);
+
+  // The drift is over (back to normal) and D65 warm: the truth of an undisturbed run at each spot and level.
+  json truth = control(daemon, {{"cmd", "truth"}});
+  EXPECT_DOUBLE_EQ(truth["drift"]["D65"]["factor"].get<double>(), 1.0) << truth["drift"].dump();
+  EXPECT_EQ(truth["drift"]["D65"]["start_s"], drift["lamp_drift"]["start_s"]);
+  json run = api.get("/v1/runs/" + e["run_id"].get<std::string>());
+  // Every step once, in the grid's order (spot-major; the lamp stays lit, so from the second spot on its
+  // levels run the other way round).
+  std::vector<std::string> expected_steps{"L/D65/D100/r0c0", "L/D65/D50/r0c0"};
+  for (int c = 1; c < 4; ++c) {
+    expected_steps.push_back("L/D65/D50/r0c" + std::to_string(c));
+    expected_steps.push_back("L/D65/D100/r0c" + std::to_string(c));
+  }
+  std::vector<std::string> steps;
+  for (const auto& m : run["measurements"]) steps.push_back(m["step"]);
+  EXPECT_EQ(steps, expected_steps);
+  // Every reading within 4 σ of the LS-110's noise at the spot's truth, plus the 1 % a lamp may still be
+  // below full output when the stability criterion accepts it: none taken while the light was away.
+  for (const auto& m : run["measurements"]) {
+    const auto& d = m["data"];
+    control(daemon, {{"cmd", "aim"}, {"row", d["row"]}, {"col", d["col"]}});
+    control(daemon, {{"cmd", "dimmer"}, {"percent", d["dimmer_percent"]}});
+    json t = control(daemon, {{"cmd", "truth"}})["ls110"];
+    const double l = t["luminance"].get<double>(), sigma = t["noise_sigma"].get<double>();
+    EXPECT_NEAR(m["value"].get<double>(), l, 4 * sigma + 0.01 * l) << m["step"];
+  }
+  // The grid lists the spot it read again, so its maps do not mix light levels silently.
+  const auto& changes = run["summary"]["script"]["light_changes"];
+  ASSERT_EQ(changes.size(), 1u) << changes.dump();
+  EXPECT_EQ(changes[0]["cause"], "lamp:drift");
+  EXPECT_EQ(changes[0]["col"], 1);
   daemon.kill9();
 }
 
