@@ -203,3 +203,38 @@ TEST(CharacterizeCamera, FitsEveryFormatWithinTheNoiseTheSimulatorInjects) {
   }
   EXPECT_EQ(result["selected"]["model"]["method"].is_string(), true);
 }
+
+// kill -9 at random moments of characterize-camera (kill_and_compare, resume_support.hpp): on each
+// fresh daemon a chart-read run gives the reference, then the characterization is killed twice and
+// must finish by itself with the uninterrupted run's steps. A kill before the photographs' call is
+// journaled re-shoots them, so camera values agree within what two series of the same chart may
+// differ by; a kill after it replays the journaled photographs and every value is the same.
+TEST(CharacterizeCamera, SurvivesKillNine) {
+  KillNineCase c;
+  c.campaign = "characterize-camera";
+  c.seed = kSeed;
+  c.time_scale = 500;
+  c.lab_toml = kLabToml;
+  c.params = {{"frames", 2}, {"cv", "k5"}, {"prior_exclude", kPriorExclude}};
+  c.prepare = [](const client::ApiClient& api) { return json{{"reference_run", run_to_end(api, "chart-read", json::object())["id"]}}; };
+  c.max_delay_ms = 0;  // anywhere in the run
+  c.runs = 3;
+  c.tolerance = [](const json& m, double ref) {
+    const std::string step = m["step"];
+    // The lamp each series is taken under is stable by lab.wait_stable's criterion: at most 1 % below
+    // full (0.5 % drift over 60 s of a tube warming with τ = 120 s), so counts agree within 1 %; plus
+    // what the frames' noise leaves in a patch mean (2 frames, hundreds of pixels: under 2 DN for the
+    // raw) or one code of an 8-bit encoding (257 in 16 bits).
+    if (step.rfind("patch/raw/", 0) == 0) return 0.01 * ref + 2;
+    if (step.rfind("patch/tiff16/", 0) == 0) return 0.01 * ref + 257;
+    if (step.rfind("patch/", 0) == 0) return 0.01 * ref + 1;
+    // Fitted errors: within the selection's own tolerance (tolerance_de00 = 0.1: models closer than
+    // that are taken as equally good).
+    if (step.rfind("characterization/", 0) == 0) return 0.1;
+    return 0.02;  // the locator's confidence
+  };
+  const auto start = std::chrono::steady_clock::now();
+  kill_and_compare(c);
+  std::cout << "[characterize] kill -9: "
+            << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() << " s\n";
+}

@@ -39,7 +39,9 @@ struct KillNineCase {
   nlohmann::json params = nlohmann::json::object();
   double time_scale = 100;
   std::uint64_t seed = 5;
-  int max_delay_ms = 2500;  // each of (at most) two kills per run comes 50..max_delay_ms after the previous event
+  // Each of (at most) two kills per run comes 50..max_delay_ms after the previous start; 0 = 90 % of what the
+  // uninterrupted run took (a moment anywhere in it, however fast the machine).
+  int max_delay_ms = 2500;
   int runs = 3;             // interrupted runs, each on a fresh daemon with its own random moments
   std::string lab_toml;     // the simulated lab's configuration, when not write_daemon_config's
   // On each fresh daemon before the campaign starts (not interrupted): parameters to add, e.g. the id of
