@@ -50,13 +50,15 @@ return {
       lab.log("meter: " .. aim.answer)
       lab.lamps.select(p.lamp)
       lab.dimmer.set(p.dimmer_percent)  -- the widget may have been left dark
-      lab.wait_stable()  -- a warming lamp would tint the first formats differently from the last
+      local stable = lab.wait_stable()  -- a warming lamp would tint the first formats differently from the last
+      lab.log(string.format("%s stable after %.0f lab s", p.lamp, stable.waited_s))
     end
     lab.progress(0.1, "photographing")
     -- The reference's luminances let the locator tell patches as dark as the chart's surround (no edge of their
     -- own) from a covered chart. (Only ids and XYZ: the spectra would swell the call's journal entry.)
     local shots = lab.camera.photograph_chart { frames = p.frames, chart = p.chart, formats = p.formats, camera = p.camera,
                                                 reference = { ids = ref.ids, XYZ = ref.XYZ } }
+    lab.log(string.format("photographed %d frames as %s", p.frames, table.concat(p.formats, ", ")))
     local out = { reference_run = p.reference_run, chart = p.chart, frames = p.frames, lamp = p.lamp,
                   instrument = shots.instrument, formats = {} }
     local best_format, best_cv
@@ -85,6 +87,8 @@ return {
         })
       end
       local chosen = c.approaches.adapted_mapping.cv.mean
+      lab.log(string.format("%s fitted: adapted mapping %s, CV mean ΔE00 %.2f%s", format, c.selected.method, chosen,
+                            c.approaches.black_box and string.format("; black box %.2f", c.approaches.black_box.cv.mean) or ""))
       if best_cv == nil or chosen < best_cv then best_format, best_cv = format, chosen end
       out.formats[format] = { confidence = f.confidence, rotation_deg = f.rotation_deg, corners = f.corners,
                               check = f.check, approaches = c.approaches, best_approach = c.best_approach,

@@ -1,5 +1,6 @@
 #include "colorlab/campaigns/engine.hpp"
 
+#include <chrono>
 #include <regex>
 
 #include <boost/asio/post.hpp>
@@ -12,6 +13,7 @@
 #include "colorlab/campaigns/lua_sandbox.hpp"
 #include "colorlab/campaigns/lua_value.hpp"
 #include "colorlab/core/log.hpp"
+#include "run_thread.hpp"
 
 namespace colorlab::campaigns {
 
@@ -65,26 +67,6 @@ class Engine final : public LabCallSink {
   bool live_ = false;
 };
 
-// "name.lua:12: message" → 12 (0 if the message has no position).
-int line_of(const std::string& message, const std::string& script) {
-  std::string prefix = script + ":";
-  if (message.rfind(prefix, 0) != 0) return 0;
-  try {
-    return std::stoi(message.substr(prefix.size()));
-  } catch (const std::exception&) {
-    return 0;
-  }
-}
-
-// The line of the script that made the current (yielded) lab call.
-int calling_line(lua_State* thread) {
-  lua_Debug ar;
-  for (int level = 0; lua_getstack(thread, level, &ar); ++level) {
-    if (lua_getinfo(thread, "Sl", &ar) && ar.currentline > 0 && std::string(ar.what) != "C") return ar.currentline;
-  }
-  return 0;
-}
-
 }  // namespace
 
 asio::awaitable<RunOutcome> run_campaign_script(ScriptRunSetup setup, Lab& lab, ExecutionSink& sink,
@@ -94,6 +76,7 @@ asio::awaitable<RunOutcome> run_campaign_script(ScriptRunSetup setup, Lab& lab, 
   RunOutcome outcome;
   Engine engine(setup);
   LabState state;
+  TimingKeys timing_keys;
   std::size_t replay_index = 0;
   bool live = setup.journal.empty();
   engine.live_ = live;
@@ -124,17 +107,8 @@ asio::awaitable<RunOutcome> run_campaign_script(ScriptRunSetup setup, Lab& lab, 
   try {
     LuaSandbox sandbox(file, script.limits, setup.random_seed);
     lua_State* L = sandbox.state();
-    install_lab_api(L, &engine);
-    sandbox.run_chunk(script.source);
-    if (!lua_istable(L, -1)) throw Error(ErrorClass::script_error, file + ": the script must return its campaign table");
-    lua_getfield(L, -1, "run");
-    if (!lua_isfunction(L, -1)) throw Error(ErrorClass::script_error, file + ": the campaign table has no run function");
-    lua_State* thread = lua_newthread(L);
-    lua_rotate(L, -2, 1);  // keep the thread referenced below the function
-    lua_xmove(L, thread, 1);
-    push_json(thread, setup.params);
+    lua_State* thread = start_run_thread(sandbox, script, setup.params, &engine);
     engine.thread_ = thread;
-    sandbox.set_yielding_thread(thread);
     int nargs = 1;
 
     for (;;) {
@@ -178,6 +152,7 @@ asio::awaitable<RunOutcome> run_campaign_script(ScriptRunSetup setup, Lab& lab, 
             ++replay_index;
             ++outcome.replayed;
             state.apply(call, args, result);
+            timing_keys.follow(call, args, result);
             answered = true;
           } else {
             live = true;
@@ -193,6 +168,8 @@ asio::awaitable<RunOutcome> run_campaign_script(ScriptRunSetup setup, Lab& lab, 
           try {
             // The step before this call is whole: commit it before anything moves. A disk that
             // refuses it suspends the execution until there is room; nothing is lost meanwhile.
+            // A call's cost includes committing the step before it: the dry run adds up whole calls.
+            const auto call_started = std::chrono::steady_clock::now();
             bool storage_suspended = false;
             for (;;) {
               std::optional<Error> refused;
@@ -211,8 +188,10 @@ asio::awaitable<RunOutcome> run_campaign_script(ScriptRunSetup setup, Lab& lab, 
               co_await lab.wait_retry(control);
             }
             if (storage_suspended) sink.resumed(json{{"condition", "storage"}});
+            bool restored_now = false;
             if (restore_pending) {
               restore_pending = false;
+              restored_now = true;
               sink.status_text("restoring the lab after a resume (step " + engine.label_ + ")");
               if (setup.verify_serials) {
                 auto changed = co_await lab.serial_mismatches(setup.expected_serials);
@@ -232,6 +211,9 @@ asio::awaitable<RunOutcome> run_campaign_script(ScriptRunSetup setup, Lab& lab, 
               sink.status_text(engine.label_.empty() ? call : engine.label_ + ": " + call);
               // Suspend, not fail: a condition that waiting mends stops the execution until it has
               // cleared, then the same call is made again (the interrupted step measured anew).
+              const std::string timing_key = timing_keys.key(call, args);
+              // A restore or a wait for disk space is not what the call costs on a normal night.
+              bool interrupted = storage_suspended || restored_now;
               for (;;) {
                 std::optional<Error> failure;
                 try {
@@ -239,7 +221,15 @@ asio::awaitable<RunOutcome> run_campaign_script(ScriptRunSetup setup, Lab& lab, 
                 } catch (const Error& e) {
                   failure = e;
                 }
-                if (!failure) break;
+                if (!failure) {
+                  if (!interrupted) {
+                    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - call_started).count();
+                    const double lab_s = std::max(0.0, wall * lab.time_scale() - TimingKeys::asked_wait_s(call, args));
+                    engine.pending_.timings.push_back({timing_key, lab_s / TimingKeys::units(call, args)});
+                  }
+                  break;
+                }
+                interrupted = true;
                 auto cause = Lab::suspend_cause(*failure);
                 if (!cause || control.requested()) throw *failure;
                 std::string reason = *cause + ": " + failure->what();
@@ -250,6 +240,7 @@ asio::awaitable<RunOutcome> run_campaign_script(ScriptRunSetup setup, Lab& lab, 
                 sink.resumed(how);
               }
               state.apply(call, args, result);
+              timing_keys.follow(call, args, result);
               engine.pending_.journal.push_back(JournalEntry{static_cast<std::int64_t>(replay_index), call, args, result});
               ++replay_index;
             }

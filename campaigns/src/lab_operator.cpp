@@ -23,7 +23,9 @@ Error bad(const std::string& what) {
                "options={\"done\",\"skip\"}, default=\"skip\", timeout_s=1800}");
 }
 
-OperatorRequest parse_request(const json& spec) {
+}  // namespace
+
+OperatorRequest parse_operator_request(const json& spec) {
   OperatorRequest r;
   if (!spec.is_object()) throw bad("takes a table");
   for (const auto& [key, value] : spec.items()) {
@@ -68,10 +70,8 @@ OperatorRequest parse_request(const json& spec) {
   return r;
 }
 
-}  // namespace
-
 asio::awaitable<json> Lab::operator_request(const json& spec, const ExecutionControl& control) {
-  OperatorRequest r = parse_request(spec);
+  OperatorRequest r = parse_operator_request(spec);
   if (hands_) {
     auto done = co_await hands_->perform(r.action, r.details);
     if (done) {

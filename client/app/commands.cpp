@@ -22,12 +22,18 @@ struct RunOptions {
   std::vector<std::string> params;
   bool detach = false;
   bool id_only = false;
+  bool dry_run = false;
   std::string idempotency_key;
 };
 
 int run_campaign(const GlobalOptions& g, const RunOptions& o) {
   auto api = make_client(g);
   json params = parse_params(o.params);
+  if (o.dry_run) {
+    json report = api.post("/v1/executions", {{"campaign", o.campaign}, {"params", params}, {"dry_run", true}});
+    print(g, report, format_dry_run);
+    return report.value("ok", false) ? 0 : 3;
+  }
   std::map<std::string, std::string> headers;
   if (!o.idempotency_key.empty()) headers["Idempotency-Key"] = o.idempotency_key;
   json execution = api.post("/v1/executions", {{"campaign", o.campaign}, {"params", params}}, headers);
@@ -93,6 +99,8 @@ void add_daemon_commands(CLI::App& app, GlobalOptions& global) {
   run->add_option("-p,--param", run_opts->params, "campaign parameter KEY=VALUE (repeatable)");
   run->add_flag("--detach", run_opts->detach, "return as soon as the campaign has started");
   run->add_flag("--id-only", run_opts->id_only, "print only the run id (for scripts)");
+  run->add_flag("--dry-run", run_opts->dry_run,
+                "check limits, instruments, disk and operator actions and estimate the duration; moves nothing (exit 3 on problems)");
   run->add_option("--idempotency-key", run_opts->idempotency_key, "retry-safe key: the same key never starts twice");
   run->callback([&global, run_opts] {
     int rc = run_campaign(global, *run_opts);

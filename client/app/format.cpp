@@ -21,6 +21,16 @@ std::string number(double v, int decimals = 2) {
   return buf;
 }
 
+// 5430 s → "1 h 30 min 30 s"; short durations keep a decimal.
+std::string duration(double s) {
+  if (s < 60) return number(s, s < 10 ? 1 : 0) + " s";
+  long t = static_cast<long>(s + 0.5);
+  std::string out;
+  if (t >= 3600) out += std::to_string(t / 3600) + " h ";
+  if (t >= 60) out += std::to_string((t % 3600) / 60) + " min ";
+  return out + std::to_string(t % 60) + " s";
+}
+
 }  // namespace
 
 std::string format_status(const json& root) {
@@ -114,6 +124,42 @@ std::string format_execution(const json& e) {
     << number(100.0 * e.value("progress", 0.0), 0) << "%  " << str(e, "step");
   if (!e.value("reason", std::string()).empty()) o << "  (" << e["reason"].get<std::string>() << ")";
   o << "\n";
+  return o.str();
+}
+
+std::string format_dry_run(const json& r) {
+  std::ostringstream o;
+  const json& e = r.value("estimate", json::object());
+  o << "dry run of " << str(r, "campaign") << ": " << (r.value("ok", false) ? "OK" : "PROBLEMS") << ", " << str(r, "calls")
+    << " lab calls, " << str(r, "measurements") << " measurements, " << str(r, "lamp_warmups") << " lamp warm-ups\n";
+  const double scale = e.value("time_scale", 1.0);
+  o << "  estimated duration: " << duration(e.value("lab_seconds", 0.0)) << " of lab time";
+  if (scale != 1.0) o << " = " << duration(e.value("wall_seconds", 0.0)) << " at time scale ×" << number(scale, 0);
+  o << " (" << number(100 * e.value("measured_share", 0.0), 0) << " % from this lab's measured timings)\n";
+  if (e.value("operator_wait_s", 0.0) > 0) {
+    o << "  of which up to " << duration(e.value("operator_wait_s", 0.0)) << " waiting for a person (each request's timeout)\n";
+  }
+  o << "  where the time goes:\n";
+  int shown = 0;
+  for (const auto& k : e.value("by_key", json::array())) {
+    if (shown++ == 8) break;
+    o << "    " << duration(k.value("lab_seconds", 0.0)) << "  " << str(k, "key") << " ×" << str(k, "calls") << "  ("
+      << str(k, "source") << (k.contains("n") ? ", n = " + k["n"].dump() : std::string()) << ")\n";
+  }
+  for (const auto& i : r.value("instruments", json::array())) {
+    o << "  " << str(i, "role") << ": " << (i["instrument"].is_null() ? "MISSING" : str(i, "instrument"))
+      << (i.value("simulated", false) ? " (simulated)" : "") << "\n";
+  }
+  for (const auto& a : r.value("operator_actions", json::array())) {
+    o << "  operator: " << str(a, "action") << " ×" << str(a, "count") << " by " << str(a, "by") << " — " << str(a, "prompt")
+      << " (default " << str(a, "default") << " after " << duration(a.value("timeout_s", 0.0)) << ")\n";
+  }
+  const json& st = r.value("storage", json::object());
+  o << "  storage: about " << number(st.value("estimated_bytes", 0.0) / 1e6, 1) << " MB";
+  if (st.contains("available_bytes")) o << " of " << number(st["available_bytes"].get<double>() / 1e9, 1) << " GB free";
+  o << "\n";
+  for (const auto& p : r.value("problems", json::array())) o << "  PROBLEM (" << str(p, "kind") << "): " << str(p, "message") << "\n";
+  if (r.contains("stopped_at")) o << "  the dry run stopped at line " << str(r["stopped_at"], "line") << "\n";
   return o.str();
 }
 

@@ -12,6 +12,7 @@ std::string format_campaigns(const nlohmann::json& list);
 std::string format_runs(const nlohmann::json& page);
 std::string format_run(const nlohmann::json& run);
 std::string format_execution(const nlohmann::json& execution);
+std::string format_dry_run(const nlohmann::json& report);
 std::string format_request(const nlohmann::json& request);
 std::string format_requests(const nlohmann::json& list);
 std::string format_queue(const nlohmann::json& queue);

@@ -1,5 +1,6 @@
 // The store's promises: forward-only migrations, refusal of newer or foreign files, durable
 // measurements, unfinished scripted runs kept for resume (legacy ones finalised) at open, whole steps, idempotent execution creation, keyset paging.
+#include <cmath>
 #include <gtest/gtest.h>
 #include <sqlite3.h>
 
@@ -246,4 +247,34 @@ TEST(Store, ExecutionLifecycleKeepsRunExecutionAndEventLogInStep) {
   EXPECT_EQ(events[1].topic, "progress");
   EXPECT_EQ(events[1].payload["step"], "reading/1");
   EXPECT_EQ(events[2].payload["status"], "finished_error");
+}
+
+// Call timings are learned with their step and read back per key at the time
+// scale nearest the lab's: the simulated lab's seconds shrink, the daemon's own time does not.
+TEST(Store, CallTimingsAccumulateWithTheirStepAndAreReadAtTheNearestTimeScale) {
+  TempDir dir;
+  Store store(dir / "colorlab.db");
+  auto run = luminance_run();
+  run.script_sha256 = "s1";
+  run.script_source = "x";
+  auto e = store.create_execution(run).execution;
+  StepRecord step;
+  step.journal.push_back({0, "meter.measure", json::array(), {{"luminance", 1.0}}});
+  step.timings = {{"meter.measure", 1.0}, {"meter.measure", 3.0}, {"wait_stable cold D65", 400.0}};
+  step.time_scale = 100;
+  store.commit_step(e, step);
+  StepRecord fast;
+  fast.journal.push_back({1, "meter.measure", json::array(), {{"luminance", 1.0}}});
+  fast.timings = {{"meter.measure", 20.0}};
+  fast.time_scale = 1000;
+  store.commit_step(e, fast);
+  auto at_200 = store.call_timings(200);  // ×200 is nearer ×100 than ×1000 (by ratio)
+  ASSERT_EQ(at_200.count("meter.measure"), 1u);
+  EXPECT_EQ(at_200["meter.measure"].n, 2);
+  EXPECT_DOUBLE_EQ(at_200["meter.measure"].mean_s, 2.0);
+  EXPECT_NEAR(at_200["meter.measure"].stdev_s, std::sqrt(2.0), 1e-9);
+  EXPECT_DOUBLE_EQ(at_200["wait_stable cold D65"].mean_s, 400.0);
+  auto at_800 = store.call_timings(800);
+  EXPECT_DOUBLE_EQ(at_800["meter.measure"].mean_s, 20.0);
+  EXPECT_DOUBLE_EQ(at_800["wait_stable cold D65"].mean_s, 400.0);  // only ever timed at ×100
 }

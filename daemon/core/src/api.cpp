@@ -127,6 +127,13 @@ HttpResponse post_execution(ApiContext& ctx, const HttpRequest& req) {
                                  "e.g. {\"campaign\": \"luminance-spot\", \"params\": {\"readings\": 3}}");
   }
   json params = body.value("params", json::object());
+  if (body.contains("dry_run") && !body["dry_run"].is_boolean()) {
+    return HttpResponse::problem(400, "bad-request", "Invalid request", "'dry_run' must be true or false");
+  }
+  if (body.value("dry_run", false)) {
+    // Nothing is stored and nothing moves: 200 with the dry run's report, not 202 with an execution.
+    return HttpResponse::json(200, ctx.executions.dry_run(body["campaign"].get<std::string>(), params));
+  }
   auto record = ctx.executions.start(body["campaign"].get<std::string>(), params, req.header("idempotency-key"));
   auto r = HttpResponse::json(202, record.to_json());
   r.headers["Location"] = std::string(protocol::kPrefix) + "/executions/" + record.id;

@@ -4,8 +4,8 @@
 
 namespace colorlab::daemon {
 
-CampaignRequest validate_campaign_request(campaigns::ScriptCatalogue& catalogue, const campaigns::Lab& lab,
-                                          const std::string& campaign, const nlohmann::json& params) {
+CampaignRequest validate_campaign_params(campaigns::ScriptCatalogue& catalogue, const std::string& campaign,
+                                        const nlohmann::json& params) {
   catalogue.refresh();
   auto script = catalogue.find(campaign);
   if (!script) {
@@ -13,8 +13,13 @@ CampaignRequest validate_campaign_request(campaigns::ScriptCatalogue& catalogue,
     for (const auto& c : catalogue.all()) names += (names.empty() ? "" : ", ") + c->name;
     throw Error(ErrorClass::not_found, "no campaign named '" + campaign + "'", "campaigns: " + names);
   }
-  CampaignRequest request{script, script->validate(params)};
-  lab.check_needs(script->needs);
+  return CampaignRequest{script, script->validate(params)};
+}
+
+CampaignRequest validate_campaign_request(campaigns::ScriptCatalogue& catalogue, const campaigns::Lab& lab,
+                                          const std::string& campaign, const nlohmann::json& params) {
+  CampaignRequest request = validate_campaign_params(catalogue, campaign, params);
+  lab.check_needs(request.script->needs);
   return request;
 }
 

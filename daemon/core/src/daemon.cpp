@@ -154,7 +154,7 @@ Daemon::Daemon(DaemonConfig config) : impl_(std::make_unique<Impl>()) {
     }
   });
   d.executions = std::make_unique<Executions>(d.io, *d.store, *d.catalogue, d.instruments, *d.lab,
-                                              ExecutionOptions{cc.max_resume_attempts},
+                                              ExecutionOptions{cc.max_resume_attempts, d.config.state_dir},
                                               [&d](const std::string& text) { d.notifier.status(text); });
   d.queue = std::make_unique<NightQueue>(d.io, *d.store, *d.executions, *d.catalogue, *d.lab,
                                          QueueOptions{d.config.queue.autostart});

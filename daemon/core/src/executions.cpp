@@ -7,6 +7,7 @@
 #include <boost/asio/detached.hpp>
 #include <boost/asio/use_awaitable.hpp>
 
+#include "colorlab/campaigns/dry_run.hpp"
 #include "colorlab/campaigns/engine.hpp"
 #include "colorlab/core/error.hpp"
 #include "colorlab/core/log.hpp"
@@ -35,8 +36,9 @@ class StoreSink final : public campaigns::ExecutionSink {
  public:
   StoreSink(store::Store& store, const store::ExecutionRecord& record, const campaigns::InstrumentSet& instruments,
             std::function<void(const std::string&)> status, json snapshot, bool replace_serials,
-            std::optional<std::string>& suspension)
+            std::optional<std::string>& suspension, double time_scale)
       : suspension_(suspension),
+        time_scale_(time_scale),
         store_(store),
         record_(record),
         instruments_(instruments),
@@ -50,6 +52,8 @@ class StoreSink final : public campaigns::ExecutionSink {
     s.step = step.label;
     s.instruments = updated_snapshot();
     for (const auto& j : step.journal) s.journal.push_back({j.seq, j.call, j.args, j.result});
+    for (const auto& t : step.timings) s.timings.push_back({t.key, t.lab_seconds});
+    s.time_scale = time_scale_;
     for (const auto& m : step.measurements) {
       auto instrument = instruments_.find(m.instrument_id);
       s.measurements.push_back(
@@ -109,6 +113,7 @@ class StoreSink final : public campaigns::ExecutionSink {
   }
 
   std::optional<std::string>& suspension_;
+  double time_scale_ = 1;
   store::Store& store_;
   const store::ExecutionRecord& record_;
   const campaigns::InstrumentSet& instruments_;
@@ -148,6 +153,20 @@ Executions::Executions(asio::io_context& io, store::Store& store, campaigns::Scr
       status_text_(std::move(status_text)) {}
 
 Executions::~Executions() = default;
+
+json Executions::dry_run(const std::string& campaign_name, const json& params) {
+  auto [script, normalized] = validate_campaign_params(catalogue_, campaign_name, params);
+  campaigns::DryRunSetup setup;
+  setup.script = script;
+  setup.params = normalized;
+  setup.instruments = &instruments_;
+  setup.options = lab_.options();
+  for (const auto& [key, t] : store_.call_timings(lab_.time_scale())) setup.timings[key] = {t.n, t.mean_s};
+  setup.runs = lab_.run_reader();
+  setup.hands = lab_.hands();
+  setup.state_dir = options_.state_dir;
+  return campaigns::dry_run_campaign(setup);
+}
 
 store::ExecutionRecord Executions::start(const std::string& campaign_name, const json& params,
                                          const std::optional<std::string>& idempotency_key) {
@@ -246,7 +265,8 @@ void Executions::launch(store::ExecutionRecord record, std::shared_ptr<const cam
             // An operator resuming a paused run has looked at the lab: accept the units as they are.
             setup.verify_serials = !accept_units;
           }
-          StoreSink sink(store_, record, instruments_, status_text_, snapshot, resumed && accept_units, active->suspension);
+          StoreSink sink(store_, record, instruments_, status_text_, snapshot, resumed && accept_units, active->suspension,
+                         lab_.time_scale());
           outcome = co_await campaigns::run_campaign_script(std::move(setup), lab_, sink, active->control);
         } catch (const Error& e) {
           outcome.kind = campaigns::RunOutcome::Kind::failed;

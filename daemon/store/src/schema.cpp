@@ -115,6 +115,20 @@ CREATE TABLE queue_state (
 INSERT INTO queue_state (id, started, halted, reason, updated_at)
   VALUES (1, 0, 0, '', strftime('%Y-%m-%dT%H:%M:%fZ', 'now'));
 )sql",
+    // 3 -> 4: how long each kind of lab call takes on this lab, learned from live calls, so a dry
+    // run can estimate a campaign's duration from the instruments' own timings. Per time scale:
+    // the simulated lab's seconds shrink, the daemon's own time does not.
+    R"sql(
+CREATE TABLE call_timings (
+  key         TEXT NOT NULL,                       -- e.g. "meter.measure", "wait_stable cold D65"
+  time_scale  REAL NOT NULL,                       -- lab seconds per wall second when measured
+  n           INTEGER NOT NULL,
+  sum_s       REAL NOT NULL,                       -- lab seconds per unit, summed
+  sum_sq      REAL NOT NULL,
+  updated_at  TEXT NOT NULL,
+  PRIMARY KEY (key, time_scale)
+) WITHOUT ROWID;
+)sql",
 };
 
 int read_pragma_int(Database& db, const char* pragma) {

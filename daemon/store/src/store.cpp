@@ -300,6 +300,18 @@ void Store::commit_step(const ExecutionRecord& execution, const StepRecord& step
       ins.reset();
     }
   }
+  if (!step.timings.empty()) {
+    auto up = db_.prepare(
+        "INSERT INTO call_timings (key, time_scale, n, sum_s, sum_sq, updated_at) VALUES (?1, ?2, 1, ?3, ?3 * ?3, ?4) "
+        "ON CONFLICT (key, time_scale) DO UPDATE SET n = n + 1, sum_s = sum_s + excluded.sum_s, "
+        "sum_sq = sum_sq + excluded.sum_sq, updated_at = excluded.updated_at");
+    for (const auto& t : step.timings) {
+      if (!std::isfinite(t.lab_seconds) || t.lab_seconds < 0) continue;
+      up.bind(1, std::string_view(t.key)).bind(2, step.time_scale).bind(3, t.lab_seconds).bind(4, std::string_view(now));
+      up.run();
+      up.reset();
+    }
+  }
   if (step.instruments) {
     db_.prepare("UPDATE runs SET instruments = ?2 WHERE id = ?1")
         .bind(1, std::string_view(execution.run_id))
@@ -332,6 +344,25 @@ std::vector<JournalRow> Store::journal(const std::string& execution_id) {
   std::vector<JournalRow> out;
   while (st.step()) {
     out.push_back(JournalRow{st.int64(0), st.text(1), parse_json_column(st.text(2)), parse_json_column(st.text(3))});
+  }
+  return out;
+}
+
+std::map<std::string, LearnedTiming> Store::call_timings(double time_scale) {
+  // Per key the figure learned nearest to how the lab runs now, by ratio (×50 is nearer ×100 than ×1).
+  const double here = std::log(time_scale > 0 ? time_scale : 1.0);
+  auto st = db_.prepare("SELECT key, time_scale, n, sum_s, sum_sq FROM call_timings WHERE n > 0 AND time_scale > 0");
+  std::map<std::string, LearnedTiming> out;
+  while (st.step()) {
+    LearnedTiming t;
+    t.time_scale = st.real(1);
+    t.n = st.int64(2);
+    const double sum = st.real(3), sum_sq = st.real(4);
+    t.mean_s = sum / static_cast<double>(t.n);
+    const double var = t.n > 1 ? (sum_sq - sum * sum / static_cast<double>(t.n)) / static_cast<double>(t.n - 1) : 0.0;
+    t.stdev_s = var > 0 ? std::sqrt(var) : 0.0;
+    auto [it, fresh] = out.emplace(st.text(0), t);
+    if (!fresh && std::abs(std::log(t.time_scale) - here) < std::abs(std::log(it->second.time_scale) - here)) it->second = t;
   }
   return out;
 }

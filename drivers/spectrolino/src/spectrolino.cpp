@@ -448,8 +448,8 @@ asio::awaitable<SpectralReading> Spectrolino::measure() {
 }
 
 asio::awaitable<SpectralReading> Spectrolino::measure_patch(const PatchVisit& patch) {
-  auto x = tenth_mm(patch.x_mm, 310.0, "x");
-  auto y = tenth_mm(patch.y_mm, 230.0, "y");
+  auto x = tenth_mm(patch.x_mm, kTravel.x_max_mm, "x");
+  auto y = tenth_mm(patch.y_mm, kTravel.y_max_mm, "y");
   auto answer = co_await protocol_.transact(sl::req::move_and_measure(x, y), options_.timeouts.move + options_.timeouts.measure,
                                             "move and measure", 1);
   try {
@@ -492,7 +492,7 @@ asio::awaitable<void> Spectrolino::move_to(double x_mm, double y_mm) {
   require_table("move");
   require_ready("move");
   try {
-    co_await scan_command(sl::req::move_absolute(sl::ScanRef::Sensor, tenth_mm(x_mm, 310.0, "x"), tenth_mm(y_mm, 230.0, "y")),
+    co_await scan_command(sl::req::move_absolute(sl::ScanRef::Sensor, tenth_mm(x_mm, kTravel.x_max_mm, "x"), tenth_mm(y_mm, kTravel.y_max_mm, "y")),
                           options_.timeouts.move, "move");
   } catch (const Error& e) {
     fail(e);

@@ -18,6 +18,7 @@
 #include <boost/asio/awaitable.hpp>
 #include <nlohmann/json.hpp>
 
+#include "colorlab/campaigns/call_timing.hpp"
 #include "colorlab/campaigns/control.hpp"
 #include "colorlab/campaigns/lab.hpp"
 #include "colorlab/campaigns/script.hpp"
@@ -47,6 +48,9 @@ struct StepCommit {
   std::vector<RecordedMeasurement> measurements;
   double progress = 0;
   std::string label;
+  // How long each live call took (none for replayed ones, nor for calls that were suspended):
+  // what the dry run estimates from.
+  std::vector<CallTiming> timings;
 };
 
 // The daemon's side of one execution.

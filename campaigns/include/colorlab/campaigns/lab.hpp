@@ -93,6 +93,10 @@ class Lab {
 
   // Where lab.runs.* reads earlier runs (the daemon's store); without one those calls fail.
   void set_run_reader(RunReader* runs) { runs_ = runs; }
+  // What a dry run of a campaign on this lab needs to know of it.
+  const OperatorHands* hands() const { return hands_; }
+  RunReader* run_reader() const { return runs_; }
+  const InstrumentSet& instruments() const { return instruments_; }
 
   const LabOptions& options() const { return options_; }
   double time_scale() const { return options_.time_scale; }

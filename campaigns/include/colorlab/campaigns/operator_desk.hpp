@@ -33,12 +33,18 @@ struct OperatorRequest {
   nlohmann::json to_json() const;
 };
 
+// The request a script's lab.operator.request{...} table describes (no id, times or answer yet);
+// Error{script_error} saying what is wrong with it.
+OperatorRequest parse_operator_request(const nlohmann::json& spec);
+
 // Something that can carry out an operator action itself. nullopt: it cannot, a person must.
 class OperatorHands {
  public:
   virtual ~OperatorHands() = default;
   virtual boost::asio::awaitable<std::optional<nlohmann::json>> perform(const std::string& action,
                                                                          const nlohmann::json& details) = 0;
+  // Whether perform would do `action` itself (a dry run lists the rest as waits for a person).
+  virtual bool can_perform(const std::string& action) const = 0;
 };
 
 class OperatorDesk {

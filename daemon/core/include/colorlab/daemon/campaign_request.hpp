@@ -19,6 +19,10 @@ struct CampaignRequest {
   nlohmann::json params;  // validated, defaults filled in
 };
 
+// The campaign and its parameters only (a dry run lists missing instruments instead of refusing).
+CampaignRequest validate_campaign_params(campaigns::ScriptCatalogue& catalogue, const std::string& campaign,
+                                         const nlohmann::json& params);
+
 // Throws Error{not_found} for an unknown campaign (hint: the known ones) or a missing instrument,
 // Error{bad_parameter} naming the parameter.
 CampaignRequest validate_campaign_request(campaigns::ScriptCatalogue& catalogue, const campaigns::Lab& lab,

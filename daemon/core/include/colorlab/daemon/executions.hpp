@@ -5,6 +5,7 @@
 // left unfinished by a crash, a power cut or a shutdown are resumed at start-up by replay, up to
 // a bounded number of attempts in a row without progress. Pause, resume and abort land at the
 // engine's next safe point.
+#include <filesystem>
 #include <functional>
 #include <map>
 #include <memory>
@@ -23,6 +24,7 @@ namespace colorlab::daemon {
 
 struct ExecutionOptions {
   int max_resume_attempts = 3;
+  std::filesystem::path state_dir;  // where runs are stored (a dry run checks its free space)
 };
 
 class Executions {
@@ -35,6 +37,10 @@ class Executions {
   // Validates, records and launches. Throws Error{bad_parameter|not_found} before anything starts.
   store::ExecutionRecord start(const std::string& campaign, const nlohmann::json& params,
                                const std::optional<std::string>& idempotency_key);
+  // The campaign run against a lab that moves nothing (campaigns/dry_run.hpp): limits, instruments,
+  // disk, operator actions and the estimated duration from this lab's learned call timings.
+  // Throws Error{bad_parameter|not_found} for an unknown campaign or invalid parameters.
+  nlohmann::json dry_run(const std::string& campaign, const nlohmann::json& params);
   // At start-up: every execution a previous process left running or suspended continues.
   void resume_unfinished();
   store::ExecutionRecord pause(const std::string& id);

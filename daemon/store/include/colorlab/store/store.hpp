@@ -4,6 +4,7 @@
 // survives power loss), busy_timeout, foreign keys, quick_check at open.
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <set>
 #include <string>
@@ -53,6 +54,19 @@ struct JournalRow {
   nlohmann::json result;
 };
 
+// One live lab call's duration in lab seconds per unit, under the key campaigns::TimingKeys gave it.
+struct CallTimingRow {
+  std::string key;
+  double lab_seconds = 0;
+};
+
+struct LearnedTiming {
+  std::int64_t n = 0;
+  double mean_s = 0;
+  double stdev_s = 0;
+  double time_scale = 1;  // the time scale it was learned at
+};
+
 struct MeasurementRow {
   std::string step;
   std::string instrument_id;
@@ -72,6 +86,9 @@ struct StepRecord {
   // When set, replaces the run's instrument snapshot in the same transaction (serials learned
   // once the instruments connected).
   std::optional<nlohmann::json> instruments;
+  // How long the step's live calls took, learned in the same transaction (see CallTimingRow).
+  std::vector<CallTimingRow> timings;
+  double time_scale = 1;
 };
 
 struct MeasurementRecord {
@@ -152,6 +169,9 @@ class Store {
   std::vector<JournalRow> journal(const std::string& execution_id);
   std::set<std::string> measurement_steps(const std::string& run_id);
   std::optional<std::string> script_source(const std::string& sha256);
+  // What each kind of lab call has cost on this lab: per key, the figures learned at `time_scale`,
+  // or at the nearest time scale where a key was never timed at this one.
+  std::map<std::string, LearnedTiming> call_timings(double time_scale);
   // waiting, running, paused or suspended, oldest first.
   std::vector<ExecutionRecord> unfinished_executions();
   // Per quantity: count, unit, mean, stdev, min, max — computed by SQL from the stored rows.

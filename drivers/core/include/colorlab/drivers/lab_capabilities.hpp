@@ -6,6 +6,7 @@
 #include <chrono>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <boost/asio/awaitable.hpp>
@@ -52,8 +53,16 @@ struct ChartPatchVisit {
   int row_length = 1;
 };
 
+// The area the measuring head can reach, from the table's origin.
+struct TableTravel {
+  double x_max_mm = 0;
+  double y_max_mm = 0;
+};
+
 class XyTable : public virtual Instrument {
  public:
+  // Where the head can go (a dry run checks a campaign's positions against it); nullopt if unknown.
+  virtual std::optional<TableTravel> travel() const { return std::nullopt; }
   virtual boost::asio::awaitable<void> move_to(double x_mm, double y_mm) = 0;
   virtual boost::asio::awaitable<void> home() = 0;
   virtual boost::asio::awaitable<void> head_up() = 0;
@@ -80,6 +89,8 @@ class Dimmer : public virtual Instrument {
   // level 0–1; returns once the ramp and the settle time are over.
   virtual boost::asio::awaitable<void> set_level(const std::string& lamp, double level) = 0;
   virtual double level(const std::string& lamp) const = 0;
+  // The levels the dimmer can hold (0–1); a ballast may not dim below some level.
+  virtual std::pair<double, double> level_range() const { return {0.0, 1.0}; }
 };
 
 }  // namespace colorlab::drivers

@@ -71,6 +71,9 @@ class Spectrolino final : public Spectrometer, public XyTable {
   boost::asio::awaitable<void> set_colorimetry(sl::Illuminant il, sl::Observer ob, sl::WhiteBase wb);
 
   // XyTable (SpectroScan only; Error{unsupported} on a stand-alone Spectrolino)
+  // The SpectroScan T's measuring area (instrument-protocols.md: positions in 0.1 mm up to 310 × 230 mm).
+  static constexpr TableTravel kTravel{310.0, 230.0};
+  std::optional<TableTravel> travel() const override { return kTravel; }
   boost::asio::awaitable<void> move_to(double x_mm, double y_mm) override;
   boost::asio::awaitable<void> home() override;
   boost::asio::awaitable<void> head_up() override;

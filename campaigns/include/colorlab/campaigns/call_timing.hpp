@@ -1,0 +1,55 @@
+#pragma once
+// What a lab call costs, learned from the calls this lab has made. No source publishes how long a
+// Spectrolino reading, a SpectroScan move or a lamp's warm-up takes (instrument-protocols.md gives
+// only Argyll's timeouts), so the dry run's estimate comes from measured durations: the engine
+// times every live call and stores it under a key that says what the time depends on (a cold lamp
+// or a warm one, per frame and format for photographs, per operator action), and the dry run adds
+// up the same keys. Keys never seen fall back to stated nominal figures, flagged as assumed.
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace colorlab::campaigns {
+
+// One live call's duration: `lab_seconds` per unit (a frame × format for photographs, a frame for
+// captures, the call otherwise), wall time × the lab's time scale, minus waits the script itself
+// asked for (a dimmer's settle_s), which the dry run adds back exactly.
+struct CallTiming {
+  std::string key;
+  double lab_seconds = 0;
+};
+
+struct TimingStats {
+  std::int64_t n = 0;
+  double mean_s = 0;
+};
+
+// key → what it cost so far on this lab (at its time scale).
+using TimingBook = std::map<std::string, TimingStats>;
+
+// Follows a script's calls (live and replayed) and names the timing key of each; both the engine
+// (to learn) and the dry run (to estimate) use it, so they cannot disagree on what a key means.
+class TimingKeys {
+ public:
+  // The key a call is timed under, known before the call is made.
+  std::string key(const std::string& call, const nlohmann::json& args) const;
+  // How many units the call counts for (frames × formats for a photograph), at least 1.
+  static double units(const std::string& call, const nlohmann::json& args);
+  // Lab seconds of the call that the script asked for outright (lab.wait, a dimmer's settle_s):
+  // not learned, always added exactly.
+  static double asked_wait_s(const std::string& call, const nlohmann::json& args);
+  // After a completed call: which lamps are lit, and which of them have been stable since.
+  void follow(const std::string& call, const nlohmann::json& args, const nlohmann::json& result);
+  // Lamps lit since the last stable wait (they still warm up): the next wait_stable waits for them.
+  std::set<std::string> cold_lamps() const;
+
+ private:
+  std::set<std::string> lit_;
+  std::set<std::string> warm_;
+};
+
+}  // namespace colorlab::campaigns
