@@ -13,6 +13,7 @@
 #include "colorlab/campaigns/lua_value.hpp"
 #include "colorlab/core/error.hpp"
 #include "dry_run_answers.hpp"
+#include "roles.hpp"
 #include "run_thread.hpp"
 
 namespace colorlab::campaigns {
@@ -213,7 +214,7 @@ json dry_run_campaign(const DryRunSetup& setup) {
   for (const auto& role : roles) {
     auto i = lab.instrument_for(role);
     if (!i) {
-      problems.push_back({"instrument", "the campaign needs a " + role + " and none is configured"});
+      problems.push_back({"instrument", "the campaign needs " + role_words(role) + ", and none is configured"});
       instruments.push_back({{"role", role}, {"instrument", nullptr}});
       continue;
     }

@@ -9,6 +9,7 @@
 #include "colorlab/core/ids.hpp"
 #include "colorlab/drivers/camera/camera_instrument.hpp"
 #include "colorlab/drivers/lab_capabilities.hpp"
+#include "roles.hpp"
 
 namespace colorlab::campaigns {
 
@@ -17,15 +18,6 @@ using drivers::Capability;
 namespace cam = drivers::camera;
 
 namespace {
-
-Capability capability_of(const std::string& role) {
-  if (role == "luminance_meter") return Capability::luminance;
-  if (role == "spectrophotometer") return Capability::reflectance_spectrum;
-  if (role == "table") return Capability::xy_table;
-  if (role == "lamps") return Capability::lamp_switching;
-  if (role == "dimmer") return Capability::dimmer;
-  return Capability::camera;
-}
 
 // Whether the instrument is of the C++ kind that serves `role` (it may learn the capability only
 // once connected, as a Spectrolino learns whether it sits on a table).

@@ -29,6 +29,14 @@ NewRun luminance_run() {
   return r;
 }
 
+// An execution of a stored script, ready for steps.
+colorlab::store::ExecutionRecord scripted_execution(Store& store) {
+  auto run = luminance_run();
+  run.script_sha256 = "s1";
+  run.script_source = "x";
+  return store.create_execution(run).execution;
+}
+
 void set_user_version(const std::filesystem::path& db, int v) {
   sqlite3* h = nullptr;
   ASSERT_EQ(sqlite3_open(db.c_str(), &h), SQLITE_OK);
@@ -128,10 +136,7 @@ TEST(Store, MeasurementsSurviveReopenAndUnfinishedRunsAwaitResume) {
 TEST(Store, CommittedStepIsWholeAndAStepStoredTwiceLeavesNothingHalfDone) {
   TempDir dir;
   Store store(dir / "colorlab.db");
-  auto run = luminance_run();
-  run.script_sha256 = "s1";
-  run.script_source = "x";
-  auto e = store.create_execution(run).execution;
+  auto e = scripted_execution(store);
   StepRecord step;
   step.journal.push_back({0, "meter.measure", json::array(), {{"luminance", 245.5}}});
   step.measurements.push_back({"reading/0", "ls110", true, "luminance", 245.5, "cd/m2", nullptr});
@@ -254,10 +259,7 @@ TEST(Store, ExecutionLifecycleKeepsRunExecutionAndEventLogInStep) {
 TEST(Store, CallTimingsAccumulateWithTheirStepAndAreReadAtTheNearestTimeScale) {
   TempDir dir;
   Store store(dir / "colorlab.db");
-  auto run = luminance_run();
-  run.script_sha256 = "s1";
-  run.script_source = "x";
-  auto e = store.create_execution(run).execution;
+  auto e = scripted_execution(store);
   StepRecord step;
   step.journal.push_back({0, "meter.measure", json::array(), {{"luminance", 1.0}}});
   step.timings = {{"meter.measure", 1.0}, {"meter.measure", 3.0}, {"wait_stable cold D65", 400.0}};
