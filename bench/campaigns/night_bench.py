@@ -4,11 +4,15 @@
 1. Chart read, time per patch above the simulated device's own time, measured with the campaign:
    chart-read runs at two time scales in the same harness; the time between consecutive patch
    commits is wall(ts) = device/ts + host, so device = (w_a - w_b) / (1/a - 1/b) and host follows.
-2. A simulated night: cabinet-grid (80 spots x 3 lamps x 4 dimmer levels) and chart-read (140
-   patches) at full size, one after the other on one daemon, with where the time goes (lab calls
-   by kind from the journal is not exposed, so the split is per campaign and per phase).
+2. A simulated night: cabinet-grid (80 spots x 3 lamps x 4 dimmer levels), chart-read (140
+   patches) and characterize-camera (the SG photographed 25 frames as RAW, TIFF 16/8 and JPEG by the
+   full-size simulated DSLR, against that chart-read, every approach fitted) at full size, one after
+   the other on one daemon, with where the time goes (lab calls by kind from the journal is not
+   exposed, so the split is per campaign and per phase; characterize-camera's phases from the times
+   its log lines reach the daemon's stderr).
 
 Usage: bench/campaigns/night_bench.py [--build build] [--night-scale 1000] [--skip-night]
+                                      [--skip-chart-scales] [--night grid,chart,camera] [--skip-camera-split]
 """
 import argparse
 import json
@@ -17,13 +21,15 @@ import signal
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from datetime import datetime
 
 import requests
 
 
-def start_daemon(build, state, scale):
+def start_daemon(build, state, scale, log=None):
+    """log: a list that receives (monotonic time, line) for every line colorlabd writes to stderr."""
     cfg = os.path.join(state, "colorlabd.toml")
     lab = os.path.join(state, "lab.toml")
     os.makedirs(state, exist_ok=True)
@@ -33,12 +39,20 @@ def start_daemon(build, state, scale):
         f.write(f"[simulator]\nenabled = true\ntime_scale = {scale}\nconfig = \"{lab}\"\n")
     proc = subprocess.Popen([os.path.join(build, "bin", "colorlabd"), "--config", cfg, "--state",
                              os.path.join(state, "s"), "--listen", "127.0.0.1:0"],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE if log is not None else subprocess.DEVNULL,
+                            text=True)
+    if log is not None:
+        def read():
+            for line in proc.stderr:
+                log.append((time.monotonic(), line.rstrip("\n")))
+        threading.Thread(target=read, daemon=True).start()
     endpoint = os.path.join(state, "s", "colorlabd.endpoint")
     for _ in range(400):
         if os.path.exists(endpoint):
             with open(endpoint) as f:
-                return proc, json.load(f)["url"]
+                e = json.load(f)
+            proc.simulator_pid = e.get("simulator_pid")
+            return proc, e["url"]
         time.sleep(0.05)
     proc.kill()
     raise SystemExit("colorlabd did not start")
@@ -59,6 +73,37 @@ def run(url, campaign, params):
     return wall, r
 
 
+def camera_phases(log, t0, t1):
+    """characterize-camera's phases between t0 and t1 from its log lines: lamp and operator, photographs,
+    then one fit per format."""
+    marks = [(t, line.split("characterize-camera: ", 1)[1]) for t, line in log
+             if t0 <= t <= t1 and "characterize-camera: " in line]
+    phases, last = [], t0
+    for t, text in marks:
+        if "stable after" in text:
+            phases.append(("lamp on, operator requests answered by the simulator, wait_stable (" + text + ")", t - last))
+        elif text.startswith("photographed"):
+            phases.append(("photograph_chart: " + text + ", averaged, located and sampled", t - last))
+        elif " fitted: " in text:
+            phases.append(("lab.analysis.characterize " + text, t - last))
+        else:
+            continue
+        last = t
+    phases.append(("records and the last commit", t1 - last))
+    return phases
+
+
+def cpu_s(pid):
+    """User + system CPU seconds of a process and its threads so far."""
+    with open(f"/proc/{pid}/stat") as f:
+        fields = f.read().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def cpu_split(proc):
+    return {"colorlabd": cpu_s(proc.pid), "colorlab-sim": cpu_s(proc.simulator_pid) if proc.simulator_pid else 0.0}
+
+
 def stamp(m):
     return datetime.fromisoformat(m["measured_at"].replace("Z", "+00:00")).timestamp()
 
@@ -74,11 +119,15 @@ def main():
     ap.add_argument("--scales", default="10,20")
     ap.add_argument("--night-scale", type=float, default=1000)
     ap.add_argument("--skip-night", action="store_true")
+    ap.add_argument("--skip-chart-scales", action="store_true", help="only the night")
+    ap.add_argument("--night", default="grid,chart,camera", help="the night's campaigns, in this order")
+    ap.add_argument("--skip-camera-split", action="store_true",
+                    help="do not photograph the chart again as RAW only after the night (the split of the camera's time)")
     a = ap.parse_args()
     out = {}
     scales = [float(s) for s in a.scales.split(",")]
     walls = {}
-    for scale in scales:
+    for scale in ([] if a.skip_chart_scales else scales):
         with tempfile.TemporaryDirectory() as d:
             proc, url = start_daemon(a.build, d, scale)
             try:
@@ -88,28 +137,64 @@ def main():
             finally:
                 proc.send_signal(signal.SIGKILL)
                 proc.wait()
-    sa, sb = scales[0], scales[1]
-    device = (walls[sa] - walls[sb]) / (1 / sa - 1 / sb)
-    host = walls[sa] - device / sa
-    out["chart_read"] = {"per_patch_s": walls, "device_s_per_patch": device, "host_s_per_patch": host,
-                         "host_over_device_at_scale_1": host / device}
-    print(f"device time per patch (time scale 1): {device:.3f} s; colorlab's own time per patch: {host*1000:.1f} ms "
-          f"= {100*host/device:.1f} % above the device's own time", flush=True)
+    if not a.skip_chart_scales:
+        sa, sb = scales[0], scales[1]
+        device = (walls[sa] - walls[sb]) / (1 / sa - 1 / sb)
+        host = walls[sa] - device / sa
+        out["chart_read"] = {"per_patch_s": walls, "device_s_per_patch": device, "host_s_per_patch": host,
+                             "host_over_device_at_scale_1": host / device}
+        print(f"device time per patch (time scale 1): {device:.3f} s; colorlab's own time per patch: {host*1000:.1f} ms "
+              f"= {100*host/device:.1f} % above the device's own time", flush=True)
     if not a.skip_night:
+        night = a.night.split(",")
         with tempfile.TemporaryDirectory() as d:
-            proc, url = start_daemon(a.build, d, a.night_scale)
+            log = []
+            proc, url = start_daemon(a.build, d, a.night_scale, log)
             try:
+                out["night"] = {"time_scale": a.night_scale}
                 t0 = time.monotonic()
-                gw, g = run(url, "cabinet-grid", {})
-                cw, c = run(url, "chart-read", {})
-                total = time.monotonic() - t0
-                s = g["summary"]["script"]
-                out["night"] = {"time_scale": a.night_scale, "cabinet_grid_s": gw, "chart_read_s": cw, "total_s": total,
-                                "grid_values": s["grid_values"], "lamp_warmups": s["lamp_warmups"],
-                                "operator_aims": s["operator_aims"]}
-                print(f"night at time scale {a.night_scale:g}: cabinet-grid {gw:.1f} s ({s['grid_values']} readings, "
-                      f"{s['lamp_warmups']} lamp warm-ups, {s['operator_aims']} aims), chart-read {cw:.1f} s, "
-                      f"total {total:.1f} s", flush=True)
+                if "grid" in night:
+                    gw, g = run(url, "cabinet-grid", {})
+                    s = g["summary"]["script"]
+                    out["night"].update({"cabinet_grid_s": gw, "grid_values": s["grid_values"],
+                                         "lamp_warmups": s["lamp_warmups"], "operator_aims": s["operator_aims"]})
+                    print(f"cabinet-grid {gw:.1f} s ({s['grid_values']} readings, {s['lamp_warmups']} lamp warm-ups, "
+                          f"{s['operator_aims']} aims)", flush=True)
+                if "chart" in night or "camera" in night:
+                    cw, c = run(url, "chart-read", {})
+                    out["night"]["chart_read_s"] = cw
+                    print(f"chart-read {cw:.1f} s", flush=True)
+                if "camera" in night:
+                    # Full size: 25 frames, every format, the SG, the full 3504 x 2336 simulated 20D.
+                    t_start, cpu0 = time.monotonic(), cpu_split(proc)
+                    kw, k = run(url, "characterize-camera", {"reference_run": c["id"], "frames": 25})
+                    phases = camera_phases(log, t_start, time.monotonic())
+                    cpu = {k_: v - cpu0[k_] for k_, v in cpu_split(proc).items()}
+                    out["night"]["characterize_cpu_s"] = cpu
+                    print("characterize-camera CPU: " + ", ".join(f"{k_} {v:.1f} s" for k_, v in cpu.items()), flush=True)
+                    r = k["summary"]["script"]
+                    cv = {f: {n: ap_["cv"]["mean"] for n, ap_ in v["approaches"].items()} for f, v in r["formats"].items()}
+                    out["night"].update({"characterize_camera_s": kw, "characterize_phases_s": phases, "characterize_cv_mean": cv})
+                    print(f"characterize-camera {kw:.1f} s", flush=True)
+                    for name, secs in phases:
+                        print(f"  {secs:7.1f} s  {name}", flush=True)
+                    for f, v in cv.items():
+                        print(f"  {f}: CV mean dE00 " + ", ".join(f"{n} {x:.2f}" for n, x in sorted(v.items())), flush=True)
+                out["night"]["total_s"] = time.monotonic() - t0
+                print(f"night at time scale {a.night_scale:g}: total {out['night']['total_s']:.1f} s", flush=True)
+                if "camera" in night and not a.skip_camera_split:
+                    # Not part of the night: the same photographs as RAW only, to split photograph_chart's time
+                    # into the raws (render, DNG, transfer, LibRaw, the frame pipeline's sum) and the camera's
+                    # own processed files (rendered, written, read back and averaged) with their locating.
+                    t_start, cpu0 = time.monotonic(), cpu_split(proc)
+                    rw, _ = run(url, "characterize-camera", {"reference_run": c["id"], "frames": 25, "formats": ["raw"]})
+                    raw_phases = camera_phases(log, t_start, time.monotonic())
+                    cpu = {k_: v - cpu0[k_] for k_, v in cpu_split(proc).items()}
+                    out["camera_raw_only"] = {"wall_s": rw, "phases_s": raw_phases, "cpu_s": cpu}
+                    print(f"(apart from the night) characterize-camera, RAW only: {rw:.1f} s; CPU "
+                          + ", ".join(f"{k_} {v:.1f} s" for k_, v in cpu.items()), flush=True)
+                    for name, secs in raw_phases:
+                        print(f"  {secs:7.1f} s  {name}", flush=True)
             finally:
                 proc.send_signal(signal.SIGKILL)
                 proc.wait()
