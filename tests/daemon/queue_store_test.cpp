@@ -88,12 +88,12 @@ TEST(queue_store, MigrationFromVersionTwoKeepsTheDataAndAddsAStoppedEmptyQueue) 
     run.script_source = "return {}";
     execution_id = store.create_execution(run).execution.id;
   }
-  // The file as version 2 left it: no queue tables.
-  exec_sql(path, "DROP TABLE queue_items; DROP TABLE queue_state; PRAGMA user_version = 2;");
+  // The file as version 2 left it: no queue tables (nor the later call timings).
+  exec_sql(path, "DROP TABLE queue_items; DROP TABLE queue_state; DROP TABLE call_timings; PRAGMA user_version = 2;");
   Store store(path);
   {
     colorlab::store::Database db(path.string(), true);
-    EXPECT_EQ(colorlab::store::schema_version(db), 3);
+    EXPECT_EQ(colorlab::store::schema_version(db), colorlab::store::kSchemaVersion);
   }
   EXPECT_TRUE(store.execution(execution_id)) << "the migration must keep what was stored";
   QueueStore queue(store);
