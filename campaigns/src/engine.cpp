@@ -33,9 +33,7 @@ class Engine final : public LabCallSink {
     has_request_ = true;
   }
   void record(const std::string& step, const json& fields) override {
-    if (!recorded_.insert(step).second) {
-      throw Error(ErrorClass::script_error, "step '" + step + "' is recorded twice; each lab.record needs its own step key");
-    }
+    claim_step(recorded_, step);
     if (setup_.stored_steps.count(step)) return;  // committed before the interruption
     RecordedMeasurement m;
     m.step = step;

@@ -345,6 +345,12 @@ void set_function(lua_State* L, const char* field, lua_CFunction f, LabCallSink*
 
 }  // namespace
 
+void claim_step(std::set<std::string>& recorded, const std::string& step) {
+  if (!recorded.insert(step).second) {
+    throw Error(ErrorClass::script_error, "step '" + step + "' is recorded twice; each lab.record needs its own step key");
+  }
+}
+
 CallKind kind_of(const std::string& call) {
   auto it = call_specs().find(call);
   if (it == call_specs().end()) throw Error(ErrorClass::internal, "unknown lab call " + call);

@@ -3,6 +3,7 @@
 // checkpoint and the analysis library. Calls that touch an instrument or take time yield the
 // script's coroutine with a request the engine carries out (or answers from the journal on
 // replay); the rest run at once. Arguments are checked here so an error names the script line.
+#include <set>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -23,6 +24,10 @@ class LabCallSink {
   virtual void progress(double fraction, const std::string& label) = 0;
   virtual void log(const std::string& text) = 0;
 };
+
+// A sink's record(): throws Error{script_error} when the script recorded `step` before in this run
+// (each lab.record needs its own step key), otherwise remembers it.
+void claim_step(std::set<std::string>& recorded, const std::string& step);
 
 // Kinds of yielding calls: an effect changes the lab (and is replayed into the desired state), a
 // reading returns a value (replayed from the journal), control only marks a safe point.
