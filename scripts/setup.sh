@@ -18,6 +18,8 @@ packages=(
   # independent references and test tools
   argyll aravis-tools aravis-tools-cli libraw-bin dcraw python3-numpy hyperfine sqlite3 curl util-linux procps strace
   imagemagick
+  # the data service: load benches against nginx, fuzzing with clang's libFuzzer, the Python client
+  wrk nginx-light clang libfuzzer-14-dev python3-requests python3-pandas
 )
 
 missing=()

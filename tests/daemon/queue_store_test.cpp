@@ -89,7 +89,7 @@ TEST(queue_store, MigrationFromVersionTwoKeepsTheDataAndAddsAStoppedEmptyQueue) 
     execution_id = store.create_execution(run).execution.id;
   }
   // The file as version 2 left it: no queue tables (nor the later call timings).
-  exec_sql(path, "DROP TABLE queue_items; DROP TABLE queue_state; DROP TABLE call_timings; PRAGMA user_version = 2;");
+  exec_sql(path, "DROP TABLE queue_items; DROP TABLE queue_state; DROP TABLE call_timings; DROP TABLE run_blobs; DROP TABLE blobs; DROP TABLE api_keys; PRAGMA user_version = 2;");
   Store store(path);
   {
     colorlab::store::Database db(path.string(), true);

@@ -129,6 +129,37 @@ CREATE TABLE call_timings (
   PRIMARY KEY (key, time_scale)
 ) WITHOUT ROWID;
 )sql",
+    // 4 -> 5: the data service. Frames kept as content-addressed files under the state directory
+    // (the file is named by its SHA-256 and written before the row that references it), which run
+    // and step each belongs to; and the API keys for listeners beyond loopback, stored as hashes.
+    R"sql(
+CREATE TABLE blobs (
+  sha256      TEXT PRIMARY KEY,                    -- of the file's bytes; also its name in the blob store
+  size        INTEGER NOT NULL,
+  media_type  TEXT NOT NULL,                       -- e.g. image/x-adobe-dng, image/tiff, application/x-colorlab-array
+  meta        TEXT NOT NULL DEFAULT '{}',          -- JSON: dtype, shape, cfa for raw arrays; width, height, bits
+  created_at  TEXT NOT NULL
+) WITHOUT ROWID;
+CREATE TABLE run_blobs (
+  run_id      TEXT NOT NULL REFERENCES runs(id),
+  name        TEXT NOT NULL,                       -- unique within the run, e.g. "D65/frame-average"
+  sha256      TEXT NOT NULL REFERENCES blobs(sha256),
+  step        TEXT NOT NULL,                       -- the step that captured it
+  kind        TEXT NOT NULL,                       -- raw, dng, average, tiff16, tiff8, jpeg, preview
+  created_at  TEXT NOT NULL,
+  PRIMARY KEY (run_id, name)
+) WITHOUT ROWID;
+CREATE INDEX run_blobs_by_sha ON run_blobs(sha256);
+CREATE TABLE api_keys (
+  id            TEXT PRIMARY KEY,                  -- UUIDv7; names the key in lists and logs, not secret
+  name          TEXT NOT NULL,                     -- who or what holds it
+  scope         TEXT NOT NULL CHECK (scope IN ('read', 'control', 'admin')),
+  secret_sha256 TEXT NOT NULL UNIQUE,              -- SHA-256 of the whole key; the key itself is never stored
+  created_at    TEXT NOT NULL,
+  last_used_at  TEXT,
+  revoked_at    TEXT
+);
+)sql",
 };
 
 int read_pragma_int(Database& db, const char* pragma) {
