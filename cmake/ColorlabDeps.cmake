@@ -45,6 +45,12 @@ if(NOT CLI11_FOUND)
   target_include_directories(CLI11::CLI11 INTERFACE ${CLI11_INCLUDE_DIR})
 endif()
 
+# TLS for listeners beyond loopback, API keys' hashes and the blob store's content addresses.
+find_package(OpenSSL QUIET COMPONENTS SSL Crypto)
+if(NOT OpenSSL_FOUND)
+  message(FATAL_ERROR "colorlab needs OpenSSL: apt-get install libssl-dev")
+endif()
+
 colorlab_require_pkg(TOMLPP tomlplusplus libtomlplusplus-dev)
 colorlab_require_pkg(LIBSERIALPORT libserialport libserialport-dev)
 colorlab_require_pkg(HIDAPI hidapi-hidraw libhidapi-dev)

@@ -1,13 +1,29 @@
 #include "colorlab/http/server.hpp"
 
+#include <fcntl.h>
+#include <sys/sendfile.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <optional>
+#include <thread>
+#include <vector>
+
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/detached.hpp>
+#include <boost/asio/executor_work_guard.hpp>
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/local/stream_protocol.hpp>
 #include <boost/asio/redirect_error.hpp>
+#include <boost/asio/ssl.hpp>
 #include <boost/asio/steady_timer.hpp>
+#include <boost/asio/strand.hpp>
+#include <boost/asio/this_coro.hpp>
 #include <boost/asio/use_awaitable.hpp>
+#include <boost/asio/write.hpp>
 #include <boost/beast/core/flat_buffer.hpp>
+#include <boost/beast/core/stream_traits.hpp>
 #include <boost/beast/http.hpp>
 
 #include "colorlab/core/error.hpp"
@@ -19,80 +35,274 @@ namespace colorlab::http {
 namespace asio = boost::asio;
 namespace beast = boost::beast;
 namespace bhttp = boost::beast::http;
+namespace ssl = boost::asio::ssl;
 using boost::system::error_code;
 using tcp = asio::ip::tcp;
 using local = asio::local::stream_protocol;
+using TlsStream = ssl::stream<tcp::socket>;
 
 namespace {
 
-HttpResponse safe_handle(const Handler& handler, HttpRequest& req) {
-  if (!req.parse_target()) {
-    return HttpResponse::problem(400, "bad-target", "Malformed request target", "cannot parse '" + req.target + "'");
-  }
-  try {
-    return handler(req);
-  } catch (const Error& e) {
-    log::error("http", std::string("handler failed: ") + e.what());
-    return HttpResponse::problem(500, "internal", "Internal error", e.what(), e.hint());
-  } catch (const std::exception& e) {
-    log::error("http", std::string("handler failed: ") + e.what());
-    return HttpResponse::problem(500, "internal", "Internal error", e.what());
-  }
+// What every session needs; sessions hold it, so a stopped Server never leaves them dangling.
+struct Shared {
+  AsyncHandler handler;
+  ServerOptions options;
+  std::shared_ptr<ssl::context> tls;
+  std::atomic<unsigned> open{0};
+  std::atomic<unsigned long long> accepted{0};
+  std::atomic<unsigned long long> refused{0};
+};
+
+struct OpenConnection {
+  explicit OpenConnection(Shared& s) : shared(s) { ++shared.open; }
+  ~OpenConnection() { --shared.open; }
+  Shared& shared;
+};
+
+template <class Stream>
+constexpr bool kIsTls = std::is_same_v<Stream, TlsStream>;
+
+template <class Stream>
+void close_stream(Stream& stream) {
+  error_code ignored;
+  auto& socket = beast::get_lowest_layer(stream);
+  socket.shutdown(asio::socket_base::shutdown_both, ignored);
+  socket.close(ignored);
 }
 
-template <class Socket>
-asio::awaitable<void> write_response(Socket& socket, const HttpResponse& r, unsigned version, bool keep_alive,
-                                     const std::string& server_name, error_code& ec) {
-  bhttp::response<bhttp::string_body> res{static_cast<bhttp::status>(r.status), version};
+// Cancels the stream's pending operations unless disarmed in time: the deadline of one write or
+// read. The flag keeps a timer that fired just as the operation finished from cancelling the next one.
+template <class Stream>
+class Deadline {
+ public:
+  Deadline(Stream& stream, std::chrono::steady_clock::duration after)
+      : timer_(stream.get_executor()), armed_(std::make_shared<bool>(true)) {
+    timer_.expires_after(after);
+    timer_.async_wait([&stream, armed = armed_](error_code ec) {
+      if (!ec && *armed) {
+        error_code ignored;
+        beast::get_lowest_layer(stream).cancel(ignored);
+      }
+    });
+  }
+  ~Deadline() {
+    *armed_ = false;
+    timer_.cancel();
+  }
+  Deadline(const Deadline&) = delete;
+  Deadline& operator=(const Deadline&) = delete;
+
+ private:
+  asio::steady_timer timer_;
+  std::shared_ptr<bool> armed_;
+};
+
+template <class Message>
+void set_common(Message& res, const HttpResponse& r, bool keep_alive, const std::string& server_name) {
   res.set(bhttp::field::server, server_name);
   res.set(bhttp::field::content_type, r.content_type);
   for (const auto& [k, v] : r.headers) res.set(k, v);
   res.keep_alive(keep_alive);
-  res.body() = r.body;
-  res.prepare_payload();
-  co_await bhttp::async_write(socket, res, asio::redirect_error(asio::use_awaitable, ec));
 }
 
-template <class Socket>
-asio::awaitable<void> session(Socket socket, Handler handler, ServerOptions options) {
+template <class Stream>
+asio::awaitable<void> write_response(Stream& stream, const HttpResponse& r, unsigned version, bool keep_alive,
+                                     bool head, const Shared& shared, error_code& ec) {
+  Deadline<Stream> deadline(stream, shared.options.idle_timeout);
+  if (head) {
+    bhttp::response<bhttp::empty_body> res{static_cast<bhttp::status>(r.status), version};
+    set_common(res, r, keep_alive, shared.options.server_name);
+    res.content_length(r.body.size());
+    bhttp::response_serializer<bhttp::empty_body> sr{res};
+    co_await bhttp::async_write_header(stream, sr, asio::redirect_error(asio::use_awaitable, ec));
+    co_return;
+  }
+  bhttp::response<bhttp::string_body> res{static_cast<bhttp::status>(r.status), version};
+  set_common(res, r, keep_alive, shared.options.server_name);
+  res.body() = r.body;
+  res.prepare_payload();
+  co_await bhttp::async_write(stream, res, asio::redirect_error(asio::use_awaitable, ec));
+}
+
+struct FileDescriptor {
+  int fd = -1;
+  ~FileDescriptor() {
+    if (fd >= 0) ::close(fd);
+  }
+};
+
+// A plain socket sends the file with sendfile(2) (no copy through user space, as nginx does); TLS
+// must encrypt, so it reads and writes in large chunks.
+template <class Stream>
+asio::awaitable<void> send_file_body(Stream& stream, int fd, std::uint64_t offset, std::uint64_t length,
+                                     const Shared& shared, error_code& ec) {
+  if constexpr (!kIsTls<Stream>) {
+    auto& socket = beast::get_lowest_layer(stream);
+    socket.native_non_blocking(true, ec);
+    if (ec) co_return;
+    off_t position = static_cast<off_t>(offset);
+    std::uint64_t remaining = length;
+    while (remaining > 0) {
+      ssize_t n = ::sendfile(socket.native_handle(), fd, &position,
+                             static_cast<std::size_t>(std::min<std::uint64_t>(remaining, 1u << 30)));
+      if (n > 0) {
+        remaining -= static_cast<std::uint64_t>(n);
+      } else if (n == 0) {
+        ec = asio::error::eof;  // the file is shorter than it was when the response was made
+        co_return;
+      } else if (errno == EAGAIN || errno == EWOULDBLOCK) {
+        Deadline<Stream> deadline(stream, shared.options.idle_timeout);
+        co_await socket.async_wait(asio::socket_base::wait_write, asio::redirect_error(asio::use_awaitable, ec));
+        if (ec) co_return;
+      } else if (errno != EINTR) {
+        ec = error_code(errno, boost::system::system_category());
+        co_return;
+      }
+    }
+  } else {
+    std::vector<char> buffer(256 * 1024);
+    std::uint64_t done = 0;
+    while (done < length) {
+      std::size_t want = static_cast<std::size_t>(std::min<std::uint64_t>(buffer.size(), length - done));
+      ssize_t n = ::pread(fd, buffer.data(), want, static_cast<off_t>(offset + done));
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) {
+        ec = n == 0 ? asio::error::eof : error_code(errno, boost::system::system_category());
+        co_return;
+      }
+      Deadline<Stream> deadline(stream, shared.options.idle_timeout);
+      co_await asio::async_write(stream, asio::buffer(buffer.data(), static_cast<std::size_t>(n)),
+                                 asio::redirect_error(asio::use_awaitable, ec));
+      if (ec) co_return;
+      done += static_cast<std::uint64_t>(n);
+    }
+  }
+}
+
+template <class Stream>
+asio::awaitable<void> write_file_response(Stream& stream, const HttpResponse& r, unsigned version, bool keep_alive,
+                                          bool head, const Shared& shared, error_code& ec) {
+  FileDescriptor file{::open(r.file->path.c_str(), O_RDONLY | O_CLOEXEC)};
+  if (file.fd < 0) {
+    // Checked by the handler a moment ago; gone now (retention, or someone's rm).
+    auto gone = HttpResponse::problem(404, "not-found", "Not found", "the file behind this response is gone");
+    co_await write_response(stream, gone, version, keep_alive, head, shared, ec);
+    co_return;
+  }
+  bhttp::response<bhttp::empty_body> res{static_cast<bhttp::status>(r.status), version};
+  set_common(res, r, keep_alive, shared.options.server_name);
+  res.content_length(r.file->length);
+  bhttp::response_serializer<bhttp::empty_body> sr{res};
+  {
+    Deadline<Stream> deadline(stream, shared.options.idle_timeout);
+    co_await bhttp::async_write_header(stream, sr, asio::redirect_error(asio::use_awaitable, ec));
+  }
+  if (ec || head) co_return;
+  co_await send_file_body(stream, file.fd, r.file->offset, r.file->length, shared, ec);
+}
+
+template <class Stream>
+class ChunkWriter final : public StreamWriter {
+ public:
+  ChunkWriter(Stream& stream, std::chrono::milliseconds timeout) : stream_(stream), timeout_(timeout) {}
+
+  asio::awaitable<bool> send(std::string_view chunk) override {
+    if (!ok_) co_return false;
+    if (chunk.empty()) co_return true;
+    Deadline<Stream> deadline(stream_, timeout_);
+    error_code ec;
+    co_await asio::async_write(stream_, bhttp::make_chunk(asio::buffer(chunk.data(), chunk.size())),
+                               asio::redirect_error(asio::use_awaitable, ec));
+    if (ec) ok_ = false;
+    co_return ok_;
+  }
+  bool ok() const { return ok_; }
+
+ private:
+  Stream& stream_;
+  std::chrono::milliseconds timeout_;
+  bool ok_ = true;
+};
+
+template <class Stream>
+asio::awaitable<void> write_stream_response(Stream& stream, const HttpResponse& r, unsigned version,
+                                            const Shared& shared, error_code& ec) {
+  bhttp::response<bhttp::empty_body> res{static_cast<bhttp::status>(r.status), version};
+  set_common(res, r, false, shared.options.server_name);
+  res.chunked(true);
+  bhttp::response_serializer<bhttp::empty_body> sr{res};
+  {
+    Deadline<Stream> deadline(stream, shared.options.idle_timeout);
+    co_await bhttp::async_write_header(stream, sr, asio::redirect_error(asio::use_awaitable, ec));
+  }
+  if (ec) co_return;
+  ChunkWriter<Stream> writer(stream, shared.options.stream_write_timeout);
+  try {
+    co_await r.stream(writer);
+  } catch (const std::exception& e) {
+    log::warning("http", std::string("a streaming response ended early: ") + e.what());
+  }
+  if (writer.ok()) {
+    Deadline<Stream> deadline(stream, shared.options.idle_timeout);
+    co_await asio::async_write(stream, bhttp::make_chunk_last(), asio::redirect_error(asio::use_awaitable, ec));
+  }
+  ec = asio::error::eof;  // a stream ends its connection
+}
+
+asio::awaitable<HttpResponse> safe_handle(const Shared& shared, HttpRequest& req) {
+  if (!req.parse_target()) {
+    co_return HttpResponse::problem(400, "bad-target", "Malformed request target", "cannot parse '" + req.target + "'");
+  }
+  try {
+    co_return co_await shared.handler(req);
+  } catch (const Error& e) {
+    log::error("http", std::string("handler failed: ") + e.what());
+    co_return HttpResponse::problem(500, "internal", "Internal error", e.what(), e.hint());
+  } catch (const std::exception& e) {
+    log::error("http", std::string("handler failed: ") + e.what());
+    co_return HttpResponse::problem(500, "internal", "Internal error", e.what());
+  }
+}
+
+HttpResponse read_failure(const error_code& ec) {
+  if (ec == bhttp::error::body_limit) {
+    return HttpResponse::problem(413, "body-too-large", "Request body too large",
+                                 "bodies are limited to " + std::to_string(protocol::kMaxRequestBody) + " bytes");
+  }
+  if (ec == bhttp::error::header_limit) {
+    return HttpResponse::problem(431, "header-too-large", "Request header fields too large",
+                                 "headers are limited to 16 KiB");
+  }
+  return HttpResponse::problem(400, "bad-http", "Malformed HTTP request", ec.message());
+}
+
+template <class Stream>
+asio::awaitable<void> session(Stream stream, Peer peer, std::shared_ptr<Shared> shared) {
+  OpenConnection counted(*shared);
   beast::flat_buffer buffer;
-  asio::steady_timer idle(socket.get_executor());
   for (;;) {
     bhttp::request_parser<bhttp::string_body> parser;
     parser.header_limit(16 * 1024);
     parser.body_limit(protocol::kMaxRequestBody);
 
-    idle.expires_after(options.idle_timeout);
-    idle.async_wait([&socket](error_code ec) {
-      if (!ec) {
-        error_code ignored;
-        socket.cancel(ignored);
-      }
-    });
     error_code ec;
-    co_await bhttp::async_read(socket, buffer, parser, asio::redirect_error(asio::use_awaitable, ec));
-    idle.cancel();
-
+    {
+      Deadline<Stream> idle(stream, shared->options.idle_timeout);
+      co_await bhttp::async_read(stream, buffer, parser, asio::redirect_error(asio::use_awaitable, ec));
+    }
     if (ec == bhttp::error::end_of_stream || ec == asio::error::eof || ec == asio::error::operation_aborted ||
-        ec == asio::error::connection_reset) {
+        ec == asio::error::connection_reset || ec == ssl::error::stream_truncated) {
       break;
     }
     if (ec) {
-      HttpResponse r = ec == bhttp::error::body_limit
-                           ? HttpResponse::problem(413, "body-too-large", "Request body too large",
-                                                   "bodies are limited to " +
-                                                       std::to_string(protocol::kMaxRequestBody) + " bytes")
-                       : ec == bhttp::error::header_limit
-                           ? HttpResponse::problem(431, "header-too-large", "Request header fields too large",
-                                                   "headers are limited to 16 KiB")
-                           : HttpResponse::problem(400, "bad-http", "Malformed HTTP request", ec.message());
       error_code wec;
-      co_await write_response(socket, r, 11, false, options.server_name, wec);
+      co_await write_response(stream, read_failure(ec), 11, false, false, *shared, wec);
       break;
     }
 
     auto& msg = parser.get();
     HttpRequest req;
+    req.peer = peer;
     req.method = std::string(msg.method_string());
     req.target = std::string(msg.target());
     for (const auto& field : msg) {
@@ -103,21 +313,74 @@ asio::awaitable<void> session(Socket socket, Handler handler, ServerOptions opti
     req.body = std::move(msg.body());
     bool keep_alive = msg.keep_alive();
     unsigned version = msg.version();
+    bool head = req.method == "HEAD";
 
-    HttpResponse r = safe_handle(handler, req);
-    co_await write_response(socket, r, version, keep_alive, options.server_name, ec);
+    HttpResponse r = co_await safe_handle(*shared, req);
+    if (r.stream && !head) {
+      co_await write_stream_response(stream, r, version, *shared, ec);
+    } else if (r.file) {
+      co_await write_file_response(stream, r, version, keep_alive, head, *shared, ec);
+    } else {
+      co_await write_response(stream, r, version, keep_alive, head, *shared, ec);
+    }
     if (ec || !keep_alive) break;
   }
-  error_code ignored;
-  socket.shutdown(asio::socket_base::shutdown_both, ignored);
-  socket.close(ignored);
+  close_stream(stream);
+}
+
+Peer peer_of(const tcp::socket& socket, bool tls) {
+  Peer p;
+  p.tls = tls;
+  error_code ec;
+  auto ep = socket.remote_endpoint(ec);
+  if (ec) {
+    p.transport = Peer::Transport::remote;  // unknown: the strictest
+    return p;
+  }
+  auto address = ep.address();
+  if (address.is_v6() && address.to_v6().is_v4_mapped()) {
+    address = asio::ip::make_address_v4(asio::ip::v4_mapped, address.to_v6());
+  }
+  p.transport = address.is_loopback() ? Peer::Transport::loopback : Peer::Transport::remote;
+  p.address = address.to_string() + ":" + std::to_string(ep.port());
+  return p;
+}
+
+template <class Socket>
+asio::awaitable<void> refuse(Socket socket, std::shared_ptr<Shared> shared) {
+  auto r = HttpResponse::problem(503, "too-many-connections", "Too many connections",
+                                 "colorlabd serves at most " + std::to_string(shared->options.max_connections) +
+                                     " connections at once",
+                                 "close idle connections or retry shortly");
+  r.headers["Retry-After"] = "1";
+  error_code ec;
+  co_await write_response(socket, r, 11, false, false, *shared, ec);
+  close_stream(socket);
+}
+
+asio::awaitable<void> tls_session(tcp::socket socket, std::shared_ptr<Shared> shared) {
+  Peer peer = peer_of(socket, true);
+  TlsStream stream(std::move(socket), *shared->tls);
+  error_code ec;
+  {
+    Deadline<TlsStream> deadline(stream, shared->options.idle_timeout);
+    co_await stream.async_handshake(ssl::stream_base::server, asio::redirect_error(asio::use_awaitable, ec));
+  }
+  if (ec) {
+    log::info("http", "TLS handshake with " + peer.address + " failed: " + ec.message());
+    close_stream(stream);
+    co_return;
+  }
+  co_await session(std::move(stream), std::move(peer), std::move(shared));
 }
 
 template <class Acceptor>
-asio::awaitable<void> accept_loop(Acceptor& acceptor, const Handler& handler, ServerOptions options) {
+asio::awaitable<void> accept_loop(Acceptor& acceptor, asio::io_context& pool, std::shared_ptr<Shared> shared) {
   for (;;) {
     error_code ec;
-    auto socket = co_await acceptor.async_accept(asio::redirect_error(asio::use_awaitable, ec));
+    // Each connection on its own strand: its timers and its I/O never run at once on two threads.
+    typename Acceptor::protocol_type::socket socket(asio::make_strand(pool));
+    co_await acceptor.async_accept(socket, asio::redirect_error(asio::use_awaitable, ec));
     if (ec == asio::error::operation_aborted) co_return;
     if (ec) {
       // EMFILE and friends: keep serving the connections we have, try again shortly.
@@ -126,33 +389,96 @@ asio::awaitable<void> accept_loop(Acceptor& acceptor, const Handler& handler, Se
       co_await t.async_wait(asio::use_awaitable);
       continue;
     }
-    asio::co_spawn(acceptor.get_executor(), session(std::move(socket), handler, options), asio::detached);
+    auto executor = socket.get_executor();
+    if (shared->open.load() >= shared->options.max_connections) {
+      ++shared->refused;
+      asio::co_spawn(executor, refuse(std::move(socket), shared), asio::detached);
+      continue;
+    }
+    ++shared->accepted;
+    if constexpr (std::is_same_v<Acceptor, local::acceptor>) {
+      Peer peer;
+      peer.transport = Peer::Transport::unix_socket;
+      peer.address = shared->options.unix_socket.string();
+      asio::co_spawn(executor, session(std::move(socket), std::move(peer), shared), asio::detached);
+    } else if (shared->tls) {
+      asio::co_spawn(executor, tls_session(std::move(socket), shared), asio::detached);
+    } else {
+      Peer peer = peer_of(socket, false);
+      asio::co_spawn(executor, session(std::move(socket), std::move(peer), shared), asio::detached);
+    }
   }
+}
+
+std::shared_ptr<ssl::context> make_tls_context(const ServerOptions& o) {
+  if (o.tls_certificate.empty() && o.tls_private_key.empty()) return nullptr;
+  if (o.tls_certificate.empty() || o.tls_private_key.empty()) {
+    throw Error(ErrorClass::bad_parameter, "TLS needs both a certificate and a private key",
+                "set both tls_certificate and tls_private_key in [api]");
+  }
+  auto ctx = std::make_shared<ssl::context>(ssl::context::tls_server);
+  ctx->set_options(ssl::context::default_workarounds | ssl::context::no_sslv2 | ssl::context::no_sslv3 |
+                   ssl::context::no_tlsv1 | ssl::context::no_tlsv1_1 | ssl::context::single_dh_use);
+  error_code ec;
+  ctx->use_certificate_chain_file(o.tls_certificate.string(), ec);
+  if (ec) {
+    throw Error(ErrorClass::bad_parameter,
+                "cannot use TLS certificate " + o.tls_certificate.string() + ": " + ec.message(),
+                "a PEM certificate (chain) file readable by colorlabd");
+  }
+  ctx->use_private_key_file(o.tls_private_key.string(), ssl::context::pem, ec);
+  if (ec) {
+    throw Error(ErrorClass::bad_parameter,
+                "cannot use TLS private key " + o.tls_private_key.string() + ": " + ec.message(),
+                "a PEM private key file matching the certificate, readable by colorlabd");
+  }
+  return ctx;
 }
 
 }  // namespace
 
 struct Server::Impl {
+  explicit Impl(asio::io_context& context) : io(context) {}
   asio::io_context& io;
-  ServerOptions options;
-  Handler handler;
+  std::shared_ptr<Shared> shared;
   std::unique_ptr<tcp::acceptor> tcp_acceptor;
   std::unique_ptr<local::acceptor> unix_acceptor;
+  std::vector<std::thread> threads;
+  // Declared last: destroyed first, while what its pending sessions refer to is still alive.
+  std::unique_ptr<asio::io_context> pool;
+  std::optional<asio::executor_work_guard<asio::io_context::executor_type>> pool_work;
+
+  asio::io_context& serving_context() { return pool ? *pool : io; }
 };
 
 Server::Server(asio::io_context& io, ServerOptions options, Handler handler)
-    : impl_(std::make_unique<Impl>(Impl{io, std::move(options), std::move(handler), nullptr, nullptr})) {}
+    : Server(io, std::move(options),
+             AsyncHandler([handler = std::move(handler)](HttpRequest& req) -> asio::awaitable<HttpResponse> {
+               co_return handler(req);
+             })) {}
+
+Server::Server(asio::io_context& io, ServerOptions options, AsyncHandler handler)
+    : impl_(std::make_shared<Impl>(io)) {
+  impl_->shared = std::make_shared<Shared>();
+  impl_->shared->handler = std::move(handler);
+  impl_->shared->options = std::move(options);
+  if (impl_->shared->options.threads > 0) {
+    impl_->pool = std::make_unique<asio::io_context>(static_cast<int>(impl_->shared->options.threads));
+  }
+}
 
 Server::~Server() { stop(); }
 
 void Server::start() {
-  auto& o = impl_->options;
+  auto& o = impl_->shared->options;
+  impl_->shared->tls = make_tls_context(o);
+  auto& ctx = impl_->serving_context();
   if (!o.tcp_host.empty()) {
     error_code ec;
     auto address = asio::ip::make_address(o.tcp_host, ec);
     if (ec) throw Error(ErrorClass::bad_parameter, "listen address '" + o.tcp_host + "' is not an IP address");
     tcp::endpoint ep(address, o.tcp_port);
-    auto acc = std::make_unique<tcp::acceptor>(impl_->io);
+    auto acc = std::make_unique<tcp::acceptor>(ctx);
     acc->open(ep.protocol(), ec);
     if (!ec) acc->set_option(asio::socket_base::reuse_address(true), ec);
     if (!ec) acc->bind(ep, ec);
@@ -163,30 +489,49 @@ void Server::start() {
                   "another colorlabd may be running; pick another port with --listen");
     }
     impl_->tcp_acceptor = std::move(acc);
-    asio::co_spawn(impl_->io, accept_loop(*impl_->tcp_acceptor, impl_->handler, o), asio::detached);
+    asio::co_spawn(ctx, accept_loop(*impl_->tcp_acceptor, ctx, impl_->shared), asio::detached);
   }
   if (!o.unix_socket.empty()) {
     std::error_code fec;
     std::filesystem::remove(o.unix_socket, fec);  // a stale socket from a killed daemon
-    auto acc = std::make_unique<local::acceptor>(impl_->io);
+    auto acc = std::make_unique<local::acceptor>(ctx);
     error_code ec;
     local::endpoint ep(o.unix_socket.string());
     acc->open(ep.protocol(), ec);
     if (!ec) acc->bind(ep, ec);
+    if (!ec && ::chmod(o.unix_socket.c_str(), 0660) != 0) ec = error_code(errno, boost::system::system_category());
     if (!ec) acc->listen(asio::socket_base::max_listen_connections, ec);
     if (ec) throw Error(ErrorClass::io_error, "cannot listen on " + o.unix_socket.string() + ": " + ec.message());
     impl_->unix_acceptor = std::move(acc);
-    asio::co_spawn(impl_->io, accept_loop(*impl_->unix_acceptor, impl_->handler, o), asio::detached);
+    asio::co_spawn(ctx, accept_loop(*impl_->unix_acceptor, ctx, impl_->shared), asio::detached);
+  }
+  if (impl_->pool && impl_->threads.empty()) {
+    impl_->pool_work.emplace(impl_->pool->get_executor());
+    for (unsigned i = 0; i < o.threads; ++i) {
+      impl_->threads.emplace_back([pool = impl_->pool.get()] { pool->run(); });
+    }
   }
 }
 
 void Server::stop() {
+  auto& impl = *impl_;
+  if (impl.pool && !impl.threads.empty()) {
+    // Ends open connections too; with the threads joined, the acceptors are ours to close.
+    impl.pool_work.reset();
+    impl.pool->stop();
+    for (auto& t : impl.threads) t.join();
+    impl.threads.clear();
+  }
   error_code ignored;
-  if (impl_->tcp_acceptor) impl_->tcp_acceptor->close(ignored);
-  if (impl_->unix_acceptor) {
-    impl_->unix_acceptor->close(ignored);
+  if (impl.tcp_acceptor) impl.tcp_acceptor->close(ignored);
+  if (impl.unix_acceptor) {
+    impl.unix_acceptor->close(ignored);
     std::error_code fec;
-    std::filesystem::remove(impl_->options.unix_socket, fec);
+    std::filesystem::remove(impl.shared->options.unix_socket, fec);
+  }
+  if (impl.pool) {
+    impl.tcp_acceptor.reset();
+    impl.unix_acceptor.reset();
   }
 }
 
@@ -195,6 +540,10 @@ unsigned short Server::bound_port() const {
   error_code ec;
   auto ep = impl_->tcp_acceptor->local_endpoint(ec);
   return ec ? 0 : ep.port();
+}
+
+ServerStats Server::stats() const {
+  return {impl_->shared->open.load(), impl_->shared->accepted.load(), impl_->shared->refused.load()};
 }
 
 }  // namespace colorlab::http

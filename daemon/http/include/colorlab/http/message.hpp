@@ -1,15 +1,28 @@
 #pragma once
 // Plain request/response values, so routing and handlers compile without Beast.
+#include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 
+#include <boost/asio/awaitable.hpp>
 #include <nlohmann/json_fwd.hpp>
 
 namespace colorlab::http {
 
+// Who is asking, as far as the connection tells: what access control decides on.
+struct Peer {
+  enum class Transport { unix_socket, loopback, remote };
+  Transport transport = Transport::loopback;
+  bool tls = false;
+  std::string address;  // "127.0.0.1:53412", or the socket path
+};
+
 struct HttpRequest {
+  Peer peer;
   std::string method;   // "GET"
   std::string target;   // "/v1/runs?limit=5"
   std::string path;     // "/v1/runs"
@@ -22,11 +35,30 @@ struct HttpRequest {
   bool parse_target();
 };
 
+// A byte range of a file sent as the body (blobs): the server streams it without reading it whole.
+struct FileSpan {
+  std::filesystem::path path;
+  std::uint64_t offset = 0;
+  std::uint64_t length = 0;
+};
+
+// What a streaming response (Server-Sent Events) writes to: each send is one chunk on the wire.
+class StreamWriter {
+ public:
+  virtual ~StreamWriter() = default;
+  // Returns false when the client is gone or did not take the chunk within the server's write
+  // deadline: the producer should stop.
+  virtual boost::asio::awaitable<bool> send(std::string_view chunk) = 0;
+};
+using StreamProducer = std::function<boost::asio::awaitable<void>(StreamWriter&)>;
+
 struct HttpResponse {
   int status = 200;
   std::string content_type = "application/json";
   std::string body;
   std::map<std::string, std::string> headers;
+  std::optional<FileSpan> file;  // when set, the body is this range of the file
+  StreamProducer stream;         // when set, a chunked body produced until it returns
 
   static HttpResponse json(int status, const nlohmann::json& body);
   static HttpResponse problem(int status, const std::string& code, const std::string& title, const std::string& detail,
