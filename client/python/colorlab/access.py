@@ -1,0 +1,32 @@
+"""Access control: the one control lock (who drives the instruments) and API keys (admin scope)."""
+from __future__ import annotations
+
+from typing import Any
+
+import pandas as pd
+
+from . import tables
+
+
+class AccessMixin:
+    def control(self) -> dict:
+        """Who holds the control lock, if anyone."""
+        return self.conn.get("/v1/control")
+
+    def acquire_control(self, holder: str) -> dict:
+        """Take the control lock for ``holder`` (a name others see); ``Conflict`` while someone else holds it."""
+        return self.conn.post("/v1/control/acquire", {"holder": holder})
+
+    def release_control(self) -> dict:
+        return self.conn.post("/v1/control/release")
+
+    def keys(self) -> pd.DataFrame:
+        """API keys (never their secrets): needs an ``admin`` key."""
+        return tables.items_frame(self.conn.get("/v1/keys").get("items", []), ("created_at", "revoked_at"))
+
+    def create_key(self, **body: Any) -> dict:
+        """A new key, e.g. ``create_key(name="jupyter", scope="read")``; the answer holds the secret once."""
+        return self.conn.post("/v1/keys", body)
+
+    def revoke_key(self, key) -> Any:
+        return self.conn.delete(f"/v1/keys/{key if isinstance(key, str) else key['id']}")

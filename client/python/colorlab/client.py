@@ -1,0 +1,49 @@
+"""``Client``: one daemon, everything it serves."""
+from __future__ import annotations
+
+import os
+from typing import Iterator
+
+from . import events as _events
+from .access import AccessMixin
+from .blobs import BlobsMixin
+from .connection import Connection, read_endpoint
+from .executions import ExecutionsMixin
+from .exports import ExportsMixin
+from .lab import LabMixin
+from .runs import RunsMixin
+
+
+class Client(RunsMixin, BlobsMixin, ExportsMixin, ExecutionsMixin, LabMixin, AccessMixin):
+    """``Client(url=None, key=None, cacert=None)``: url from ``COLORLAB_URL`` (else http://127.0.0.1:8765), key
+    from ``COLORLAB_API_KEY`` (sent as ``Authorization: Bearer``), ``cacert`` for an https daemon whose
+    certificate your system does not trust. ``Client.local()`` finds a daemon on this machine."""
+
+    def __init__(self, url: str | None = None, key: str | None = None, cacert: str | os.PathLike | None = None,
+                 *, timeout: float = 30.0):
+        self.conn = Connection(url, key, cacert, timeout=timeout)
+
+    @classmethod
+    def local(cls, state_dir: str | os.PathLike | None = None, *, key: str | None = None,
+              cacert: str | os.PathLike | None = None, timeout: float = 30.0) -> "Client":
+        """The daemon whose ``<state_dir>/colorlabd.endpoint`` says where it listens. Without ``state_dir``:
+        ``./colorlab-state`` (colorlabd's default), then ``/var/lib/colorlabd`` (the systemd service's)."""
+        return cls(read_endpoint(state_dir)["url"], key, cacert, timeout=timeout)
+
+    @property
+    def url(self) -> str:
+        return self.conn.url
+
+    def __repr__(self) -> str:
+        return repr(self.conn).replace("Connection", "Client", 1)
+
+    def events(self, topic: str | None = None, *, after: int | None = None, reconnect: bool = True,
+               give_up_after: float | None = 60.0) -> Iterator[_events.Event]:
+        """The live event stream: a snapshot (unless ``after``), then every event, reconnecting by itself with
+        ``Last-Event-ID`` so none is lost or repeated. ``topic``: only that topic's events."""
+        return _events.stream(self.conn, topic=topic, after=after, reconnect=reconnect,
+                              give_up_after=give_up_after)
+
+    def event_log(self, after: int = 0, topic: str | None = None, limit: int = 300) -> list[dict]:
+        """One page of the stored event log (``GET /v1/events``), oldest first."""
+        return self.conn.get("/v1/events", {"after": after, "topic": topic, "limit": limit}).get("items", [])
