@@ -1,8 +1,6 @@
 """Access control: the one control lock (who drives the instruments) and API keys (admin scope)."""
 from __future__ import annotations
 
-from typing import Any
-
 import pandas as pd
 
 from . import tables
@@ -24,9 +22,9 @@ class AccessMixin:
         """API keys (never their secrets): needs an ``admin`` key."""
         return tables.items_frame(self.conn.get("/v1/keys").get("items", []), ("created_at", "revoked_at"))
 
-    def create_key(self, **body: Any) -> dict:
-        """A new key, e.g. ``create_key(name="jupyter", scope="read")``; the answer holds the secret once."""
-        return self.conn.post("/v1/keys", body)
+    def create_key(self, name: str, scope: str = "read") -> dict:
+        """A new key (``scope``: read, control or admin); its ``secret`` is in this answer and nowhere else."""
+        return self.conn.post("/v1/keys", {"name": name, "scope": scope})
 
-    def revoke_key(self, key) -> Any:
+    def revoke_key(self, key) -> dict | None:
         return self.conn.delete(f"/v1/keys/{key if isinstance(key, str) else key['id']}")

@@ -30,6 +30,16 @@ class Client(RunsMixin, BlobsMixin, ExportsMixin, ExecutionsMixin, LabMixin, Acc
         ``./colorlab-state`` (colorlabd's default), then ``/var/lib/colorlabd`` (the systemd service's)."""
         return cls(read_endpoint(state_dir)["url"], key, cacert, timeout=timeout)
 
+    def close(self) -> None:
+        """Closes the pooled connections (also at the end of ``with Client(...) as lab:``)."""
+        self.conn.session.close()
+
+    def __enter__(self) -> "Client":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
     @property
     def url(self) -> str:
         return self.conn.url
