@@ -7,7 +7,7 @@ from dataclasses import dataclass
 from typing import Any, Iterator
 
 from . import events as _events
-from .errors import ConnectionFailed, ExecutionFailed
+from .errors import ColorlabError, ConnectionFailed, ExecutionFailed
 
 TERMINAL = frozenset({"finished_ok", "finished_error", "aborted", "interrupted"})  # protocol/states.hpp
 
@@ -132,7 +132,9 @@ class ExecutionsMixin:
         stream = _events.stream(self.conn, give_up_after=give_up_after)
         try:
             # The stream is open before the execution is read: whatever happens after that read is an event.
-            first = next(stream)
+            first = next(stream, None)
+            if first is None:
+                raise ColorlabError(f"the event stream of {self.conn.url} ended before it began")
             state = self.execution(eid)
             current = Progress(eid, "state", state.status, state.get("progress"), state.get("step"),
                                reason=state.get("reason"))
