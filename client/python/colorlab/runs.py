@@ -7,6 +7,8 @@ import pandas as pd
 
 from . import tables
 
+MEASUREMENT_PAGE = 1000  # protocol::kDefaultMeasurementPageLimit (at most kMaxMeasurementPageLimit, 5000)
+
 
 def run_id(run) -> str:
     """A run's id from the id itself, a ``Run`` or any dict with ``id`` (an execution gives its ``run_id``)."""
@@ -55,7 +57,7 @@ class RunsMixin:
         return Run(self, self.conn.get(f"/v1/runs/{run_id(run)}"))
 
     def measurement_items(self, run, *, step_prefix: str | None = None, quantity: str | None = None,
-                          instrument: str | None = None, page_size: int = 300) -> Iterator[dict]:
+                          instrument: str | None = None, page_size: int = MEASUREMENT_PAGE) -> Iterator[dict]:
         """A run's measurements as the daemon sends them, in order, a page at a time."""
         params = {"step_prefix": step_prefix, "quantity": quantity, "instrument": instrument}
         return self.conn.paged(f"/v1/runs/{run_id(run)}/measurements", params, page_size=page_size)

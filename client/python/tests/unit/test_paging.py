@@ -41,19 +41,19 @@ class PagedMeasurements:
 
 class PagingTest(unittest.TestCase):
     def test_all_pages_in_order_with_the_filters_on_every_page(self):
-        items = [measurement(i) for i in range(1, 701)]
+        items = [measurement(i) for i in range(1, 2501)]
         with FakeDaemon() as fake:
             PagedMeasurements(fake, items)
             lab = self.enterContext(colorlab.Client(fake.url))
             df = lab.measurements(RUN, step_prefix="reading/", quantity="luminance")
-            self.assertEqual(df["seq"].tolist(), list(range(1, 701)))
+            self.assertEqual(df["seq"].tolist(), list(range(1, 2501)))
             calls = fake.requests_to("GET", f"/v1/runs/{RUN}/measurements")
-            self.assertEqual(len(calls), 3)  # 300 + 300 + 100
+            self.assertEqual(len(calls), 3)  # 1000 + 1000 + 500: the daemon's default page
             for _, _, query, _, _ in calls:
                 self.assertEqual((query["step_prefix"], query["quantity"], query["limit"]),
-                                 ("reading/", "luminance", "300"))
+                                 ("reading/", "luminance", "1000"))
             self.assertNotIn("cursor", calls[0][2])
-            self.assertEqual([q["cursor"] for _, _, q, _, _ in calls[1:]], ["300", "600"])
+            self.assertEqual([q["cursor"] for _, _, q, _, _ in calls[1:]], ["1000", "2000"])
             self.assertNotIn("instrument", calls[0][2])  # None filters are not sent
 
     def test_an_empty_run_is_an_empty_frame_with_the_columns(self):
