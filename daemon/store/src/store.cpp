@@ -5,6 +5,7 @@
 #include "colorlab/core/error.hpp"
 #include "colorlab/core/ids.hpp"
 #include "colorlab/core/log.hpp"
+#include "colorlab/store/blob_index.hpp"
 #include "colorlab/store/schema.hpp"
 
 namespace colorlab::store {
@@ -312,6 +313,7 @@ void Store::commit_step(const ExecutionRecord& execution, const StepRecord& step
       up.reset();
     }
   }
+  insert_step_blobs(db_, execution.run_id, step.step, step.blobs, now);
   if (step.instruments) {
     db_.prepare("UPDATE runs SET instruments = ?2 WHERE id = ?1")
         .bind(1, std::string_view(execution.run_id))

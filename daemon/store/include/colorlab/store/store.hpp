@@ -14,6 +14,7 @@
 
 #include "colorlab/protocol/states.hpp"
 #include "colorlab/store/sqlite.hpp"
+#include "colorlab/store/step_blob.hpp"
 
 namespace colorlab::store {
 
@@ -89,6 +90,8 @@ struct StepRecord {
   // How long the step's live calls took, learned in the same transaction (see CallTimingRow).
   std::vector<CallTimingRow> timings;
   double time_scale = 1;
+  // Frames the step kept: their files are already durable; their rows are the step's (blob_index.hpp).
+  std::vector<StepBlob> blobs;
 };
 
 struct MeasurementRecord {
@@ -197,6 +200,7 @@ class Store {
  private:
   // The queue's rows live in their own file and share this connection (one writer, one thread).
   friend class QueueStore;
+  friend class BlobIndex;  // blob_index.hpp: the blob store's rows
   RunRecord read_run(Statement& st);
   ExecutionRecord read_execution(Statement& st);
 
