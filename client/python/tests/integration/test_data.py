@@ -24,9 +24,10 @@ class FrameTest(unittest.TestCase):
         cls.daemon.cleanup()
 
     def stored_file(self, sha):
-        """The blob's file in the daemon's state directory, found by its name alone."""
-        found = [p for p in self.daemon.state.rglob(sha + "*") if p.is_file()]
-        return found[0] if found else None
+        """The blob's file in the daemon's content-addressed store (<state>/blobs/ab/cdef…), read without HTTP."""
+        path = self.daemon.state / "blobs" / sha[:2] / sha[2:]
+        self.assertTrue(path.is_file(), f"{path} missing")
+        return path
 
     def test_kept_frames_are_arrays_with_their_headers_and_bytes(self):
         blobs = skip_unless_served(self, lambda: self.lab.blobs(self.run_id), "GET /v1/runs/{id}/blobs")
@@ -49,9 +50,7 @@ class FrameTest(unittest.TestCase):
             self.assertTrue(np.isfinite(frame).all())
             self.assertGreaterEqual(float(frame.min()), 0.0)  # counts, dark-subtracted or not, are not negative
             self.assertGreater(float(frame.mean()), 0.0)
-            stored = self.stored_file(blob["sha256"])
-            if stored is not None:
-                self.assertEqual(frame.tobytes(), stored.read_bytes())
+            self.assertEqual(frame.tobytes(), self.stored_file(blob["sha256"]).read_bytes())
             # A band of rows through Range is the same band of the whole frame.
             h = info.shape[0]
             band = self.lab.read_array(blob, rows=(h // 3, h // 3 + 7))
@@ -74,9 +73,7 @@ class FrameTest(unittest.TestCase):
                 self.assertEqual(data[:2], b"\xff\xd8")
             if blob["media_type"] == "image/png":
                 self.assertEqual(data[:8], b"\x89PNG\r\n\x1a\n")
-            stored = self.stored_file(blob["sha256"])
-            if stored is not None:
-                self.assertEqual(data, stored.read_bytes())
+            self.assertEqual(data, self.stored_file(blob["sha256"]).read_bytes())
 
     def test_an_unknown_blob_is_not_found(self):
         skip_unless_served(self, lambda: self.lab.blobs(self.run_id), "GET /v1/runs/{id}/blobs")
