@@ -1,8 +1,5 @@
 #include "colorlab/analysis/cgats.hpp"
 
-#include <fstream>
-#include <sstream>
-
 #include "colorlab/analysis/csv.hpp"
 #include "parse_util.hpp"
 
@@ -152,41 +149,5 @@ std::vector<CgatsTable> read_cgats_all(const std::filesystem::path& path) {
 }
 
 CgatsTable read_cgats(const std::filesystem::path& path) { return std::move(read_cgats_all(path).front()); }
-
-std::string format_cgats(const CgatsTable& t) {
-  std::ostringstream os;
-  os << (t.file_type.empty() ? "CGATS.17" : t.file_type) << "\n\n";
-  for (const auto& [k, v] : t.keywords) {
-    if (k == "NUMBER_OF_FIELDS" || k == "NUMBER_OF_SETS") continue;
-    bool numeric = detail::to_double(v).has_value();
-    bool standard = k == "SPECTRAL_BANDS" || k == "SPECTRAL_START_NM" || k == "SPECTRAL_END_NM" ||
-                    k == "SPECTRAL_NORM" || k == "DESCRIPTOR" || k == "ORIGINATOR" || k == "CREATED" ||
-                    k == "DEVICE_CLASS" || k == "COLOR_REP" || k == "INSTRUMENTATION" || k == "TARGET_INSTRUMENT";
-    if (!standard) os << "KEYWORD \"" << k << "\"\n";
-    if (numeric && k.rfind("SPECTRAL_", 0) == 0)
-      os << k << " \"" << v << "\"\n";
-    else
-      os << k << " \"" << v << "\"\n";
-  }
-  os << "NUMBER_OF_FIELDS " << t.fields.size() << "\nBEGIN_DATA_FORMAT\n";
-  for (const auto& f : t.fields) os << f << ' ';
-  os << "\nEND_DATA_FORMAT\n\nNUMBER_OF_SETS " << t.rows.size() << "\nBEGIN_DATA\n";
-  for (const auto& r : t.rows) {
-    for (std::size_t i = 0; i < r.size(); ++i) {
-      bool quote = !detail::to_double(r[i]).has_value();
-      os << (i ? " " : "") << (quote ? "\"" : "") << r[i] << (quote ? "\"" : "");
-    }
-    os << '\n';
-  }
-  os << "END_DATA\n";
-  return os.str();
-}
-
-void write_cgats(const CgatsTable& table, const std::filesystem::path& path) {
-  std::ofstream f(path);
-  if (!f) throw Error(ErrorClass::io_error, "cannot write CGATS file " + path.string());
-  f << format_cgats(table);
-  if (!f) throw Error(ErrorClass::io_error, "write failed for " + path.string());
-}
 
 }  // namespace colorlab::analysis

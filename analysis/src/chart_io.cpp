@@ -1,5 +1,7 @@
 #include "colorlab/analysis/chart_io.hpp"
 
+#include <array>
+#include <charconv>
 #include <cmath>
 #include <sstream>
 
@@ -31,6 +33,15 @@ std::string fmt(double v) {
   os.precision(10);
   os << v;
   return os.str();
+}
+
+// Argyll types a non-standard field (SPEC_*) by its values: a real needs its decimal point ("7" is an
+// integer and spec2cie refuses it). Six decimals are far below any instrument's resolution on 0–100.
+std::string real(double v) {
+  std::array<char, 400> buf{};
+  auto [end, ec] = std::to_chars(buf.data(), buf.data() + buf.size(), v, std::chars_format::fixed, 6);
+  if (ec != std::errc()) detail::fail("CGATS: value " + fmt(v) + " cannot be written");
+  return std::string(buf.data(), end);
 }
 
 void complete(ChartData& d, bool have_xyz, bool have_lab, const std::string& src) {
@@ -104,32 +115,48 @@ ChartData read_chart(const std::filesystem::path& path, const Xyz& white) {
   return d;
 }
 
-void write_argyll_ti3(const std::filesystem::path& path, const ChartData& chart, const SpectralSet* spectra) {
+CgatsTable argyll_ti3_table(const ChartData& chart, const SpectralSet* spectra, const Ti3Options& o) {
   chart.check();
   if (spectra && spectra->size() != chart.size())
     detail::fail("ti3: " + std::to_string(spectra->size()) + " spectra for " + std::to_string(chart.size()) + " patches");
+  if (o.device_class != "INPUT" && o.device_class != "OUTPUT")
+    throw Error(ErrorClass::bad_parameter, "ti3: device class must be INPUT or OUTPUT, not " + o.device_class);
   CgatsTable t;
   t.file_type = "CTI3";
-  t.keywords = {{"DESCRIPTOR", "colorlab chart data"}, {"ORIGINATOR", "colorlab"}, {"DEVICE_CLASS", "INPUT"},
-                {"COLOR_REP", "XYZ_RGB"}};
+  // Argyll names the colour spaces in the direction its profile maps: PCS from device for an input.
+  t.keywords = {{"DESCRIPTOR", o.descriptor}, {"ORIGINATOR", "colorlab"}, {"DEVICE_CLASS", o.device_class},
+                {"COLOR_REP", o.device_class == "INPUT" ? "XYZ_RGB" : "RGB_XYZ"}};
   t.fields = {"SAMPLE_ID", "RGB_R", "RGB_G", "RGB_B", "XYZ_X", "XYZ_Y", "XYZ_Z"};
+  if (o.with_lab) t.fields.insert(t.fields.end(), {"LAB_L", "LAB_A", "LAB_B"});
   if (spectra) {
+    spectra->check_shape();
     t.keywords.emplace_back("SPECTRAL_BANDS", std::to_string(spectra->bands()));
-    t.keywords.emplace_back("SPECTRAL_START_NM", fmt(spectra->wavelengths.front()));
-    t.keywords.emplace_back("SPECTRAL_END_NM", fmt(spectra->wavelengths.back()));
-    t.keywords.emplace_back("SPECTRAL_NORM", "100.0");
+    t.keywords.emplace_back("SPECTRAL_START_NM", real(spectra->wavelengths.front()));
+    t.keywords.emplace_back("SPECTRAL_END_NM", real(spectra->wavelengths.back()));
+    t.keywords.emplace_back("SPECTRAL_NORM", real(100));
     for (double w : spectra->wavelengths) t.fields.push_back("SPEC_" + std::to_string(static_cast<int>(std::lround(w))));
   }
+  t.keywords.insert(t.keywords.end(), o.keywords.begin(), o.keywords.end());
   for (std::size_t i = 0; i < chart.size(); ++i) {
     auto r = static_cast<Eigen::Index>(i);
     std::vector<std::string> row{chart.ids[i]};
-    for (int c = 0; c < 3; ++c) row.push_back(fmt(chart.rgb(r, c) * 100));
-    for (int c = 0; c < 3; ++c) row.push_back(fmt(chart.xyz(r, c)));
+    for (int c = 0; c < 3; ++c) row.push_back(real(chart.rgb(r, c) * 100));
+    for (int c = 0; c < 3; ++c) row.push_back(real(chart.xyz(r, c)));
+    if (o.with_lab)
+      for (int c = 0; c < 3; ++c) row.push_back(real(chart.lab(r, c)));
     if (spectra)
-      for (Eigen::Index k = 0; k < spectra->values.cols(); ++k) row.push_back(fmt(spectra->values(r, k) * 100));
+      for (Eigen::Index k = 0; k < spectra->values.cols(); ++k) row.push_back(real(spectra->values(r, k) * 100));
     t.rows.push_back(std::move(row));
   }
-  write_cgats(t, path);
+  return t;
+}
+
+std::string format_argyll_ti3(const ChartData& chart, const SpectralSet* spectra, const Ti3Options& options) {
+  return format_cgats(argyll_ti3_table(chart, spectra, options));
+}
+
+void write_argyll_ti3(const std::filesystem::path& path, const ChartData& chart, const SpectralSet* spectra) {
+  write_cgats(argyll_ti3_table(chart, spectra), path);
 }
 
 void write_spectra_cgats(const std::filesystem::path& path, const SpectralSet& s, const std::string& file_type) {
@@ -143,7 +170,7 @@ void write_spectra_cgats(const std::filesystem::path& path, const SpectralSet& s
   for (double w : s.wavelengths) t.fields.push_back("SPEC_" + std::to_string(static_cast<int>(std::lround(w))));
   for (std::size_t i = 0; i < s.size(); ++i) {
     std::vector<std::string> row{s.names[i]};
-    for (Eigen::Index k = 0; k < s.values.cols(); ++k) row.push_back(fmt(s.values(static_cast<Eigen::Index>(i), k) * 100));
+    for (Eigen::Index k = 0; k < s.values.cols(); ++k) row.push_back(real(s.values(static_cast<Eigen::Index>(i), k) * 100));
     t.rows.push_back(std::move(row));
   }
   write_cgats(t, path);

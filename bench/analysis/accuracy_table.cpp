@@ -22,6 +22,7 @@
 
 #include "colorlab/analysis/characterization.hpp"
 #include "colorlab/analysis/chart_io.hpp"
+#include "colorlab/analysis/csv.hpp"
 #include "colorlab/analysis/standard_data.hpp"
 #include "colorlab/core/data_paths.hpp"
 #include "synthetic_chart.hpp"
@@ -102,12 +103,12 @@ int main(int argc, char** argv) {
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i], v = argv[i + 1];
     if (a == "--quality") quality = v;
-    else if (a == "--cameras") cameras = split(v, ',');
+    else if (a == "--cameras") cameras = ca::parse_csv_row(v, "--cameras");
     else if (a == "--keep") keep = v;
     else if (a == "--oracle") oracle = v == "1";
     else if (a == "--conditions") {
       conditions.clear();
-      for (const auto& c : split(v, ',')) {
+      for (const auto& c : ca::parse_csv_row(v, "--conditions")) {
         const auto p = split(c, ':');
         if (p.size() == 2) conditions.emplace_back(p[0], p[1]);
       }

@@ -4,7 +4,6 @@
 #include <iostream>
 #include <memory>
 #include <optional>
-#include <sstream>
 
 #include "analyze_output.hpp"
 #include "colorlab/analysis/blackbox.hpp"
@@ -215,39 +214,17 @@ void run_fit(const FitCliOptions& o) {
 }
 
 Eigen::MatrixXd read_grid(const std::string& file) {
-  std::string text = ca::read_text_file(file);
-  std::vector<std::vector<double>> rows;
-  std::istringstream in(text);
-  std::string line;
-  std::size_t line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    if (line.empty() || line[0] == '#' || line == "\r") continue;
-    std::vector<double> r;
-    std::stringstream ls(line);
-    std::string cell;
-    bool numeric = true;
-    while (std::getline(ls, cell, ',')) {
-      try {
-        std::size_t used = 0;
-        r.push_back(std::stod(cell, &used));
-      } catch (const std::exception&) {
-        numeric = false;
-      }
-    }
-    if (!numeric) {
-      if (rows.empty()) continue;  // a header row
-      throw Error(ErrorClass::bad_data, file + ":" + std::to_string(line_no) + ": non-numeric luminance value");
-    }
-    if (!rows.empty() && r.size() != rows.front().size())
-      throw Error(ErrorClass::bad_data, file + ":" + std::to_string(line_no) + ": row has " + std::to_string(r.size()) +
-                                            " values, first row " + std::to_string(rows.front().size()));
-    rows.push_back(std::move(r));
+  const ca::CsvTable t = ca::read_csv(file, {.header = false});
+  // A first row that is not all numbers names the columns.
+  std::size_t first = 0;
+  if (!t.rows.empty()) {
+    for (std::size_t c = 0; c < t.columns(); ++c)
+      if (!t.try_number(0, c)) first = 1;
   }
-  if (rows.empty()) throw Error(ErrorClass::bad_data, file + ": no luminance rows");
-  Eigen::MatrixXd g(static_cast<Eigen::Index>(rows.size()), static_cast<Eigen::Index>(rows.front().size()));
-  for (std::size_t i = 0; i < rows.size(); ++i)
-    for (std::size_t j = 0; j < rows[i].size(); ++j) g(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = rows[i][j];
+  if (t.rows.size() <= first) throw Error(ErrorClass::bad_data, file + ": no luminance rows");
+  Eigen::MatrixXd g(static_cast<Eigen::Index>(t.rows.size() - first), static_cast<Eigen::Index>(t.columns()));
+  for (std::size_t i = first; i < t.rows.size(); ++i)
+    for (std::size_t j = 0; j < t.columns(); ++j) g(static_cast<Eigen::Index>(i - first), static_cast<Eigen::Index>(j)) = t.number(i, j);
   return g;
 }
 

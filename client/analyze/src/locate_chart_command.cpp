@@ -2,12 +2,12 @@
 
 #include <iostream>
 #include <memory>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include "analyze_output.hpp"
 #include "colorlab/analysis/chart_locate.hpp"
+#include "colorlab/analysis/csv.hpp"
 #include "colorlab/core/error.hpp"
 
 namespace colorlab::cli::detail {
@@ -22,11 +22,10 @@ struct LocateCliOptions {
   bool json = false;
 };
 
+// A list of numbers on the command line ("x1,y1,…"), read as one CSV row.
 std::vector<double> numbers(const std::string& text, const std::string& what) {
   std::vector<double> v;
-  std::stringstream ss(text);
-  std::string cell;
-  while (std::getline(ss, cell, ',')) {
+  for (const auto& cell : ca::parse_csv_row(text, what)) {
     try {
       std::size_t used = 0;
       v.push_back(std::stod(cell, &used));

@@ -29,6 +29,9 @@ std::vector<CgatsTable> read_cgats_all(const std::filesystem::path& path);
 // The first table; throws Error(io_error) if unreadable, Error(bad_data) if malformed.
 CgatsTable read_cgats(const std::filesystem::path& path);
 
+// Written by lcms2's IT8/CGATS writer (cgats_write.cpp). Cells are written as given: ArgyllCMS types a
+// field it does not know (SPEC_*) by its values, so reals must carry their decimal point.
+// Throws Error(bad_data) for a row of the wrong width or what lcms2 refuses.
 std::string format_cgats(const CgatsTable& table);
 void write_cgats(const CgatsTable& table, const std::filesystem::path& path);
 

@@ -3,6 +3,10 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
+
+#include "colorlab/analysis/cgats.hpp"
 
 #include "colorlab/analysis/regression.hpp"
 #include "colorlab/analysis/spectral.hpp"
@@ -19,8 +23,20 @@ int sg_patch_number(const std::string& id);
 // RGB_* in a .ti3 are on 0–100 and returned as 0–1.
 ChartData read_chart(const std::filesystem::path& path, const Xyz& white = kIccD50White);
 
-// CTI3 file that ArgyllCMS colprof reads: RGB (0–1 in, written 0–100) with XYZ, and spectra when given
-// (written in percent).
+// What an Argyll .ti3 says about its data beyond the patches (ArgyllCMS's ti3 format description).
+struct Ti3Options {
+  std::string descriptor = "colorlab chart data";
+  // INPUT: a camera or scanner's values of a reflective chart (colprof makes an input profile);
+  // OUTPUT: device values a chart was made from, read patch by patch (chartread's kind).
+  std::string device_class = "INPUT";
+  bool with_lab = false;  // LAB_L/A/B beside XYZ_X/Y/Z
+  std::vector<std::pair<std::string, std::string>> keywords;  // more, e.g. where the data came from
+};
+
+// CTI3 table that ArgyllCMS colprof, profcheck and spec2cie read: RGB (0–1 in, written 0–100) with XYZ
+// (Y = 100 for the perfect reflector), and reflectance spectra (0–1 in, written in percent) when given.
+CgatsTable argyll_ti3_table(const ChartData& chart, const SpectralSet* reflectances = nullptr, const Ti3Options& options = {});
+std::string format_argyll_ti3(const ChartData& chart, const SpectralSet* reflectances = nullptr, const Ti3Options& options = {});
 void write_argyll_ti3(const std::filesystem::path& path, const ChartData& chart,
                       const SpectralSet* reflectances = nullptr);
 
