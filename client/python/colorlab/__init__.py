@@ -9,7 +9,7 @@ from .blobs import BlobInfo
 from .client import Client
 from .errors import (ApiError, BadRequest, ColorlabError, Conflict, ConnectionFailed, ExecutionFailed, Forbidden,
                      InstrumentError, IntegrityError, MethodNotAllowed, NotFound, PayloadTooLarge,
-                     RangeNotSatisfiable, ScriptFailed, ServerError, ServiceUnavailable, Unauthorized,
+                     RangeNotSatisfiable, Unprocessable, ServerError, ServiceUnavailable, Unauthorized,
                      UnsupportedMediaType)
 from .events import Event
 from .executions import TERMINAL, Execution, Progress
@@ -22,6 +22,6 @@ __all__ = [
     "Client", "Run", "Execution", "Progress", "Event", "BlobInfo", "SseParser", "SseEvent", "TERMINAL",
     "ColorlabError", "ConnectionFailed", "IntegrityError", "ExecutionFailed", "ApiError", "BadRequest",
     "Unauthorized", "Forbidden", "NotFound", "MethodNotAllowed", "Conflict", "PayloadTooLarge",
-    "UnsupportedMediaType", "RangeNotSatisfiable", "ScriptFailed", "ServerError", "InstrumentError",
+    "UnsupportedMediaType", "RangeNotSatisfiable", "Unprocessable", "ServerError", "InstrumentError",
     "ServiceUnavailable",
 ]

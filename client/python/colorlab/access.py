@@ -11,12 +11,13 @@ class AccessMixin:
         """Who holds the control lock, if anyone."""
         return self.conn.get("/v1/control")
 
-    def acquire_control(self, holder: str) -> dict:
-        """Take the control lock for ``holder`` (a name others see); ``Conflict`` while someone else holds it."""
-        return self.conn.post("/v1/control/acquire", {"holder": holder})
+    def acquire_control(self, holder: str, *, force: bool = False) -> dict:
+        """Take the control lock for ``holder`` (a name others see); ``Conflict`` while someone else holds it,
+        unless ``force`` (an admin breaking a forgotten lock)."""
+        return self.conn.post("/v1/control/acquire", {"holder": holder, "force": force})
 
-    def release_control(self) -> dict:
-        return self.conn.post("/v1/control/release")
+    def release_control(self, *, force: bool = False) -> dict:
+        return self.conn.post("/v1/control/release", {"force": force})
 
     def keys(self) -> pd.DataFrame:
         """API keys (never their secrets): needs an ``admin`` key."""

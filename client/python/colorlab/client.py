@@ -17,18 +17,25 @@ from .runs import RunsMixin
 class Client(RunsMixin, BlobsMixin, ExportsMixin, ExecutionsMixin, LabMixin, AccessMixin):
     """``Client(url=None, key=None, cacert=None)``: url from ``COLORLAB_URL`` (else http://127.0.0.1:8765), key
     from ``COLORLAB_API_KEY`` (sent as ``Authorization: Bearer``), ``cacert`` for an https daemon whose
-    certificate your system does not trust. ``Client.local()`` finds a daemon on this machine."""
+    certificate your system does not trust; or ``socket=``, the daemon's Unix socket, instead of a URL.
+    ``Client.local()`` finds a daemon on this machine."""
 
     def __init__(self, url: str | None = None, key: str | None = None, cacert: str | os.PathLike | None = None,
-                 *, timeout: float = 30.0):
-        self.conn = Connection(url, key, cacert, timeout=timeout)
+                 *, socket: str | os.PathLike | None = None, timeout: float = 30.0):
+        self.conn = Connection(url, key, cacert, timeout=timeout, socket=socket)
 
     @classmethod
     def local(cls, state_dir: str | os.PathLike | None = None, *, key: str | None = None,
-              cacert: str | os.PathLike | None = None, timeout: float = 30.0) -> "Client":
+              cacert: str | os.PathLike | None = None, use_socket: bool = True, timeout: float = 30.0) -> "Client":
         """The daemon whose ``<state_dir>/colorlabd.endpoint`` says where it listens. Without ``state_dir``:
-        ``./colorlab-state`` (colorlabd's default), then ``/var/lib/colorlabd`` (the systemd service's)."""
-        return cls(read_endpoint(state_dir)["url"], key, cacert, timeout=timeout)
+        ``./colorlab-state`` (colorlabd's default), then ``/var/lib/colorlabd`` (the systemd service's).
+        Through its Unix socket when this user may open it — the socket's permissions are its access control,
+        so no key is needed to start campaigns — else (or with ``use_socket=False``) through its ``url``."""
+        endpoint = read_endpoint(state_dir)
+        path = endpoint.get("unix_socket")
+        if use_socket and path and os.path.exists(path) and os.access(path, os.R_OK | os.W_OK):
+            return cls(key=key, cacert=cacert, socket=path, timeout=timeout)
+        return cls(endpoint["url"], key, cacert, timeout=timeout)
 
     def close(self) -> None:
         """Closes the pooled connections (also at the end of ``with Client(...) as lab:``)."""
@@ -42,7 +49,12 @@ class Client(RunsMixin, BlobsMixin, ExportsMixin, ExecutionsMixin, LabMixin, Acc
 
     @property
     def url(self) -> str:
+        """The base URL (``http://localhost`` through a Unix socket)."""
         return self.conn.url
+
+    @property
+    def socket(self) -> str | None:
+        return self.conn.socket
 
     def __repr__(self) -> str:
         return repr(self.conn).replace("Connection", "Client", 1)

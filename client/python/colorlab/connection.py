@@ -9,6 +9,7 @@ from typing import Any, Iterator
 import requests
 
 from .errors import ColorlabError, ConnectionFailed, api_error
+from .unix_socket import UnixSocketAdapter
 
 DEFAULT_URL = "http://127.0.0.1:8765"  # protocol::kDefaultListen
 # Where a daemon writes colorlabd.endpoint: its own default (protocol::kDefaultStateDir, relative to the
@@ -53,17 +54,26 @@ def _alive(pid: int) -> bool:
 
 class Connection:
     """One daemon: ``url`` (``COLORLAB_URL``, else 127.0.0.1:8765), ``key`` (``COLORLAB_API_KEY``), sent as
-    ``Authorization: Bearer``, and ``cacert`` (a CA bundle for an https daemon with its own certificate)."""
+    ``Authorization: Bearer``, and ``cacert`` (a CA bundle for an https daemon with its own certificate);
+    or ``socket``, the daemon's Unix socket, instead of a URL."""
 
     def __init__(self, url: str | None = None, key: str | None = None, cacert: str | os.PathLike | None = None,
-                 *, timeout: float = 30.0, session: requests.Session | None = None):
-        self.url = (url or os.environ.get("COLORLAB_URL") or DEFAULT_URL).rstrip("/")
-        if not self.url.startswith(("http://", "https://")):
-            raise ColorlabError(f"url must start with http:// or https://, got {self.url!r}")
-        key = key if key is not None else os.environ.get("COLORLAB_API_KEY")
+                 *, timeout: float = 30.0, socket: str | os.PathLike | None = None,
+                 session: requests.Session | None = None):
+        self.socket = os.fspath(socket) if socket is not None else None
         self.timeout = timeout
         self.session = session or requests.Session()
         self.session.headers["User-Agent"] = "colorlab-python"
+        if self.socket is not None:
+            # Every request to this base goes through the socket; no proxy may take it elsewhere.
+            self.url = "http://localhost"
+            self.session.trust_env = False
+            self.session.mount(self.url + "/", UnixSocketAdapter(self.socket))
+        else:
+            self.url = (url or os.environ.get("COLORLAB_URL") or DEFAULT_URL).rstrip("/")
+            if not self.url.startswith(("http://", "https://")):
+                raise ColorlabError(f"url must start with http:// or https://, got {self.url!r}")
+        key = key if key is not None else os.environ.get("COLORLAB_API_KEY")
         if key:
             self.session.headers["Authorization"] = f"Bearer {key}"
         if cacert is not None:
@@ -71,7 +81,12 @@ class Connection:
         self._has_key = bool(key)
 
     def __repr__(self) -> str:
-        return f"{type(self).__name__}({self.url!r}{', key=…' if self._has_key else ''})"
+        where = f"socket={self.socket!r}" if self.socket is not None else repr(self.url)
+        return f"{type(self).__name__}({where}{', key=…' if self._has_key else ''})"
+
+    @property
+    def where(self) -> str:
+        return self.socket if self.socket is not None else self.url
 
     def absolute(self, path: str) -> str:
         """A route (``/v1/...``) or a link the daemon returned, as a full URL."""
@@ -90,7 +105,7 @@ class Connection:
             raise ConnectionFailed(f"TLS with {self.url} failed: {e}",
                                    hint="pass cacert= the CA certificate that signed the daemon's") from e
         except (requests.ConnectionError, requests.Timeout) as e:
-            raise ConnectionFailed(f"cannot talk to colorlabd at {self.url}: {e}",
+            raise ConnectionFailed(f"cannot talk to colorlabd at {self.where}: {e}",
                                    hint="is colorlabd running? Client.local() finds a local one") from e
         if r.status_code >= 400:
             try:

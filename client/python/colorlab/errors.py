@@ -104,7 +104,9 @@ class RangeNotSatisfiable(ApiError):
     status_code = 416
 
 
-class ScriptFailed(ApiError):
+class Unprocessable(ApiError):
+    """422: understood but not possible (a campaign script failed; a run that cannot take the export format)."""
+
     status_code = 422
 
 
@@ -127,7 +129,7 @@ class ServiceUnavailable(ApiError):
 
 
 _BY_STATUS = {c.status_code: c for c in (BadRequest, Unauthorized, Forbidden, NotFound, MethodNotAllowed, Conflict,
-                                         PayloadTooLarge, UnsupportedMediaType, RangeNotSatisfiable, ScriptFailed,
+                                         PayloadTooLarge, UnsupportedMediaType, RangeNotSatisfiable, Unprocessable,
                                          ServerError, InstrumentError, ServiceUnavailable)}
 
 

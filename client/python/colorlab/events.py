@@ -132,7 +132,7 @@ def stream(conn: Connection, *, topic: str | None = None, after: int | None = No
                 resp.close()
         if not reconnect:
             if problem is not None and not isinstance(problem, ApiError):
-                raise ConnectionFailed(f"event stream from {conn.url} failed: {problem}") from problem
+                raise ConnectionFailed(f"event stream from {conn.where} failed: {problem}") from problem
             if isinstance(problem, ApiError):
                 raise problem
             return
@@ -141,7 +141,7 @@ def stream(conn: Connection, *, topic: str | None = None, after: int | None = No
             failing_since = failing_since or now
             failures += 1
             if give_up_after is not None and now - failing_since > give_up_after:
-                raise ConnectionFailed(f"event stream from {conn.url} lost for {now - failing_since:.0f} s: "
+                raise ConnectionFailed(f"event stream from {conn.where} lost for {now - failing_since:.0f} s: "
                                        f"{problem}", hint="is colorlabd running?") from problem
         # The spec's reconnection time after a clean end (the daemon dropped a slow client); after failures,
         # growing from it, so a daemon that is down is not hammered.

@@ -56,9 +56,10 @@ class Execution(dict):
 
 @dataclass(frozen=True)
 class Progress:
-    """Where an execution stands after one event: the latest status, progress (0..1), step and measurement
-    count seen so far. ``kind``: ``state`` (read when following began), ``progress``, ``execution`` (a status
-    change or a requested pause/abort), ``operator`` (``request`` is the operator request)."""
+    """Where an execution stands after one event: the latest status, progress (0..1) and step seen so far.
+    ``kind``: ``state`` (read when following began), ``progress`` (a step was committed; ``measurements``: how
+    many it stored), ``execution`` (a status change or a requested pause/abort), ``operator`` (``request`` is
+    the operator request)."""
 
     execution_id: str
     kind: str
@@ -134,7 +135,7 @@ class ExecutionsMixin:
             # The stream is open before the execution is read: whatever happens after that read is an event.
             first = next(stream, None)
             if first is None:
-                raise ColorlabError(f"the event stream of {self.conn.url} ended before it began")
+                raise ColorlabError(f"the event stream of {self.conn.where} ended before it began")
             state = self.execution(eid)
             current = Progress(eid, "state", state.status, state.get("progress"), state.get("step"),
                                reason=state.get("reason"))
@@ -147,7 +148,7 @@ class ExecutionsMixin:
                 if ev.topic == "snapshot":  # reconnected without an id: re-read instead of guessing
                     state = self.execution(eid)
                     nxt = Progress(eid, "state", state.status, state.get("progress"), state.get("step"),
-                                   current.measurements, state.get("reason"), event=ev)
+                                   reason=state.get("reason"), event=ev)
                 if nxt is None:
                     continue
                 current = nxt
@@ -184,13 +185,13 @@ def _apply(current: Progress, ev: _events.Event, eid: str) -> Progress | None:
     if ev.topic == "progress" and p.get("execution_id") == eid:
         return Progress(eid, "progress", "running" if current.status in (None, "waiting") else current.status,
                         p.get("progress", current.progress), p.get("step", current.step),
-                        p.get("measurements", current.measurements), current.reason, event=ev)
+                        p.get("measurements"), current.reason, event=ev)
     if ev.topic == "execution" and p.get("execution_id") == eid:
         return Progress(eid, "execution", p.get("status", current.status), current.progress, current.step,
-                        current.measurements, p.get("reason", current.reason), event=ev)
+                        reason=p.get("reason", current.reason), event=ev)
     if ev.topic == "operator":
         req = p.get("request") or {}
         if req.get("execution_id") == eid:
-            return Progress(eid, "operator", current.status, current.progress, current.step, current.measurements,
-                            current.reason, request=dict(req, event=p.get("event")), event=ev)
+            return Progress(eid, "operator", current.status, current.progress, current.step,
+                            reason=current.reason, request=dict(req, event=p.get("event")), event=ev)
     return None

@@ -1,13 +1,16 @@
 """A real colorlabd on the embedded simulated lab, in a temporary state directory — the Python twin of
 tests/support's DaemonProcess and resume_support's write_daemon_config: the daemon listens on 127.0.0.1:0
-(or a given port, to come back on it after a restart) and says where in <state>/colorlabd.endpoint."""
+(or a given port, to come back on it after a restart) and says where in <state>/colorlabd.endpoint.
+``client`` is Client.local(): through the daemon's Unix socket, which may do everything."""
 from __future__ import annotations
 
+import ctypes
 import json
 import os
 import shutil
 import signal
 import socket
+import sqlite3
 import subprocess
 import tempfile
 import time
@@ -22,6 +25,12 @@ BIN_DIR = Path(os.environ.get("COLORLAB_BIN_DIR") or SOURCE_DIR / "build" / "bin
 # simulated DSLR, small, is the lab's camera.
 LAB_TOML = "[genicam]\nenabled = false\n[dslr]\nsize = [640, 428]\n"
 TERMINAL = colorlab.TERMINAL
+
+
+def _die_with_parent() -> None:
+    """In the child: SIGKILL when the test process dies (a ctest timeout), so no daemon outlives its test."""
+    PR_SET_PDEATHSIG = 1
+    ctypes.CDLL("libc.so.6", use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
 
 
 def free_port() -> int:
@@ -41,7 +50,11 @@ class Daemon:
         self.log = self.dir / "colorlabd.log"
         self.proc = None
         self.endpoint = {}
-        self.start()
+        try:
+            self.start()
+        except BaseException:
+            self.cleanup()  # a daemon that did not come up must not outlive the test
+            raise
 
     def start(self) -> None:
         binary = BIN_DIR / "colorlabd"
@@ -50,13 +63,16 @@ class Daemon:
         with open(self.log, "ab") as log:  # appended: a restarted daemon's log follows the killed one's
             self.proc = subprocess.Popen([str(binary), "--config", str(self.dir / "colorlabd.toml"), "--state",
                                           str(self.state), "--listen", f"127.0.0.1:{self.port}"],
-                                         stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
+                                         stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
+                                         preexec_fn=_die_with_parent)
         deadline = time.monotonic() + 60
         while time.monotonic() < deadline:
             try:
                 endpoint = json.loads((self.state / "colorlabd.endpoint").read_text())
                 if endpoint.get("pid") == self.proc.pid:
                     self.endpoint = endpoint
+                    if getattr(self, "client", None):
+                        self.client.close()
                     self.client = colorlab.Client.local(self.state)
                     return
             except (FileNotFoundError, ValueError):
@@ -69,6 +85,10 @@ class Daemon:
     @property
     def url(self) -> str:
         return self.endpoint["url"]
+
+    def tcp_client(self, key: str | None = None) -> colorlab.Client:
+        """A client over loopback TCP, as a remote user's would be: reads need no key, control does."""
+        return colorlab.Client(self.url, key=key or "")
 
     def log_text(self) -> str:
         try:
@@ -105,13 +125,23 @@ class Daemon:
             raise AssertionError(f"{campaign} ended {done['status']}: {done}\n{self.log_text()}")
         return done
 
-    def cli_json(self, *args: str) -> dict:
-        """The C++ CLI's view, as an independent reader of the daemon's data."""
-        r = subprocess.run([str(BIN_DIR / "colorlab"), "--url", self.url, "--json", *args],
-                           capture_output=True, text=True, timeout=120)
-        if r.returncode != 0:
-            raise AssertionError(f"colorlab {' '.join(args)} exited {r.returncode}: {r.stderr}")
-        return json.loads(r.stdout)
+    def stored_measurements(self, run_id: str) -> list[dict]:
+        """The run's measurements as stored: read from the daemon's SQLite file (read-only, beside the running
+        daemon: WAL readers never block its writer), not through its API."""
+        con = sqlite3.connect(f"file:{self.state / 'colorlab.db'}?mode=ro", uri=True)
+        try:
+            rows = con.execute("SELECT seq, step, instrument_id, simulated, quantity, value, unit, data, measured_at "
+                               "FROM measurements WHERE run_id = ? ORDER BY seq", (run_id,)).fetchall()
+        finally:
+            con.close()
+        keys = ("seq", "step", "instrument_id", "simulated", "quantity", "value", "unit", "data", "measured_at")
+        out = []
+        for row in rows:
+            m = dict(zip(keys, row))
+            m["simulated"] = bool(m["simulated"])
+            m["data"] = json.loads(m["data"]) if m["data"] else None
+            out.append(m)
+        return out
 
     def _wait_simulator_gone(self) -> None:
         pid = self.endpoint.get("simulator_pid", -1)

@@ -1,6 +1,6 @@
 """The Python client against a real colorlabd on the simulated lab: a campaign started and followed
-through the event stream, its measurements as a DataFrame checked against the C++ CLI's reading of the
-same run, its exports, and the daemon's refusals as exceptions."""
+through the event stream, its measurements as a DataFrame checked against the same run read from the
+daemon's database file, its exports, keys and scopes, and the daemon's refusals as exceptions."""
 import hashlib
 import io
 import json
@@ -21,19 +21,20 @@ class CampaignTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.daemon = Daemon()
+        cls.addClassCleanup(cls.daemon.cleanup)  # also when the rest of setUpClass fails
         cls.lab = cls.daemon.client
         cls.daemon.wait_ready("ls110")
         # One run for the data tests, made without the client's stream so they do not depend on it.
         cls.done = cls.daemon.run_to_end("luminance-spot", readings=READINGS)
         cls.run_id = cls.done["run_id"]
-        cls.reference = cls.daemon.cli_json("show", cls.run_id)
+        cls.stored = cls.daemon.stored_measurements(cls.run_id)
 
-    @classmethod
-    def tearDownClass(cls):
-        cls.daemon.cleanup()
 
     def test_local_finds_the_daemon_and_it_is_the_simulated_lab(self):
-        self.assertEqual(self.lab.url, self.daemon.url)
+        self.assertEqual(self.lab.socket, self.daemon.endpoint["unix_socket"])
+        with colorlab.Client.local(self.daemon.state, use_socket=False) as tcp:
+            self.assertEqual(tcp.url, self.daemon.url)
+            self.assertIs(tcp.status()["simulated_lab"], True)
         self.assertIs(self.lab.status()["simulated_lab"], True)
         self.assertIn("ls110", self.lab.instruments()["id"].tolist())
         self.assertIn("luminance-spot", self.lab.campaigns()["name"].tolist())
@@ -51,21 +52,35 @@ class CampaignTest(unittest.TestCase):
         self.assertEqual(final.status, "finished_ok", self.daemon.log_text())
         self.assertTrue(seen[-1].terminal)
         self.assertEqual(seen[-1].status, "finished_ok")
-        # One progress event per committed step, in order, none twice: the script reports reading/0..3.
-        steps = [p.step for p in seen if p.kind == "progress"]
-        self.assertEqual([s for s in steps if s.startswith("reading/")], [f"reading/{i}" for i in range(4)])
-        seqs = [p.event.seq for p in seen if p.event is not None]
-        self.assertEqual(seqs, sorted(set(seqs)))
-        # The stream's progress agrees with the store: the last count is the run's measurements.
-        counts = [p.measurements for p in seen if p.kind == "progress" and p.measurements is not None]
-        self.assertEqual(counts, sorted(counts))
-        stored = self.daemon.cli_json("show", final.run_id)["measurements"]
-        self.assertEqual(len(stored), 4)
-        if counts:
-            self.assertLessEqual(counts[-1], 4)
+        # One progress event per committed step, in the script's order, ending at "done".
+        progress = [p for p in seen if p.kind == "progress"]
+        order = ["reading/0", "reading/1", "reading/2", "reading/3", "done"]
+        steps = [p.step for p in progress]
+        self.assertEqual(steps, sorted(set(steps), key=order.index), steps)
+        self.assertEqual(steps[-1], "done")
+        self.assertEqual([p.progress for p in progress], sorted(p.progress for p in progress))
+        self.assertEqual(progress[-1].progress, 1.0)
+        # From the first event seen on, exactly the stored log's progress events of this execution: none
+        # lost, none twice (the ones before the stream opened are the state follow() read first).
+        stored = [ev for ev in self.all_events("progress") if ev["payload"]["execution_id"] == e.id]
+        first = progress[0].event.seq
+        self.assertEqual([(p.event.seq, p.event.payload) for p in progress],
+                         [(ev["seq"], ev["payload"]) for ev in stored if ev["seq"] >= first])
+        # The steps' measurements add up to what the store holds.
+        self.assertEqual(sum(ev["payload"]["measurements"] for ev in stored), 4)
+        self.assertEqual(len(self.daemon.stored_measurements(final.run_id)), 4)
         # An execution that has ended is followed in one step.
         self.assertEqual([p.status for p in self.lab.follow(e)], ["finished_ok"])
         self.assertEqual(self.lab.wait(e).status, "finished_ok")
+
+    def all_events(self, topic):
+        events, after = [], 0
+        while True:
+            page = self.lab.event_log(after=after, topic=topic)
+            if not page:
+                return events
+            events += page
+            after = page[-1]["seq"]
 
     def test_the_idempotency_key_never_starts_twice(self):
         first = self.lab.start("luminance-spot", readings=1, idempotency_key="python-integration-once")
@@ -77,9 +92,9 @@ class CampaignTest(unittest.TestCase):
         return skip_unless_served(self, lambda: self.lab.measurements(self.run_id, **filters),
                                   "GET /v1/runs/{id}/measurements")
 
-    def test_measurements_frame_equals_the_run_as_the_cli_reads_it(self):
+    def test_measurements_frame_equals_the_stored_run(self):
         df = self.measurements()
-        ref = self.reference["measurements"]
+        ref = self.stored
         self.assertEqual(len(df), READINGS)
         self.assertEqual(df["seq"].tolist(), [m["seq"] for m in ref])
         self.assertEqual(df["step"].tolist(), [f"reading/{i}" for i in range(READINGS)])
@@ -92,7 +107,9 @@ class CampaignTest(unittest.TestCase):
         self.assertEqual(df["measured_at"].tolist(), pd.to_datetime([m["measured_at"] for m in ref], utc=True).tolist())
         self.assertEqual(df["data.raw"].tolist(), [m["data"]["raw"] for m in ref])
         # The daemon's own summary (computed by SQL) agrees with the frame's.
-        summary = self.reference["summary"]["measurements"]["luminance"]
+        run = self.lab.run(self.run_id)
+        self.assertEqual(run["measurement_count"], READINGS)
+        summary = run["summary"]["measurements"]["luminance"]
         self.assertEqual(summary["count"], len(df))
         self.assertAlmostEqual(summary["mean"], df["value"].mean(), delta=1e-9 * abs(summary["mean"]))
         self.assertAlmostEqual(summary["min"], df["value"].min())
@@ -126,19 +143,22 @@ class CampaignTest(unittest.TestCase):
                                   "GET /v1/runs/{id}/export")
 
     def test_exports_carry_the_stored_values(self):
-        ref = self.reference["measurements"]
+        ref = self.stored
         doc = json.loads(self.export("json"))
         exported = doc["measurements"] if isinstance(doc, dict) else doc
         self.assertEqual([m["value"] for m in exported], [m["value"] for m in ref])
         csv = pd.read_csv(io.BytesIO(self.export("csv")))
         self.assertEqual(csv["step"].tolist(), [m["step"] for m in ref])
         np.testing.assert_allclose(csv["value"].to_numpy(), [m["value"] for m in ref], rtol=1e-12)
-        ti3 = self.export("ti3")
-        self.assertTrue(ti3.startswith(b"CTI3"), ti3[:80])
         with tempfile.TemporaryDirectory() as d:
-            path = self.export("ti3", d)
+            path = self.export("csv", d)
             self.assertEqual(path.parent, Path(d))
-            self.assertEqual(path.read_bytes(), ti3)
+            self.assertEqual(path.suffix, ".csv")
+            self.assertEqual(pd.read_csv(path)["value"].tolist(), csv["value"].tolist())
+        # A .ti3 pairs patches with their colour: luminance readings have none, and the daemon says so.
+        with self.assertRaises(colorlab.Unprocessable) as caught:
+            self.export("ti3")
+        self.assertIn("csv", caught.exception.hint)
 
     def test_refusals_are_typed_exceptions(self):
         with self.assertRaises(colorlab.NotFound) as caught:
@@ -154,6 +174,46 @@ class CampaignTest(unittest.TestCase):
             self.lab.pause(self.done["id"])  # it has ended
         self.assertEqual(self.lab.requests(), [])
         self.assertIn(self.lab.queue()["state"], ("running", "stopped", "stopping"))
+
+
+
+class AccessTest(unittest.TestCase):
+    """Keys and scopes as a remote user meets them, over TCP; the admin is the Unix socket's user."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.daemon = Daemon()
+        cls.addClassCleanup(cls.daemon.cleanup)  # also when the rest of setUpClass fails
+        cls.admin = cls.daemon.client
+        cls.daemon.wait_ready("ls110")
+
+
+    def test_loopback_reads_without_a_key_and_needs_one_to_start(self):
+        with self.daemon.tcp_client() as anonymous:
+            self.assertIn("items", anonymous.conn.get("/v1/runs"))
+            with self.assertRaises(colorlab.Forbidden) as caught:
+                anonymous.start("luminance-spot", readings=1)
+            self.assertEqual(caught.exception.status, 403)
+            self.assertTrue(caught.exception.hint)
+        with self.daemon.tcp_client(key="clk_not_a_key") as stranger:
+            with self.assertRaises(colorlab.Unauthorized):
+                stranger.runs()
+
+    def test_a_control_key_starts_and_follows_and_revoked_it_is_refused(self):
+        created = skip_unless_served(self, lambda: self.admin.create_key("python-tests", scope="control"),
+                                     "POST /v1/keys")
+        secret = created["secret"]
+        listed = self.admin.keys()
+        self.assertIn("python-tests", listed["name"].tolist())
+        self.assertNotIn(secret, listed.to_string())  # the secret is shown once, in the answer that made it
+        with self.daemon.tcp_client(key=secret) as operator:
+            e = operator.start("luminance-spot", readings=2)
+            self.assertEqual(self.daemon.wait_terminal(e.id)["status"], "finished_ok")
+            with self.assertRaises(colorlab.Forbidden):  # control is not admin
+                operator.keys()
+            self.admin.revoke_key(created["id"])
+            with self.assertRaises(colorlab.Unauthorized):
+                operator.runs()
 
 
 if __name__ == "__main__":

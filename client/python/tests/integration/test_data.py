@@ -1,6 +1,6 @@
 """Frames and spectra from real campaigns on the simulated lab: frame-average's kept frames as numpy arrays
 (checked byte for byte against the blob store's files), and chart-read's spectra by wavelength (checked
-against the C++ CLI's reading of the same run)."""
+against the same run read from the daemon's database file)."""
 import unittest
 
 import numpy as np
@@ -15,13 +15,11 @@ class FrameTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.daemon = Daemon()
+        cls.addClassCleanup(cls.daemon.cleanup)  # also when the rest of setUpClass fails
         cls.lab = cls.daemon.client
         cls.daemon.wait_ready("dslr")
         cls.run_id = cls.daemon.run_to_end("frame-average", frames=FRAMES)["run_id"]
 
-    @classmethod
-    def tearDownClass(cls):
-        cls.daemon.cleanup()
 
     def stored_file(self, sha):
         """The blob's file in the daemon's content-addressed store (<state>/blobs/ab/cdef…), read without HTTP."""
@@ -86,14 +84,12 @@ class SpectraTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.daemon = Daemon()
+        cls.addClassCleanup(cls.daemon.cleanup)  # also when the rest of setUpClass fails
         cls.lab = cls.daemon.client
         cls.daemon.wait_ready("spectrolino")
         cls.run_id = cls.daemon.run_to_end("chart-read", chart="cc24", confirm_load=False)["run_id"]
-        cls.reference = cls.daemon.cli_json("show", cls.run_id)["measurements"]
+        cls.reference = cls.daemon.stored_measurements(cls.run_id)
 
-    @classmethod
-    def tearDownClass(cls):
-        cls.daemon.cleanup()
 
     def test_spectra_by_wavelength_equal_the_stored_readings(self):
         spectra = skip_unless_served(self, lambda: self.lab.spectra(self.run_id), "GET /v1/runs/{id}/measurements")
@@ -117,6 +113,42 @@ class SpectraTest(unittest.TestCase):
             np.testing.assert_array_equal(row["data.Lab"], m["data"]["Lab"])
             self.assertEqual(row["value"], m["data"]["Lab"][0])  # the script records L* as the value
             self.assertEqual(row["data.values"].shape, (36,))
+
+    def test_the_ti3_export_carries_the_stored_spectra(self):
+        ti3 = skip_unless_served(self, lambda: self.lab.export(self.run_id, "ti3"), "GET /v1/runs/{id}/export")
+        table = read_cgats(ti3.decode())
+        self.assertEqual(table["keywords"]["NUMBER_OF_SETS"], "24")
+        self.assertEqual(len(table["rows"]), 24)
+        norm = float(table["keywords"].get("SPECTRAL_NORM", '"1"').strip('"'))
+        rows = {row["SAMPLE_ID"].strip('"'): row for row in table["rows"]}
+        self.assertEqual(sorted(rows), sorted(m["data"]["id"] for m in self.reference))
+        for m in self.reference:
+            d = m["data"]
+            row = rows[d["id"]]
+            spectrum = [float(row[f"SPEC_{int(d['first_nm'] + i * d['step_nm'])}"]) / norm for i in range(len(d["values"]))]
+            # Printed with 6 decimals (spectra on the 0..SPECTRAL_NORM scale): within half the last digit.
+            np.testing.assert_allclose(spectrum, d["values"], rtol=0, atol=0.51e-6 / norm)
+            np.testing.assert_allclose([float(row[f"LAB_{c}"]) for c in "LAB"], d["Lab"], rtol=0, atol=0.51e-6)
+
+
+def read_cgats(text: str) -> dict:
+    """Just enough CGATS to read a table: keywords, the data format's field names, the rows by field."""
+    keywords, fields, rows, section = {}, [], [], None
+    for line in text.splitlines():
+        parts = line.split()
+        if not parts:
+            continue
+        if parts[0] in ("BEGIN_DATA_FORMAT", "BEGIN_DATA"):
+            section = parts[0]
+        elif parts[0] in ("END_DATA_FORMAT", "END_DATA"):
+            section = None
+        elif section == "BEGIN_DATA_FORMAT":
+            fields += parts
+        elif section == "BEGIN_DATA":
+            rows.append(dict(zip(fields, parts)))
+        elif len(parts) >= 2:
+            keywords[parts[0]] = line.split(None, 1)[1].strip()
+    return {"keywords": keywords, "fields": fields, "rows": rows}
 
 
 if __name__ == "__main__":

@@ -15,8 +15,9 @@ class StreamAcrossRestartTest(unittest.TestCase):
         self.daemon.wait_ready("ls110")
 
     def test_no_event_lost_or_repeated_across_kill_9(self):
-        lab = self.daemon.client
-        stream = lab.events(give_up_after=120)
+        # Over loopback TCP, as a remote reader's stream; the restarted daemon listens on the same port.
+        reader_client = self.enterContext(self.daemon.tcp_client())
+        stream = reader_client.events(give_up_after=120)
         first = skip_unless_served(self, lambda: next(stream), "GET /v1/events/stream")
         self.assertEqual(first.topic, "snapshot")
         got = queue.Queue()

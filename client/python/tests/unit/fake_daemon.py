@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import json
+import socketserver
 import threading
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from urllib.parse import parse_qs, urlsplit
@@ -76,12 +77,24 @@ class Handler(BaseHTTPRequestHandler):
         self.connection.shutdown(2)
 
 
+class _UnixServer(socketserver.ThreadingMixIn, socketserver.UnixStreamServer):
+    def get_request(self):
+        sock, _ = super().get_request()
+        return sock, ("unix", 0)  # BaseHTTPRequestHandler expects a (host, port) peer
+
+
 class FakeDaemon:
-    def __init__(self):
+    """On 127.0.0.1:<free port>, or on a Unix socket at ``unix_path``."""
+
+    def __init__(self, unix_path=None):
         self.routes = {}
         self.requests = []
         self.lock = threading.Lock()
-        self.server = ThreadingHTTPServer(("127.0.0.1", 0), Handler)
+        self.unix_path = unix_path
+        if unix_path:
+            self.server = _UnixServer(unix_path, Handler)
+        else:
+            self.server = ThreadingHTTPServer(("127.0.0.1", 0), Handler)
         self.server.daemon_threads = True
         self.server.fake = self
         self.thread = threading.Thread(target=self.server.serve_forever, args=(0.02,), daemon=True)

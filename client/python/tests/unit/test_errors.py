@@ -15,7 +15,7 @@ class ErrorMappingTest(unittest.TestCase):
         cases = {400: colorlab.BadRequest, 401: colorlab.Unauthorized, 403: colorlab.Forbidden,
                  404: colorlab.NotFound, 405: colorlab.MethodNotAllowed, 409: colorlab.Conflict,
                  413: colorlab.PayloadTooLarge, 415: colorlab.UnsupportedMediaType,
-                 416: colorlab.RangeNotSatisfiable, 422: colorlab.ScriptFailed, 500: colorlab.ServerError,
+                 416: colorlab.RangeNotSatisfiable, 422: colorlab.Unprocessable, 500: colorlab.ServerError,
                  502: colorlab.InstrumentError, 503: colorlab.ServiceUnavailable}
         with FakeDaemon() as fake:
             for status in cases:
