@@ -76,8 +76,9 @@ class Connection:
         key = key if key is not None else os.environ.get("COLORLAB_API_KEY")
         if key:
             self.session.headers["Authorization"] = f"Bearer {key}"
-        if cacert is not None:
-            self.session.verify = os.fspath(cacert)
+        # Passed with every request: requests lets REQUESTS_CA_BUNDLE override a session's verify (psf/requests
+        # #3829), and a CA given here must win.
+        self.verify = os.fspath(cacert) if cacert is not None else None
         self._has_key = bool(key)
 
     def __repr__(self) -> str:
@@ -100,7 +101,7 @@ class Connection:
             params = {k: v for k, v in params.items() if v is not None}
         try:
             r = self.session.request(method, url, params=params, json=json_body, headers=headers, stream=stream,
-                                     timeout=self.timeout if timeout is None else timeout)
+                                     timeout=self.timeout if timeout is None else timeout, verify=self.verify)
         except requests.exceptions.SSLError as e:
             raise ConnectionFailed(f"TLS with {self.url} failed: {e}",
                                    hint="pass cacert= the CA certificate that signed the daemon's") from e

@@ -93,7 +93,8 @@ def stream(conn: Connection, *, topic: str | None = None, after: int | None = No
         problem: Exception | None = None
         try:
             resp = conn.session.get(conn.absolute(STREAM_PATH), params={"topic": topic} if topic else None,
-                                    headers=headers, stream=True, timeout=(conn.timeout, read_timeout))
+                                    headers=headers, stream=True, timeout=(conn.timeout, read_timeout),
+                                    verify=conn.verify)
         except requests.exceptions.SSLError as e:
             raise ConnectionFailed(f"TLS with {conn.url} failed: {e}",
                                    hint="pass cacert= the CA certificate that signed the daemon's") from e
