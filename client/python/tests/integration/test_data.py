@@ -54,6 +54,27 @@ class FrameTest(unittest.TestCase):
             band = self.lab.read_array(blob, rows=(h // 3, h // 3 + 7))
             np.testing.assert_array_equal(band, frame[h // 3:h // 3 + 7])
 
+    def test_the_averaged_frame_reproduces_the_campaigns_noise_figures(self):
+        """frame-average records, per CFA channel, the spread of the N-frame average over its most uniform
+        window; numpy on the frame served here must find the same figures."""
+        blobs = skip_unless_served(self, lambda: self.lab.blobs(self.run_id), "GET /v1/runs/{id}/blobs")
+        average = blobs[blobs["kind"] == "average"].iloc[0]
+        frame = self.lab.read_array(average)
+        self.assertLessEqual(float(frame.max()), average["meta"]["white_level"])
+        cfa = self.lab.blob_info(average).cfa  # the colours of (row % 2, col % 2), e.g. RGGB
+        noise = self.lab.measurements(self.run_id, step_prefix=f"noise/N{FRAMES}/")
+        self.assertEqual(sorted(noise["data.channel"]), ["B", "G", "R"])
+        x, y, w, h = (int(v) for v in noise["data.region"].iloc[0])
+        planes = {}
+        for dy in (0, 1):
+            for dx in (0, 1):
+                colour = cfa[2 * dy + dx]
+                if colour not in planes:  # the first green only, as the campaign keeps it
+                    planes[colour] = frame[y + (dy - y) % 2:y + h:2, x + (dx - x) % 2:x + w:2]
+        for _, m in noise.iterrows():
+            spread = float(np.std(planes[m["data.channel"]], ddof=1, dtype=np.float64))
+            self.assertAlmostEqual(spread, m["value"], delta=1e-4 * m["value"], msg=m["step"])
+
     def test_raw_files_and_previews(self):
         blobs = skip_unless_served(self, lambda: self.lab.blobs(self.run_id), "GET /v1/runs/{id}/blobs")
         for _, blob in blobs.iterrows():
