@@ -142,9 +142,22 @@ class ExecutionsMixin:
             yield current
             if current.terminal:
                 return state
+            # A request already waiting was posted before the stream: the snapshot lists it.
+            posted = set()
+            snapshot = first.payload if first.topic == "snapshot" and isinstance(first.payload, dict) else {}
+            waiting = snapshot["requests"] if "requests" in snapshot else self.requests()
+            for req in waiting:
+                if req.get("execution_id") == eid and req.get("id") not in posted:
+                    posted.add(req.get("id"))
+                    yield Progress(eid, "operator", current.status, current.progress, current.step,
+                                   reason=current.reason, request=dict(req, event="posted"))
             # A daemon that sends no snapshot: its first event is news like any other.
             for ev in _chain(None if first.topic == "snapshot" else first, stream):
                 nxt = _apply(current, ev, eid)
+                if nxt is not None and nxt.kind == "operator" and nxt.request.get("event") == "posted":
+                    if nxt.request.get("id") in posted:
+                        continue  # listed already (GET /v1/requests raced the event)
+                    posted.add(nxt.request.get("id"))
                 if ev.topic == "snapshot":  # reconnected without an id: re-read instead of guessing
                     state = self.execution(eid)
                     nxt = Progress(eid, "state", state.status, state.get("progress"), state.get("step"),

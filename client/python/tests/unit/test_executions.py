@@ -57,6 +57,8 @@ class StartTest(unittest.TestCase):
 
 
 class FollowTest(unittest.TestCase):
+    waiting = []  # operator requests in the snapshot
+
     def serve(self, fake, first_status, events, final_status):
         state = {"status": first_status}
         snapshot_sent = threading.Event()
@@ -70,7 +72,8 @@ class FollowTest(unittest.TestCase):
 
         def stream(h):
             h.start_chunked()
-            h.chunk(b"id: 10\nevent: snapshot\ndata: {\"last_seq\": 10, \"executions\": []}\n\n")
+            h.chunk(b"id: 10\nevent: snapshot\ndata: " + json.dumps(
+                {"last_seq": 10, "executions": [], "requests": self.waiting}).encode() + b"\n\n")
             snapshot_sent.set()
             # Wait until follow() has read the execution, as a real run would go on meanwhile.
             for _ in range(2000):
@@ -121,6 +124,22 @@ class FollowTest(unittest.TestCase):
         self.assertTrue(seen[-1].terminal)
         self.assertEqual(final.status, "finished_ok")
         self.assertIn("reading/1", str(seen[4]))
+
+    def test_a_request_waiting_before_the_stream_opened_is_yielded_once(self):
+        req = {"id": "q7", "execution_id": EID, "action": "load_chart", "prompt": "Load the SG"}
+        self.waiting = [req, dict(req, id="q8", execution_id="someone-else")]
+        events = [
+            # The same request's event, had the log raced the snapshot: not yielded twice.
+            ("operator", {"event": "posted", "request": req}),
+            ("operator", {"event": "answered", "request": dict(req, answer="loaded")}),
+            ("execution", {"execution_id": EID, "status": "finished_ok"}),
+        ]
+        with FakeDaemon() as fake:
+            self.serve(fake, "running", events, "finished_ok")
+            lab = self.enterContext(colorlab.Client(fake.url))
+            seen = [(p.kind, p.request and (p.request["id"], p.request["event"])) for p in lab.follow(EID)]
+        self.assertEqual(seen, [("state", None), ("operator", ("q7", "posted")), ("operator", ("q7", "answered")),
+                                ("execution", None)])
 
     def test_an_execution_that_already_ended_yields_once(self):
         with FakeDaemon() as fake:
