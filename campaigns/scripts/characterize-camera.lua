@@ -24,6 +24,9 @@ return {
                       description = "camspec cameras the black box's prior leaves out (the camera under test, to judge its curves against its published ones)" },
     load_timeout_s = { type = "number", default = 600, min = 0, max = 86400, unit = "s",
                        description = "how long to wait for the operator to confirm the chart before photographing anyway" },
+    keep = { type = "array", items = "string", values = { "average", "raw", "tiff16", "tiff8", "jpeg", "preview" },
+             default = { "average", "raw", "preview" }, max_items = 6,
+             description = "frames kept in the image store: the averaged raw (float array), the first raw as captured, the first frame's TIFF/JPEG, a PNG preview" },
   },
   run = function(p)
     if p.reference_run == nil or p.reference_run == "" then
@@ -57,7 +60,7 @@ return {
     -- The reference's luminances let the locator tell patches as dark as the chart's surround (no edge of their
     -- own) from a covered chart. (Only ids and XYZ: the spectra would swell the call's journal entry.)
     local shots = lab.camera.photograph_chart { frames = p.frames, chart = p.chart, formats = p.formats, camera = p.camera,
-                                                reference = { ids = ref.ids, XYZ = ref.XYZ } }
+                                                reference = { ids = ref.ids, XYZ = ref.XYZ }, keep = p.keep }
     lab.log(string.format("photographed %d frames as %s", p.frames, table.concat(p.formats, ", ")))
     local out = { reference_run = p.reference_run, chart = p.chart, frames = p.frames, lamp = p.lamp,
                   instrument = shots.instrument, formats = {} }

@@ -12,12 +12,14 @@ return {
                description = "[x, y, width, height] in visible pixels; empty = the most uniform mid-level 32×32 window" },
     exposure_us = { type = "number", default = nil, min = 1, max = 10000000, unit = "µs",
                     description = "exposure time of a GenICam camera; unset = as configured" },
+    keep = { type = "array", items = "string", values = { "average", "raw", "preview" }, default = { "average", "raw", "preview" },
+             max_items = 3, description = "frames kept in the image store: the average (float array), the first frame as captured, a PNG preview" },
   },
   run = function(p)
     if #p.region ~= 0 and #p.region ~= 4 then error("region must be empty or {x, y, width, height}") end
     if p.exposure_us then lab.camera.configure({ exposure_us = p.exposure_us }) end
     lab.progress(0.0, "capturing")
-    local t = lab.camera.capture({ frames = p.frames, region = p.region })
+    local t = lab.camera.capture({ frames = p.frames, region = p.region, keep = p.keep })
     lab.progress(0.9, "analysing")
     local table2 = {}
     for _, row in ipairs(t.rows) do

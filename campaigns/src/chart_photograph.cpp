@@ -9,6 +9,7 @@
 #include <boost/asio/use_awaitable.hpp>
 
 #include "chart_sampling.hpp"
+#include "frame_keeping.hpp"
 #include "colorlab/core/error.hpp"
 #include "colorlab/drivers/camera/asio_camera.hpp"
 #include "colorlab/drivers/camera/camera_instrument.hpp"
@@ -28,12 +29,16 @@ struct PhotographOptions {
   int frames = 25;
   std::vector<std::string> formats = kFormats;
   detail::SamplingOptions sampling;
+  detail::KeepOptions keep;
 };
 
 PhotographOptions parse(const json& o) {
   PhotographOptions p;
   auto bad = [](const std::string& what) { return Error(ErrorClass::bad_parameter, "lab.camera.photograph_chart: " + what); };
   if (!o.is_object() && !(o.is_array() && o.empty())) throw bad("takes a table {frames=, chart=, formats=, camera=, reference=}");
+  // What a lab wants back of a photograph: the averaged raw and one raw as captured (a preview to glance at).
+  p.keep = detail::parse_keep(o, "camera.photograph_chart", {"average", "raw", "tiff16", "tiff8", "jpeg", "preview"},
+                              {"average", "raw", "preview"});
   if (!o.is_object()) return p;
   if (o.contains("frames")) {
     if (!o["frames"].is_number_integer() || o["frames"].get<int>() < 1 || o["frames"].get<int>() > 256) throw bad("frames must be an integer from 1 to 256");
@@ -107,6 +112,8 @@ struct RawSum {
   cam::CfaPattern cfa;
   double black = 0;
   int bits = 16;
+  std::array<std::uint16_t, 4> blacks{};
+  std::uint16_t white = 0;
 };
 
 int significant_bits(const cam::RawImage& image) {
@@ -138,9 +145,12 @@ std::map<std::string, detail::AveragedPhoto> average_sidecars(const std::vector<
 }
 
 // Runs on the worker pool: average the processed files, locate and sample every photograph.
+// Returns {formats, blobs}: the frames are kept only once every photograph was located and sampled.
 asio::awaitable<json> sample_all(std::shared_ptr<RawSum> raw, std::vector<std::filesystem::path> sidecars,
-                                 PhotographOptions p, std::string camera_name) {
+                                 std::vector<std::filesystem::path> raw_files, PhotographOptions p, std::string camera_name,
+                                 FrameKeeper* keeper) {
   json formats = json::object();
+  const bool keeping = keeper && p.keep.any();
   if (wants(p, "raw")) {
     detail::AveragedPhoto a;
     a.format = "raw";
@@ -157,7 +167,7 @@ asio::awaitable<json> sample_all(std::shared_ptr<RawSum> raw, std::vector<std::f
     auto* dst = reinterpret_cast<std::uint16_t*>(a.photo.bytes.data());
     const double k = a.scale / raw->frames;
     for (std::size_t i = 0; i < raw->sum.size(); ++i) dst[i] = static_cast<std::uint16_t>(std::min(65535.0, std::round(raw->sum[i] * k)));
-    raw->sum = {};
+    if (!keeping) raw->sum = {};
     formats["raw"] = detail::locate_and_sample(a, p.sampling);
   }
   auto processed = average_sidecars(sidecars, p);
@@ -170,7 +180,26 @@ asio::awaitable<json> sample_all(std::shared_ptr<RawSum> raw, std::vector<std::f
     }
     formats[format] = detail::locate_and_sample(it->second, p.sampling);
   }
-  co_return formats;
+  json blobs = json::array();
+  if (keeping) {
+    detail::SeriesFrames series;
+    if (wants(p, "raw") && raw->frames > 0) {
+      series.sum = std::move(raw->sum);
+      series.width = static_cast<std::size_t>(raw->width);
+      series.height = static_cast<std::size_t>(raw->height);
+      series.frames = raw->frames;
+      series.cfa = raw->cfa.is_mosaic() ? raw->cfa.name() : "mono";
+      series.black = raw->blacks;
+      series.white = raw->white;
+    }
+    detail::KeepRequest request{p.keep, "raw/", &series, {}, {}};
+    if (wants(p, "raw") && !raw_files.empty()) request.raw_files.push_back(raw_files.front());
+    for (const auto& [format, photo] : processed) {
+      if (!photo.files.empty()) request.processed.emplace_back(format, photo.files.front());
+    }
+    blobs = detail::keep_now(*keeper, request);
+  }
+  co_return json{{"formats", formats}, {"blobs", blobs}};
 }
 
 // One thread for chart work: a second campaign's photographs wait rather than take both cores
@@ -203,7 +232,7 @@ std::shared_ptr<cam::CameraInstrument> select_camera(const InstrumentSet& instru
                               : "the configured cameras are " + cameras);
 }
 
-asio::awaitable<json> photograph_chart(cam::CameraInstrument& instrument, const json& options) {
+asio::awaitable<json> photograph_chart(cam::CameraInstrument& instrument, const json& options, FrameKeeper* keeper) {
   const PhotographOptions p = parse(options);
   auto& camera = instrument.camera();
   const bool tiff = wants(p, "tiff8") || wants(p, "tiff16");
@@ -234,6 +263,8 @@ asio::awaitable<json> photograph_chart(cam::CameraInstrument& instrument, const 
       r.sum.assign(image.width * image.height, 0);
       r.cfa = image.cfa;
       r.black = image.black_level[0];
+      r.blacks = image.black_level;
+      r.white = image.white_level;
       r.bits = significant_bits(image);
     } else if (static_cast<int>(image.width) != r.width || static_cast<int>(image.height) != r.height) {
       throw Error(ErrorClass::bad_data, "frame " + std::to_string(image.frame_index) + " is " + std::to_string(image.width) + "×" +
@@ -256,18 +287,21 @@ asio::awaitable<json> photograph_chart(cam::CameraInstrument& instrument, const 
     throw Error(ErrorClass::hardware_fail, "the camera delivered " + std::to_string(report.delivered) + " of " +
                                                std::to_string(report.requested) + " frames");
   }
-  std::vector<std::filesystem::path> sidecars;
+  std::vector<std::filesystem::path> sidecars, raw_files;
   for (const auto& f : report.saved_files) {
+    if (detail::is_raw_file(f)) raw_files.push_back(f);
     std::string ext = f.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
     if (ext == ".jpg" || ext == ".jpeg" || ext == ".tif" || ext == ".tiff") sidecars.push_back(f);
   }
-  json formats = co_await asio::co_spawn(chart_worker(), sample_all(raw, std::move(sidecars), p, camera.name()),
+  json sampled = co_await asio::co_spawn(chart_worker(),
+                                         sample_all(raw, std::move(sidecars), std::move(raw_files), p, camera.name(), keeper),
                                          asio::use_awaitable);
   co_return json{{"instrument", instrument.id()},
                  {"chart", std::string(ca::to_string(p.sampling.chart))},
                  {"frames", p.frames},
-                 {"formats", formats}};
+                 {"formats", sampled["formats"]},
+                 {"blobs", sampled["blobs"]}};
 }
 
 }  // namespace colorlab::campaigns

@@ -9,6 +9,7 @@
 #include "colorlab/core/error.hpp"
 #include "colorlab/drivers/camera/asio_camera.hpp"
 #include "colorlab/drivers/camera/camera_instrument.hpp"
+#include "frame_keeping.hpp"
 
 namespace colorlab::campaigns {
 
@@ -65,8 +66,12 @@ void choose_uniform_region(const cam::RawImage& image, RegionFrames& g) {
 
 }  // namespace
 
-boost::asio::awaitable<json> capture_noise_table(cam::CameraInstrument& instrument, const json& options) {
+boost::asio::awaitable<json> capture_noise_table(cam::CameraInstrument& instrument, const json& options, FrameKeeper* keeper) {
   const int frames = options.value("frames", 25);
+  const auto keep = detail::parse_keep(options, "camera.capture", {"average", "raw", "preview"}, {"average", "raw", "preview"});
+  auto series = std::make_shared<detail::SeriesFrames>();
+  series->keep_first = keep.wants("raw");
+  const bool keeping = keeper && keep.any();
   if (frames < 1 || frames > 256) throw Error(ErrorClass::bad_parameter, "camera.capture: frames must be from 1 to 256");
   auto& camera = instrument.camera();
   // Averaging needs the sensor's counts: ask a GenICam camera for its raw Bayer (or mono) format.
@@ -94,7 +99,8 @@ boost::asio::awaitable<json> capture_noise_table(cam::CameraInstrument& instrume
     if (region->width < 4 || region->height < 4) throw Error(ErrorClass::bad_parameter, "camera.capture: region width and height must be ≥ 4");
   }
   // Runs on the camera's decode thread; the campaign reads `region` only after the series ends.
-  auto sink = [region](const cam::RawImage& image) {
+  auto sink = [region, series, keeping](const cam::RawImage& image) {
+    if (keeping) series->add(image);
     auto& g = *region;
     if (g.width == 0) choose_uniform_region(image, g);
     if (g.x + g.width > image.width || g.y + g.height > image.height) {
@@ -133,6 +139,13 @@ boost::asio::awaitable<json> capture_noise_table(cam::CameraInstrument& instrume
                                                std::to_string(report.requested) + " frames");
   }
 
+  detail::KeepRequest kept{keep, "", series.get(), {}, {}};
+  for (const auto& f : report.saved_files) {
+    if (detail::is_raw_file(f)) kept.raw_files.push_back(f);
+  }
+  json blobs = json::array();
+  if (keeping) blobs = co_await detail::keep_on_worker(keeper, std::move(kept));
+
   std::vector<std::size_t> subsets;
   for (std::size_t n : analysis::kTable2Subsets) {
     if (n <= static_cast<std::size_t>(frames)) subsets.push_back(n);
@@ -154,7 +167,8 @@ boost::asio::awaitable<json> capture_noise_table(cam::CameraInstrument& instrume
                  {"region", {region->x, region->y, region->width, region->height}},
                  {"rows", rows},
                  {"instrument", instrument.id()},
-                 {"unit", "DN above black"}};
+                 {"unit", "DN above black"},
+                 {"blobs", blobs}};
 }
 
 }  // namespace colorlab::campaigns

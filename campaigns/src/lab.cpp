@@ -388,7 +388,7 @@ asio::awaitable<json> Lab::perform(const std::string& call, const json& args, co
     if (call == "camera.capture") {
       // Named, not a temporary in the co_await: GCC 12 destroys such temporaries twice.
       json options = args.empty() ? json::object() : args[0];
-      json table = co_await capture_noise_table(*camera, options);
+      json table = co_await capture_noise_table(*camera, options, keeper_);
       co_return table;
     }
     cam::CameraSettings s;
@@ -416,7 +416,7 @@ asio::awaitable<json> Lab::perform(const std::string& call, const json& args, co
     } else {
       camera = co_await acquire<cam::CameraInstrument>("camera");
     }
-    json photographs = co_await photograph_chart(*camera, options);
+    json photographs = co_await photograph_chart(*camera, options, keeper_);
     co_return photographs;
   }
   if (call == "runs.chart_reference") {

@@ -11,6 +11,7 @@
 #include <boost/asio/awaitable.hpp>
 #include <nlohmann/json.hpp>
 
+#include "colorlab/campaigns/frame_keeper.hpp"
 #include "colorlab/campaigns/instrument_set.hpp"
 
 namespace colorlab::drivers::camera {
@@ -25,12 +26,16 @@ std::shared_ptr<drivers::camera::CameraInstrument> select_camera(const Instrumen
                                                                  const nlohmann::json& id_or_kind);
 
 // options: {frames = 25 (1..256), chart = "sg" | "cc24", formats = {"raw", "tiff16", "tiff8", "jpeg"},
-// sample_fraction = 0.6, min_confidence = 0.6, camera = id (used by the caller to choose)}.
+// sample_fraction = 0.6, min_confidence = 0.6, camera = id (used by the caller to choose),
+// keep = {"average", "raw", "preview"} (of average, raw, tiff16, tiff8, jpeg, preview: what goes into
+// the keeper once every photograph was sampled — the averaged raw as a float array, the first raw as
+// captured, the first frame's processed files, a PNG preview of the average)}.
 // Returns {instrument, chart, frames, formats = {<format> = {confidence, rotation_deg, corners,
-// patches_detected, reprojection_rms_px, check, ids, values = [[r, g, b], …], …}}}.
+// patches_detected, reprojection_rms_px, check, ids, values = [[r, g, b], …], …}}, blobs = [kept blob
+// references]}.
 // Throws Error(unsupported) when the camera cannot deliver a format, the locator's Error when a
 // photograph does not show the chart clearly.
 boost::asio::awaitable<nlohmann::json> photograph_chart(drivers::camera::CameraInstrument& camera,
-                                                        const nlohmann::json& options);
+                                                        const nlohmann::json& options, FrameKeeper* keeper = nullptr);
 
 }  // namespace colorlab::campaigns

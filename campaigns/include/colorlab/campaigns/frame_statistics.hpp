@@ -6,15 +6,19 @@
 #include <boost/asio/awaitable.hpp>
 #include <nlohmann/json.hpp>
 
+#include "colorlab/campaigns/frame_keeper.hpp"
+
 namespace colorlab::drivers::camera {
 class CameraInstrument;
 }
 
 namespace colorlab::campaigns {
 
-// options: {frames = 25, region = {x, y, w, h} | {}}; returns
-// {frames, region = {x, y, w, h}, rows = [{frames, channel, stdev, mean}], unit = "DN above black"}.
+// options: {frames = 25, region = {x, y, w, h} | {}, keep = {"average", "raw", "preview"}}; returns
+// {frames, region = {x, y, w, h}, rows = [{frames, channel, stdev, mean}], unit = "DN above black",
+// blobs = [kept blob references]}. `keep` (with a keeper): the series' average as a float array, the
+// first frame as captured (its raw file, or its counts as a <u2 array), a PNG preview of the average.
 boost::asio::awaitable<nlohmann::json> capture_noise_table(drivers::camera::CameraInstrument& camera,
-                                                           const nlohmann::json& options);
+                                                           const nlohmann::json& options, FrameKeeper* keeper = nullptr);
 
 }  // namespace colorlab::campaigns

@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "colorlab/campaigns/control.hpp"
+#include "colorlab/campaigns/frame_keeper.hpp"
 #include "colorlab/campaigns/instrument_set.hpp"
 #include "colorlab/campaigns/lab_state.hpp"
 #include "colorlab/campaigns/light_reference.hpp"
@@ -93,6 +94,9 @@ class Lab {
 
   // Where lab.runs.* reads earlier runs (the daemon's store); without one those calls fail.
   void set_run_reader(RunReader* runs) { runs_ = runs; }
+  // Where frames worth keeping go (the daemon's blob store); without one nothing is kept.
+  void set_frame_keeper(FrameKeeper* keeper) { keeper_ = keeper; }
+  FrameKeeper* frame_keeper() const { return keeper_; }
   // What a dry run of a campaign on this lab needs to know of it.
   const OperatorHands* hands() const { return hands_; }
   RunReader* run_reader() const { return runs_; }
@@ -154,6 +158,7 @@ class Lab {
   OperatorDesk* desk_ = nullptr;
   OperatorHands* hands_ = nullptr;
   RunReader* runs_ = nullptr;
+  FrameKeeper* keeper_ = nullptr;
 };
 
 }  // namespace colorlab::campaigns
