@@ -64,7 +64,7 @@ fs::path target_path(const ExportOptions& o, const client::RawResponse& r) {
   std::string name;
   for (const auto& [field, value] : r.headers) {
     std::smatch m;
-    if (strcasecmp(field.c_str(), "content-disposition") == 0 && std::regex_search(value, m, std::regex(R"(filename="?([^";]+)"?)")))
+    if (strcasecmp(field.c_str(), "content-disposition") == 0 && std::regex_search(value, m, std::regex(R"re(filename="?([^";]+)"?)re")))
       name = fs::path(m[1].str()).filename().string();
   }
   return out / (name.empty() || name == "." || name == ".." ? o.run + "." + o.format : name);

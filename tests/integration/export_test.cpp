@@ -81,6 +81,13 @@ std::filesystem::path save(const std::filesystem::path& path, const std::string&
   return path;
 }
 
+// run_command execs a path, not a name looked up on PATH.
+std::string tool(const std::string& name) {
+  std::string path = shell_output("command -v " + name);
+  while (!path.empty() && (path.back() == '\n' || path.back() == ' ')) path.pop_back();
+  return path.empty() ? name : path;
+}
+
 #define REQUIRE_ARGYLL(tool)                                                          \
   if (!on_path(tool)) GTEST_SKIP() << tool << " (ArgyllCMS) is not installed: scripts/setup.sh installs argyll"
 
@@ -88,7 +95,7 @@ std::filesystem::path save(const std::filesystem::path& path, const std::string&
 // integrator and Argyll's agree within 0.07 on 10 nm reflectances under D50, 2° (analysis_spec2cie_test).
 void expect_spec2cie_agrees(const std::filesystem::path& ti3, std::size_t patches) {
   const auto out = ti3.parent_path() / (ti3.stem().string() + "-spec2cie.ti3");
-  auto r = run_command({"spec2cie", "-i", "D50", "-o", "1931_2", ti3.string(), out.string()});
+  auto r = run_command({tool("spec2cie"), "-i", "D50", "-o", "1931_2", ti3.string(), out.string()});
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
   const auto in = analysis::read_cgats(ti3), back = analysis::read_cgats(out);
   ASSERT_EQ(back.rows.size(), patches);
@@ -139,10 +146,10 @@ TEST_F(Exports, CharacterizationTi3MakesAnArgyllProfileThatProfcheckAccepts) {
   // patch's values beside another's colour, or channels out of scale) shows as tens of ΔE; a camera whose
   // raw is linear in the light fits its chart within a few.
   const auto base = lab->dir / "camera";
-  auto made = run_command({"colprof", "-v", "-qm", "-ax", base.string()}, std::chrono::seconds(300));
+  auto made = run_command({tool("colprof"), "-v", "-qm", "-ax", base.string()}, std::chrono::seconds(300));
   ASSERT_EQ(made.exit_code, 0) << made.out << made.err;
   ASSERT_TRUE(std::filesystem::exists(base.string() + ".icc"));
-  auto check = run_command({"profcheck", ti3.string(), base.string() + ".icc"}, std::chrono::seconds(120));
+  auto check = run_command({tool("profcheck"), ti3.string(), base.string() + ".icc"}, std::chrono::seconds(120));
   ASSERT_EQ(check.exit_code, 0) << check.out << check.err;
   std::smatch m;
   const std::string text = check.out + check.err;
