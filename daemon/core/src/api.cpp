@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include "colorlab/core/error.hpp"
+#include "colorlab/daemon/blob_api.hpp"
 #include "colorlab/daemon/queue_api.hpp"
 #include "colorlab/protocol/api.hpp"
 #include "colorlab/protocol/problem.hpp"
@@ -261,6 +262,7 @@ HttpResponse handle_api(ApiContext& ctx, const HttpRequest& req) {
       }
     }
     if (auto queue = handle_queue_api(ctx, req)) return *queue;
+    if (auto blob = handle_blob_api(ctx, req)) return *blob;
     if (p == prefix + "/runs") {
       if (req.method != "GET") return method_not_allowed(req, "GET");
       return get_runs(ctx, req);

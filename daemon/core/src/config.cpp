@@ -1,5 +1,7 @@
 #include "colorlab/daemon/config.hpp"
 
+#include <algorithm>
+
 #include <toml++/toml.h>
 
 #include "colorlab/core/toml_json.hpp"
@@ -53,6 +55,38 @@ namespace {
 [[noreturn]] void bad(const std::filesystem::path& file, const toml::source_region& where, const std::string& what) {
   throw Error(ErrorClass::bad_parameter,
               file.string() + ":" + std::to_string(where.begin.line) + ": " + what, "see docs/configuration.md");
+}
+
+// [blobs]: retention of the image store (docs/configuration.md).
+void parse_blobs(const toml::node& node, BlobConfig& b, const std::filesystem::path& file) {
+  auto t = node.as_table();
+  if (!t) bad(file, node.source(), "[blobs] must be a table");
+  for (const auto& [bkey, bnode] : *t) {
+    std::string bk(bkey.str());
+    if (bk == "retention_days") {
+      auto v = bnode.value<double>();
+      if (!v || !(*v >= 0 && *v <= 36500)) bad(file, bnode.source(), "blobs.retention_days must be a number from 0 (for ever) to 36500");
+      b.retention_days = *v;
+    } else if (bk == "keep") {
+      auto arr = bnode.as_array();
+      if (!arr) bad(file, bnode.source(), "blobs.keep must be a list of kinds, e.g. [\"raw\", \"average\"]");
+      b.keep.clear();
+      for (const auto& item : *arr) {
+        auto v = item.value<std::string>();
+        static const std::vector<std::string> kinds = {"raw", "average", "tiff16", "tiff8", "jpeg", "preview"};
+        if (!v || std::find(kinds.begin(), kinds.end(), *v) == kinds.end()) {
+          bad(file, item.source(), "blobs.keep names raw, average, tiff16, tiff8, jpeg or preview");
+        }
+        b.keep.push_back(*v);
+      }
+    } else if (bk == "verify_hashes") {
+      auto v = bnode.value<bool>();
+      if (!v) bad(file, bnode.source(), "blobs.verify_hashes must be true or false");
+      b.verify_hashes = *v;
+    } else {
+      bad(file, bnode.source(), "unknown key 'blobs." + bk + "'");
+    }
+  }
 }
 
 
@@ -151,6 +185,8 @@ DaemonConfig load_config(const std::filesystem::path& file) {
           bad(file, qnode.source(), "unknown key 'queue." + qk + "'");
         }
       }
+    } else if (k == "blobs") {
+      parse_blobs(node, c.blobs, file);
     } else if (k == "instrument") {
       auto arr = node.as_array();
       if (!arr) bad(file, node.source(), "instruments are [[instrument]] tables");

@@ -17,6 +17,7 @@
 #include "colorlab/campaigns/catalogue.hpp"
 #include "colorlab/campaigns/lab.hpp"
 #include "colorlab/daemon/api.hpp"
+#include "colorlab/daemon/blob_service.hpp"
 #include "colorlab/daemon/embedded_sim.hpp"
 #include "colorlab/daemon/executions.hpp"
 #include "colorlab/daemon/simulator_hands.hpp"
@@ -35,6 +36,7 @@ struct Daemon::Impl {
   asio::io_context io{1};
   std::unique_ptr<EmbeddedSim> sim;
   std::unique_ptr<store::Store> store;
+  std::unique_ptr<BlobService> blobs;  // the image store (blob_service.hpp)
   campaigns::InstrumentSet instruments;
   std::unique_ptr<campaigns::ScriptCatalogue> catalogue;
   std::unique_ptr<campaigns::Lab> lab;
@@ -95,6 +97,8 @@ Daemon::Daemon(DaemonConfig config) : impl_(std::make_unique<Impl>()) {
   d.config = std::move(config);
   // The database first: if it is unusable, nothing else should start.
   d.store = std::make_unique<store::Store>(d.config.database_path());
+  d.blobs = std::make_unique<BlobService>(d.io, *d.store, d.config.state_dir, d.config.blobs);
+  d.blobs->start_check();  // files without rows, rows without files: reported, never deleted
 
   auto instrument_configs = d.config.instruments;
   if (d.config.simulator.enabled) {
@@ -145,6 +149,7 @@ Daemon::Daemon(DaemonConfig config) : impl_(std::make_unique<Impl>()) {
   d.lab->set_operator(&d.desk, d.hands.get());
   d.run_reader = std::make_unique<StoreRunReader>(*d.store);
   d.lab->set_run_reader(d.run_reader.get());
+  d.lab->set_frame_keeper(d.blobs.get());
   d.desk.set_listener([&d](const std::string& event, const campaigns::OperatorRequest& r) {
     log::info("operator", event + ": " + r.prompt + (r.answer ? " → " + *r.answer + " (" + r.answered_by + ")" : ""));
     try {
@@ -161,6 +166,7 @@ Daemon::Daemon(DaemonConfig config) : impl_(std::make_unique<Impl>()) {
   d.api = std::make_unique<ApiContext>(ApiContext{*d.store, d.instruments, *d.catalogue, *d.executions,
                                                   d.config.simulator.enabled, now_iso8601(), d.discovery.get(), "",
                                                   &d.desk, d.queue.get()});
+  d.api->blobs = d.blobs.get();
 
   http::ServerOptions so;
   so.tcp_host = d.config.listen_host;

@@ -11,6 +11,7 @@
 #include "colorlab/campaigns/engine.hpp"
 #include "colorlab/core/error.hpp"
 #include "colorlab/core/log.hpp"
+#include "colorlab/daemon/blob_service.hpp"
 #include "colorlab/daemon/campaign_request.hpp"
 #include "colorlab/protocol/problem.hpp"
 
@@ -51,7 +52,10 @@ class StoreSink final : public campaigns::ExecutionSink {
     s.progress = step.progress;
     s.step = step.label;
     s.instruments = updated_snapshot();
-    for (const auto& j : step.journal) s.journal.push_back({j.seq, j.call, j.args, j.result});
+    for (const auto& j : step.journal) {
+      s.journal.push_back({j.seq, j.call, j.args, j.result});
+      for (auto& b : step_blobs(j.call, j.seq, j.result)) s.blobs.push_back(std::move(b));
+    }
     for (const auto& t : step.timings) s.timings.push_back({t.key, t.lab_seconds});
     s.time_scale = time_scale_;
     for (const auto& m : step.measurements) {

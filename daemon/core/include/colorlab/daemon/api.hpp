@@ -14,6 +14,7 @@
 namespace colorlab::daemon {
 
 class NightQueue;
+class BlobService;
 
 struct ApiContext {
   store::Store& store;
@@ -26,6 +27,7 @@ struct ApiContext {
   std::string hotplug_status;
   campaigns::OperatorDesk* desk = nullptr;
   NightQueue* queue = nullptr;  // /v1/queue (queue_api.cpp)
+  BlobService* blobs = nullptr;  // /v1/blobs, /v1/runs/{id}/blobs (blob_api.cpp)
 };
 
 http::HttpResponse handle_api(ApiContext& ctx, const http::HttpRequest& req);

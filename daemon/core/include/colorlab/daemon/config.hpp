@@ -40,6 +40,13 @@ struct QueueConfig {
   bool autostart = false;  // start the queue with the daemon (unless a failed item halted it)
 };
 
+// [blobs]: the image store under <state_dir>/blobs (docs/configuration.md).
+struct BlobConfig {
+  double retention_days = 0;      // 0: blobs are kept for ever
+  std::vector<std::string> keep;  // kinds retention never removes ("raw", "average", …)
+  bool verify_hashes = true;      // the start-up check hashes every file (false: sizes only)
+};
+
 struct DaemonConfig {
   std::filesystem::path state_dir = "./colorlab-state";
   std::string listen_host = "127.0.0.1";
@@ -49,6 +56,7 @@ struct DaemonConfig {
   SimulatorConfig simulator;
   CampaignConfig campaigns;
   QueueConfig queue;
+  BlobConfig blobs;
 
   std::filesystem::path database_path() const;
   std::filesystem::path socket_path() const;

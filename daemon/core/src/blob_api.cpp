@@ -1,0 +1,268 @@
+#include "colorlab/daemon/blob_api.hpp"
+
+#include <cctype>
+#include <charconv>
+
+#include <nlohmann/json.hpp>
+
+#include "colorlab/campaigns/frame_keeper.hpp"
+#include "colorlab/core/error.hpp"
+#include "colorlab/daemon/blob_service.hpp"
+#include "colorlab/protocol/api.hpp"
+#include "colorlab/store/blob_index.hpp"
+
+namespace colorlab::daemon {
+
+namespace fs = std::filesystem;
+using http::HttpRequest;
+using http::HttpResponse;
+using nlohmann::json;
+
+namespace {
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
+  return s;
+}
+
+std::optional<std::uint64_t> number(std::string_view s) {
+  if (s.empty() || s.size() > 19) return std::nullopt;
+  std::uint64_t v = 0;
+  auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc() || end != s.data() + s.size()) return std::nullopt;
+  return v;
+}
+
+// Read routes run on the server's pool with their own read-only connection.
+// TODO(lead): ctx.reads() once ApiContext has it; until then the writer connection.
+store::Store& reads(ApiContext& ctx) { return ctx.store; }
+
+BlobService& service(ApiContext& ctx) {
+  if (!ctx.blobs) throw Error(ErrorClass::unsupported, "this daemon keeps no blob store");
+  return *ctx.blobs;
+}
+
+HttpResponse method_not_allowed(const HttpRequest& req, const std::string& allowed) {
+  auto r = HttpResponse::problem(405, "method-not-allowed", "Method not allowed",
+                                 req.method + " is not allowed on " + req.path, "allowed: " + allowed);
+  r.headers["Allow"] = allowed;
+  return r;
+}
+
+store::BlobRecord require_blob(ApiContext& ctx, const std::string& sha256) {
+  if (!store::BlobStore::is_sha256(sha256)) {
+    throw Error(ErrorClass::not_found, "no blob named '" + sha256.substr(0, 80) + "'",
+                "a blob is named by the 64 lower-case hex digits of its SHA-256 (GET /v1/runs/{id}/blobs lists a run's)");
+  }
+  auto row = store::BlobIndex(reads(ctx)).blob(sha256);
+  if (!row) throw Error(ErrorClass::not_found, "no blob " + sha256, "GET /v1/runs/{id}/blobs lists a run's blobs");
+  return *row;
+}
+
+std::string join_shape(const json& shape) {
+  std::string out;
+  for (const auto& d : shape) out += (out.empty() ? "" : ",") + std::to_string(d.get<long long>());
+  return out;
+}
+
+// Everything a GET and a HEAD of the blob share, before the body: identity, type and caching. The
+// bytes of a name never change, so a client may keep them for good.
+void describe(HttpResponse& r, const store::BlobRecord& blob, const std::string& etag) {
+  r.headers["ETag"] = etag;
+  r.headers["Accept-Ranges"] = "bytes";
+  r.headers["Cache-Control"] = "public, max-age=31536000, immutable";
+  if (blob.media_type == campaigns::kArrayMediaType) {
+    const json& m = blob.meta;
+    if (m.contains("dtype") && m["dtype"].is_string()) r.headers["X-Colorlab-Dtype"] = m["dtype"].get<std::string>();
+    if (m.contains("shape") && m["shape"].is_array()) r.headers["X-Colorlab-Shape"] = join_shape(m["shape"]);
+    if (m.contains("cfa") && m["cfa"].is_string()) r.headers["X-Colorlab-Cfa"] = m["cfa"].get<std::string>();
+  }
+}
+
+HttpResponse get_blob(ApiContext& ctx, const HttpRequest& req, const std::string& sha256) {
+  const store::BlobRecord blob = require_blob(ctx, sha256);
+  const fs::path path = service(ctx).files().path_of(sha256);
+  std::error_code ec;
+  const auto size = fs::file_size(path, ec);
+  if (ec) {
+    throw Error(ErrorClass::not_found, "the file of blob " + sha256 + " is missing from the blob store",
+                "GET /v1/blobs/check lists what the store lacks");
+  }
+  const std::string etag = "\"" + sha256 + "\"";
+  HttpResponse r;
+  r.content_type = blob.media_type;
+  describe(r, blob, etag);
+  if (auto inm = req.header("if-none-match"); inm && none_match_hits(*inm, etag)) {
+    r.status = 304;
+    return r;
+  }
+  ByteRange range;
+  if (auto h = req.header("range")) {
+    range = parse_byte_range(*h, size);
+    // If-Range compares strongly: a weak or another tag (or a date: ours never changes, yet we
+    // have no Last-Modified to compare with) means "send it whole".
+    if (auto ir = req.header("if-range"); ir && trim(*ir) != etag) range.kind = ByteRange::Kind::whole;
+  }
+  if (range.kind == ByteRange::Kind::unsatisfiable) {
+    auto p = HttpResponse::problem(416, "range-not-satisfiable", "Range not satisfiable",
+                                   "blob " + sha256 + " has " + std::to_string(size) + " bytes; the range asked for starts beyond them");
+    describe(p, blob, etag);
+    p.headers["Content-Range"] = "bytes */" + std::to_string(size);
+    return p;
+  }
+  r.status = 200;
+  std::uint64_t offset = 0, length = size;
+  if (range.kind == ByteRange::Kind::partial) {
+    r.status = 206;
+    offset = range.first;
+    length = range.last - range.first + 1;
+    r.headers["Content-Range"] = "bytes " + std::to_string(range.first) + "-" + std::to_string(range.last) + "/" + std::to_string(size);
+  }
+  r.file = http::FileSpan{path, offset, length};
+  return r;
+}
+
+HttpResponse get_preview(ApiContext& ctx, const HttpRequest& req, const std::string& sha256) {
+  const store::BlobRecord blob = require_blob(ctx, sha256);
+  const fs::path png = service(ctx).preview_path(reads(ctx), blob);
+  std::error_code ec;
+  const auto size = fs::file_size(png, ec);
+  if (ec) throw Error(ErrorClass::not_found, "the preview of blob " + sha256 + " is gone");
+  // Weak: the same frame's preview may be rendered anew by a later version, with other bytes.
+  const std::string etag = "W/\"preview-" + sha256 + "\"";
+  HttpResponse r;
+  r.content_type = "image/png";
+  r.headers["ETag"] = etag;
+  r.headers["Cache-Control"] = "public, max-age=86400";
+  if (auto inm = req.header("if-none-match"); inm && none_match_hits(*inm, etag)) {
+    r.status = 304;
+    return r;
+  }
+  r.file = http::FileSpan{png, 0, size};
+  return r;
+}
+
+json blob_links(const std::string& sha256) {
+  const std::string self = std::string(protocol::kPrefix) + "/blobs/" + sha256;
+  return json{{"self", self}, {"preview", self + "/preview.png"}};
+}
+
+HttpResponse get_run_blobs(ApiContext& ctx, const std::string& run_id) {
+  store::Store& db = reads(ctx);
+  if (!db.run(run_id)) throw Error(ErrorClass::not_found, "no run with id '" + run_id + "'");
+  json items = json::array();
+  for (const auto& b : store::BlobIndex(db).of_run(run_id)) {
+    items.push_back({{"name", b.name},
+                     {"sha256", b.blob.sha256},
+                     {"kind", b.kind},
+                     {"step", b.step},
+                     {"media_type", b.blob.media_type},
+                     {"size", b.blob.size},
+                     {"meta", b.blob.meta},
+                     {"created_at", b.created_at},
+                     {"links", blob_links(b.blob.sha256)}});
+  }
+  return HttpResponse::json(200, {{"run_id", run_id}, {"items", items}});
+}
+
+HttpResponse post_retention(ApiContext& ctx, const HttpRequest& req) {
+  bool dry_run = false;
+  if (auto it = req.query.find("dry_run"); it != req.query.end()) {
+    if (it->second != "true" && it->second != "false" && it->second != "1" && it->second != "0") {
+      throw Error(ErrorClass::bad_parameter, "dry_run must be true or false");
+    }
+    dry_run = it->second == "true" || it->second == "1";
+  }
+  return HttpResponse::json(200, service(ctx).apply_retention(dry_run));
+}
+
+}  // namespace
+
+ByteRange parse_byte_range(std::string_view header, std::uint64_t size) {
+  ByteRange whole;
+  std::string_view h = trim(header);
+  constexpr std::string_view unit = "bytes=";
+  if (h.size() < unit.size()) return whole;
+  for (std::size_t i = 0; i < unit.size(); ++i) {
+    if (std::tolower(static_cast<unsigned char>(h[i])) != unit[i]) return whole;
+  }
+  h = trim(h.substr(unit.size()));
+  if (h.find(',') != std::string_view::npos) return whole;  // several ranges: the whole body (RFC 9110 allows it)
+  const auto dash = h.find('-');
+  if (dash == std::string_view::npos) return whole;
+  const std::string_view a = trim(h.substr(0, dash)), b = trim(h.substr(dash + 1));
+  ByteRange r;
+  r.kind = ByteRange::Kind::partial;
+  if (a.empty()) {  // suffix: the last N bytes
+    auto n = number(b);
+    if (!n) return whole;
+    if (*n == 0 || size == 0) return ByteRange{ByteRange::Kind::unsatisfiable};
+    r.first = size - std::min(*n, size);
+    r.last = size - 1;
+    return r;
+  }
+  auto first = number(a);
+  if (!first) return whole;
+  std::optional<std::uint64_t> last;
+  if (!b.empty()) {
+    last = number(b);
+    if (!last || *last < *first) return whole;  // invalid: ignored
+  }
+  if (*first >= size) return ByteRange{ByteRange::Kind::unsatisfiable};
+  r.first = *first;
+  r.last = last ? std::min(*last, size - 1) : size - 1;
+  return r;
+}
+
+bool none_match_hits(std::string_view if_none_match, std::string_view etag) {
+  auto opaque = [](std::string_view t) {
+    t = trim(t);
+    if (t.rfind("W/", 0) == 0) t.remove_prefix(2);
+    return t;
+  };
+  const std::string_view want = opaque(etag);
+  std::string_view rest = if_none_match;
+  while (!rest.empty()) {
+    const auto comma = rest.find(',');
+    const std::string_view tag = trim(rest.substr(0, comma));
+    if (tag == "*" || (!tag.empty() && opaque(tag) == want)) return true;
+    if (comma == std::string_view::npos) break;
+    rest.remove_prefix(comma + 1);
+  }
+  return false;
+}
+
+std::optional<HttpResponse> handle_blob_api(ApiContext& ctx, const HttpRequest& req) {
+  const std::string& p = req.path;
+  const std::string blobs = std::string(protocol::kPrefix) + "/blobs";
+  const std::string runs = std::string(protocol::kPrefix) + "/runs/";
+  const bool read = req.method == "GET" || req.method == "HEAD";
+  if (p.rfind(runs, 0) == 0 && p.size() > runs.size() + 6 && p.ends_with("/blobs") &&
+      p.find('/', runs.size()) == p.size() - 6) {
+    if (!read) return method_not_allowed(req, "GET, HEAD");
+    return get_run_blobs(ctx, p.substr(runs.size(), p.size() - 6 - runs.size()));
+  }
+  if (p.rfind(blobs + "/", 0) != 0) return std::nullopt;
+  const std::string rest = p.substr(blobs.size() + 1);
+  if (rest == "check") {
+    if (!read) return method_not_allowed(req, "GET, HEAD");
+    return HttpResponse::json(200, service(ctx).check_report());
+  }
+  if (rest == "retention") {
+    if (req.method != "POST") return method_not_allowed(req, "POST");
+    return post_retention(ctx, req);
+  }
+  const auto slash = rest.find('/');
+  if (slash == std::string::npos) {
+    if (!read) return method_not_allowed(req, "GET, HEAD");
+    return get_blob(ctx, req, rest);
+  }
+  if (rest.substr(slash) == "/preview.png") {
+    if (!read) return method_not_allowed(req, "GET, HEAD");
+    return get_preview(ctx, req, rest.substr(0, slash));
+  }
+  return std::nullopt;
+}
+
+}  // namespace colorlab::daemon
