@@ -1,6 +1,5 @@
 #include "export_commands.hpp"
 
-#include <cctype>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -26,26 +25,13 @@ struct ExportOptions {
   std::string output;
 };
 
-// Query values as RFC 3986 unreserved characters, everything else %XX.
-std::string encode(const std::string& text) {
-  static const char* hex = "0123456789ABCDEF";
-  std::string out;
-  for (unsigned char c : text) {
-    if (std::isalnum(c) || c == '-' || c == '.' || c == '_' || c == '~') {
-      out += static_cast<char>(c);
-    } else {
-      out += '%';
-      out += hex[c >> 4];
-      out += hex[c & 15];
-    }
-  }
-  return out;
-}
-
 // The bytes as sent; a refusal becomes ApiError with the server's problem (exit code 2).
 client::RawResponse fetch(const GlobalOptions& g, const ExportOptions& o) {
-  std::string target = "/v1/runs/" + encode(o.run) + "/export?format=" + encode(o.format);
-  if (!o.camera_format.empty()) target += "&camera_format=" + encode(o.camera_format);
+  // Checked rather than escaped: a run id is a UUID, and anything else would name another route.
+  if (o.run.empty() || o.run.find_first_not_of("0123456789abcdefABCDEF-") != std::string::npos)
+    throw Error(ErrorClass::bad_parameter, "'" + o.run + "' is not a run id", "colorlab runs lists them");
+  std::string target = "/v1/runs/" + o.run + "/export?format=" + o.format;
+  if (!o.camera_format.empty()) target += "&camera_format=" + o.camera_format;
   client::RawResponse r = make_client(g).request("GET", target);
   if (r.status >= 200 && r.status < 300) return r;
   protocol::Problem p;
@@ -88,7 +74,8 @@ void add_export_command(CLI::App& app, GlobalOptions& global) {
   cmd->add_option("run", o->run, "run id (colorlab runs lists them)")->required();
   cmd->add_option("-f,--format", o->format, "ti3, csv or json")->check(CLI::IsMember({"ti3", "csv", "json"}))->capture_default_str();
   cmd->add_option("--camera-format", o->camera_format,
-                  "for a characterize-camera .ti3: raw, tiff16, tiff8 or jpeg (default: the format the run selected)");
+                  "for a characterize-camera .ti3: raw, tiff16, tiff8 or jpeg (default: the format the run selected)")
+      ->check(CLI::IsMember({"raw", "tiff16", "tiff8", "jpeg"}));
   cmd->add_option("-o,--output", o->output, "file to write, or a directory for the daemon's file name (default: stdout)");
   cmd->callback([&global, o] {
     const auto r = fetch(global, *o);

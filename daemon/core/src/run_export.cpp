@@ -1,6 +1,8 @@
 #include "run_export.hpp"
 
 #include <algorithm>
+#include <array>
+#include <cctype>
 #include <map>
 
 #include "colorlab/analysis/chart_io.hpp"
@@ -91,12 +93,26 @@ std::vector<std::pair<std::string, std::string>> provenance(const store::RunReco
   return k;
 }
 
+struct FormatInfo {
+  Format format;
+  std::string_view name;  // the query's value and the file's extension
+  std::string_view media_type;
+};
+constexpr FormatInfo kFormats[] = {{Format::ti3, "ti3", "text/x-cgats"},
+                                   {Format::csv, "csv", "text/csv; charset=utf-8; header=present"},
+                                   {Format::json, "json", "application/json"}};
+
+const FormatInfo& info(Format f) {
+  for (const auto& k : kFormats)
+    if (k.format == f) return k;
+  throw Error(ErrorClass::internal, "export format without a table entry");
+}
+
 }  // namespace
 
 Format parse_format(std::string_view name) {
-  if (name == "ti3") return Format::ti3;
-  if (name == "csv") return Format::csv;
-  if (name == "json") return Format::json;
+  for (const auto& k : kFormats)
+    if (k.name == name) return k.format;
   throw Error(ErrorClass::bad_parameter, "format must be ti3, csv or json, not '" + std::string(name) + "'",
               "e.g. GET /v1/runs/{id}/export?format=csv");
 }
@@ -115,23 +131,9 @@ std::optional<Format> format_for_accept(std::string_view accept) {
   return std::nullopt;
 }
 
-std::string media_type(Format f) {
-  switch (f) {
-    case Format::ti3: return "text/x-cgats";
-    case Format::csv: return "text/csv; charset=utf-8; header=present";
-    case Format::json: return "application/json";
-  }
-  return "application/octet-stream";
-}
+std::string media_type(Format f) { return std::string(info(f).media_type); }
 
-std::string_view extension(Format f) {
-  switch (f) {
-    case Format::ti3: return "ti3";
-    case Format::csv: return "csv";
-    case Format::json: return "json";
-  }
-  return "bin";
-}
+std::string_view extension(Format f) { return info(f).name; }
 
 std::string file_name(const store::RunRecord& run, Format f, std::string_view part) {
   std::string name = run.campaign + "-" + run.id;
