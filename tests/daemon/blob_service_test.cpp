@@ -9,7 +9,9 @@
 #include <boost/asio/io_context.hpp>
 
 #include "colorlab/daemon/blob_api.hpp"
+#include "colorlab/core/error.hpp"
 #include "colorlab/daemon/blob_service.hpp"
+#include "colorlab/daemon/config.hpp"
 #include "colorlab/store/blob_index.hpp"
 #include "colorlab/testing/temp_dir.hpp"
 
@@ -172,4 +174,65 @@ TEST(BlobPreview, AFloatMosaicBecomesAHalfSizePng) {
   EXPECT_EQ(be32(16), w / 2);  // IHDR width
   EXPECT_EQ(be32(20), h / 2);  // IHDR height
   EXPECT_EQ(static_cast<int>(png[25]), 2);  // colour type 2: RGB
+}
+
+TEST(BlobRetention, RemovesOnlyOldBlobsOfKindsNotKeptAndSaysSo) {
+  TempDir dir;
+  boost::asio::io_context io;
+  colorlab::store::Store store(dir / "colorlab.db");
+  colorlab::daemon::BlobConfig config;
+  config.retention_days = 1.0 / 86400;  // one second
+  config.keep = {"average"};
+  BlobService blobs(io, store, dir.path(), config);
+  auto keep = [&](const std::string& s, const std::string& kind) {
+    return blobs.keep_bytes(kind, kind, "application/octet-stream", json::object(),
+                            std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(s.data()), s.size()));
+  };
+  auto raw = keep("a raw", "raw"), average = keep("an average", "average");
+  colorlab::store::NewRun r;
+  r.campaign = "frame-average";
+  r.params = json::object();
+  r.instruments = json::array();
+  r.script_sha256 = "s";
+  r.script_source = "x";
+  auto e = store.create_execution(r).execution;
+  colorlab::store::StepRecord step;
+  step.step = "s";
+  for (const auto& b : {raw, average}) step.blobs.push_back({b.sha256, b.name, b.kind, b.media_type, b.size, b.meta});
+  store.commit_step(e, step);
+
+  // Nothing is a second old yet.
+  EXPECT_EQ(blobs.apply_retention(false)["count"], 0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(1100));
+  const json dry = blobs.apply_retention(true);
+  EXPECT_EQ(dry["count"], 1);
+  EXPECT_TRUE(std::filesystem::exists(blobs.files().path_of(raw.sha256)));  // a dry run removes nothing
+  const json done = blobs.apply_retention(false);
+  ASSERT_EQ(done["count"], 1);
+  EXPECT_EQ(done["removed"][0]["sha256"], raw.sha256);
+  EXPECT_EQ(done["bytes"], raw.size);
+  EXPECT_FALSE(std::filesystem::exists(blobs.files().path_of(raw.sha256)));
+  EXPECT_TRUE(std::filesystem::exists(blobs.files().path_of(average.sha256)));  // a kind retention keeps
+  EXPECT_EQ(colorlab::store::BlobIndex(store).of_run(e.run_id).size(), 1u);
+  auto events = store.events(0, 100, std::string("blobs"));
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0].payload["event"], "retention");
+  EXPECT_EQ(events[0].payload["count"], 1);
+}
+
+TEST(BlobConfigFile, TheBlobsSectionIsReadAndCheckedWithItsLine) {
+  TempDir dir;
+  std::ofstream(dir / "good.toml") << "[blobs]\nretention_days = 30\nkeep = [\"raw\", \"average\"]\nverify_hashes = false\n";
+  auto c = colorlab::daemon::load_config(dir / "good.toml");
+  EXPECT_EQ(c.blobs.retention_days, 30);
+  EXPECT_EQ(c.blobs.keep, (std::vector<std::string>{"raw", "average"}));
+  EXPECT_FALSE(c.blobs.verify_hashes);
+  std::ofstream(dir / "bad.toml") << "[blobs]\nretention_days = 1\nkeep = [\"frames\"]\n";
+  try {
+    colorlab::daemon::load_config(dir / "bad.toml");
+    FAIL() << "an unknown kind was accepted";
+  } catch (const colorlab::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.toml:3"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("blobs.keep"), std::string::npos) << e.what();
+  }
 }

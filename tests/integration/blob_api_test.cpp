@@ -342,3 +342,97 @@ return {
   }
   FAIL() << "each of three kills came after the step had committed";
 }
+
+// kill -9 after the capture's step (files and rows) was committed: the resumed run answers the capture
+// from its journal — no new frames — and the run's blobs are exactly those it kept before the kill.
+TEST(BlobApi, AResumedRunKeepsTheBlobsItsJournalNames) {
+  TempDir dir;
+  write_dslr_lab(dir.path());
+  std::filesystem::create_directories(dir / "state" / "campaigns");
+  std::ofstream(dir / "state" / "campaigns" / "capture-then-ask.lua") << R"lua(
+return {
+  description = "test: a capture, then an operator request the test answers after a kill -9",
+  needs = { "camera" },
+  parameters = {},
+  run = function(p)
+    local t = lab.camera.capture({ frames = 2 })
+    local a = lab.operator.request { action = "test_wait", prompt = "go on", options = { "go" }, default = "go",
+                                     timeout_s = 100000 }
+    return { blobs = t.blobs, answer = a.answer }
+  end,
+}
+)lua";
+  json before;
+  std::string execution_id, run_id;
+  {
+    DaemonProcess daemon(dir / "state", dir / "colorlabd.toml", dir / "colorlabd.log");
+    auto api = api_for(daemon);
+    auto e = api.post("/v1/executions", {{"campaign", "capture-then-ask"}, {"params", json::object()}});
+    execution_id = e["id"];
+    run_id = e["run_id"];
+    // The request is posted only after the capture's step was committed (the commit precedes the next call).
+    for (int i = 0; i < 600 && api.get("/v1/requests")["items"].empty(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    ASSERT_FALSE(api.get("/v1/requests")["items"].empty());
+    before = api.get("/v1/runs/" + run_id + "/blobs")["items"];
+    ASSERT_EQ(before.size(), 3u) << before.dump();
+    daemon.kill9();
+  }
+  DaemonProcess daemon(dir / "state", dir / "colorlabd.toml", dir / "colorlabd.log");
+  auto api = api_for(daemon);
+  json pending;
+  for (int i = 0; i < 600 && pending.empty(); ++i) {
+    auto items = api.get("/v1/requests")["items"];
+    if (!items.empty()) pending = items[0];
+    else std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ASSERT_FALSE(pending.empty());
+  api.post("/v1/requests/" + pending["id"].get<std::string>(), {{"answer", "go"}});
+  auto done = wait_terminal(api, execution_id);
+  ASSERT_EQ(done["status"], "finished_ok") << done.dump();
+  const json after = api.get("/v1/runs/" + run_id + "/blobs")["items"];
+  EXPECT_EQ(after, before);
+  // The script saw the same references from the journal as it got live.
+  json run = colorlab::client::fetch_run(api, run_id);
+  std::set<std::string> from_script;
+  for (const auto& b : run["summary"]["script"]["blobs"]) from_script.insert(b["sha256"].get<std::string>());
+  EXPECT_EQ(from_script, shas(before));
+  const json report = wait_for_check(api);
+  EXPECT_TRUE(report["ok"]) << report.dump();
+  EXPECT_EQ(report["files"], 3);
+}
+
+// characterize-camera keeps what its keep parameter names: the averaged raw, the first DNG, the
+// first JPEG and a preview, listed under the run with their media types and the average's shape.
+TEST(BlobApi, ChartPhotographKeepsTheAveragedRawAndTheCamerasOwnFiles) {
+  TempDir dir;
+  auto config = write_daemon_config(dir.path(), 500, 5);
+  std::ofstream(dir / "lab.toml") << "[genicam]\nenabled = false\n[dslr]\nsize = [1752, 1168]\n";
+  DaemonProcess daemon(dir / "state", config);
+  auto api = api_for(daemon);
+  json reference = run_to_end(api, "chart-read", json::object());
+  json run = run_to_end(api, "characterize-camera",
+                        {{"reference_run", reference["id"]}, {"frames", 2}, {"formats", {"raw", "jpeg"}},
+                         {"keep", {"average", "raw", "jpeg", "preview"}}, {"prior_exclude", {"Canon_20D"}}},
+                        std::chrono::seconds(300));
+  const json listed = api.get("/v1/runs/" + run["id"].get<std::string>() + "/blobs");
+  std::map<std::string, json> by_kind;
+  for (const auto& item : listed["items"]) by_kind[item["kind"].get<std::string>()] = item;
+  ASSERT_EQ(by_kind.size(), 4u) << listed.dump(2);
+  EXPECT_EQ(by_kind["average"]["meta"]["dtype"], "<f4");
+  EXPECT_EQ(by_kind["average"]["meta"]["frames"], 2);
+  EXPECT_EQ(by_kind["average"]["meta"]["shape"].size(), 2u);
+  EXPECT_EQ(by_kind["average"]["size"].get<std::size_t>(),
+            4 * by_kind["average"]["meta"]["shape"][0].get<std::size_t>() * by_kind["average"]["meta"]["shape"][1].get<std::size_t>());
+  EXPECT_TRUE(by_kind["average"]["name"].get<std::string>().find("/raw/average") != std::string::npos) << by_kind["average"]["name"];
+  EXPECT_EQ(by_kind["raw"]["media_type"], "image/x-adobe-dng");
+  EXPECT_EQ(by_kind["jpeg"]["media_type"], "image/jpeg");
+  EXPECT_EQ(by_kind["preview"]["meta"]["preview_of"], by_kind["average"]["sha256"]);
+  // The files are what they say: a JPEG's and a TIFF-based DNG's first bytes.
+  const std::string jpeg = read_all(blob_file(daemon.state_dir(), by_kind["jpeg"]["sha256"]));
+  ASSERT_GE(jpeg.size(), 2u);
+  EXPECT_EQ(static_cast<unsigned char>(jpeg[0]), 0xFF);
+  EXPECT_EQ(static_cast<unsigned char>(jpeg[1]), 0xD8);
+  const std::string dng = read_all(blob_file(daemon.state_dir(), by_kind["raw"]["sha256"]));
+  ASSERT_GE(dng.size(), 4u);
+  EXPECT_TRUE(dng.substr(0, 4) == std::string("II*\0", 4) || dng.substr(0, 4) == std::string("MM\0*", 4));
+}

@@ -128,10 +128,6 @@ json BlobService::run_check(std::vector<store::BlobRecord> rows, fs::file_time_t
 }
 
 void BlobService::check_done(json report) {
-  {
-    std::lock_guard lock(mutex_);
-    report_ = report;
-  }
   if (report.value("state", "") != "done") {
     log::warning("blobs", "the blob store check failed: " + report.value("error", std::string("?")));
   } else if (report.value("ok", false)) {
@@ -154,6 +150,11 @@ void BlobService::check_done(json report) {
     writer_.append_event("blobs", event);
   } catch (const Error& e) {
     log::warning("blobs", std::string("cannot record the check: ") + e.what());
+  }
+  // Published after its event: whoever sees the report done finds the event in the log.
+  {
+    std::lock_guard lock(mutex_);
+    report_ = report;
   }
   if (config_.retention_days > 0 && report.value("state", "") == "done") {
     try {
