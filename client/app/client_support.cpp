@@ -14,8 +14,9 @@ client::ApiClient make_client(const GlobalOptions& g) {
     e.unix_socket = g.socket;
   } else {
     e = client::Endpoint::from_url(g.url);
+    e.ca_file = g.cacert;
   }
-  return client::ApiClient(e);
+  return client::ApiClient(e).with_api_key(g.key);
 }
 
 void print(const GlobalOptions& g, const json& j, std::string (*human)(const json&)) {

@@ -4,6 +4,7 @@
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/local/stream_protocol.hpp>
+#include <boost/asio/ssl.hpp>
 #include <boost/beast/core/flat_buffer.hpp>
 #include <boost/beast/http.hpp>
 
@@ -13,24 +14,42 @@ namespace colorlab::client {
 
 namespace asio = boost::asio;
 namespace bhttp = boost::beast::http;
+namespace ssl = boost::asio::ssl;
 
 Endpoint Endpoint::from_url(const std::string& url) {
-  const std::string scheme = "http://";
-  if (url.rfind(scheme, 0) != 0) {
-    throw Error(ErrorClass::bad_parameter, "URL '" + url + "' must start with http://", "e.g. http://127.0.0.1:8765");
-  }
-  std::string rest = url.substr(scheme.size());
-  if (auto slash = rest.find('/'); slash != std::string::npos) rest = rest.substr(0, slash);
   Endpoint e;
-  auto colon = rest.rfind(':');
-  if (colon == std::string::npos) {
-    e.host = rest;
-    e.port = 80;
+  std::string rest;
+  if (url.rfind("http://", 0) == 0) {
+    rest = url.substr(7);
+  } else if (url.rfind("https://", 0) == 0) {
+    rest = url.substr(8);
+    e.tls = true;
   } else {
+    throw Error(ErrorClass::bad_parameter, "URL '" + url + "' must start with http:// or https://",
+                "e.g. http://127.0.0.1:8765");
+  }
+  if (auto slash = rest.find('/'); slash != std::string::npos) rest = rest.substr(0, slash);
+  std::string port_text;
+  if (!rest.empty() && rest.front() == '[') {
+    auto close = rest.find(']');
+    if (close == std::string::npos) throw Error(ErrorClass::bad_parameter, "URL '" + url + "' has an unclosed '['");
+    e.host = rest.substr(1, close - 1);
+    if (close + 1 < rest.size()) {
+      if (rest[close + 1] != ':') throw Error(ErrorClass::bad_parameter, "URL '" + url + "' has an invalid port");
+      port_text = rest.substr(close + 2);
+    }
+  } else if (auto colon = rest.rfind(':'); colon != std::string::npos) {
     e.host = rest.substr(0, colon);
+    port_text = rest.substr(colon + 1);
+  } else {
+    e.host = rest;
+  }
+  e.port = e.tls ? 443 : 80;
+  if (!port_text.empty() || rest.ends_with(':')) {
     try {
-      int p = std::stoi(rest.substr(colon + 1));
-      if (p <= 0 || p > 65535) throw std::out_of_range("port");
+      std::size_t used = 0;
+      int p = std::stoi(port_text, &used);
+      if (used != port_text.size() || p <= 0 || p > 65535) throw std::out_of_range("port");
       e.port = static_cast<unsigned short>(p);
     } catch (const std::exception&) {
       throw Error(ErrorClass::bad_parameter, "URL '" + url + "' has an invalid port");
@@ -41,7 +60,9 @@ Endpoint Endpoint::from_url(const std::string& url) {
 }
 
 std::string Endpoint::describe() const {
-  return unix_socket.empty() ? "http://" + host + ":" + std::to_string(port) : "unix:" + unix_socket;
+  if (!unix_socket.empty()) return "unix:" + unix_socket;
+  std::string h = host.find(':') != std::string::npos ? "[" + host + "]" : host;
+  return (tls ? "https://" : "http://") + h + ":" + std::to_string(port);
 }
 
 ApiError::ApiError(protocol::Problem p)
@@ -81,24 +102,73 @@ RawResponse exchange(Stream& stream, const std::string& host, const std::string&
 
 }  // namespace
 
+namespace {
+
+void set_receive_timeout(int fd, std::chrono::milliseconds timeout) {
+  struct timeval tv {
+    static_cast<time_t>(timeout.count() / 1000), static_cast<suseconds_t>((timeout.count() % 1000) * 1000)
+  };
+  ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+}
+
+RawResponse exchange_tls(asio::io_context& io, const Endpoint& endpoint, std::chrono::milliseconds timeout,
+                         const std::string& method, const std::string& target, const std::string& body,
+                         const std::map<std::string, std::string>& headers) {
+  ssl::context context(ssl::context::tls_client);
+  context.set_options(ssl::context::default_workarounds | ssl::context::no_sslv2 | ssl::context::no_sslv3 |
+                      ssl::context::no_tlsv1 | ssl::context::no_tlsv1_1);
+  context.set_verify_mode(ssl::verify_peer);
+  if (endpoint.ca_file.empty()) {
+    context.set_default_verify_paths();
+  } else {
+    boost::system::error_code ec;
+    context.load_verify_file(endpoint.ca_file, ec);
+    if (ec) {
+      throw Error(ErrorClass::bad_parameter, "cannot read the CA certificates in " + endpoint.ca_file + ": " + ec.message(),
+                  "--cacert (COLORLAB_CACERT) takes a PEM file");
+    }
+  }
+  ssl::stream<asio::ip::tcp::socket> stream(io, context);
+  // The certificate must name the host we asked for (DNS name, or IP address in subjectAltName).
+  stream.set_verify_callback(ssl::host_name_verification(endpoint.host));
+  boost::system::error_code ec;
+  asio::ip::make_address(endpoint.host, ec);
+  if (ec) SSL_set_tlsext_host_name(stream.native_handle(), endpoint.host.c_str());  // SNI: names only
+  asio::ip::tcp::resolver resolver(io);
+  asio::connect(stream.next_layer(), resolver.resolve(endpoint.host, std::to_string(endpoint.port)));
+  set_receive_timeout(stream.next_layer().native_handle(), timeout);
+  stream.handshake(ssl::stream_base::client);
+  auto out = exchange(stream, endpoint.host, method, target, body, headers);
+  stream.shutdown(ec);  // the answer is complete; a peer that closes without close_notify changes nothing
+  return out;
+}
+
+}  // namespace
+
 RawResponse ApiClient::request(const std::string& method, const std::string& target, const std::string& body,
                                const std::map<std::string, std::string>& headers) const {
+  auto all = headers;
+  if (!api_key_.empty() && all.find("Authorization") == all.end()) all["Authorization"] = "Bearer " + api_key_;
   asio::io_context io;
   try {
     if (!endpoint_.unix_socket.empty()) {
       asio::local::stream_protocol::socket s(io);
       s.connect(asio::local::stream_protocol::endpoint(endpoint_.unix_socket));
-      return exchange(s, "localhost", method, target, body, headers);
+      return exchange(s, "localhost", method, target, body, all);
     }
+    if (endpoint_.tls) return exchange_tls(io, endpoint_, timeout_, method, target, body, all);
     asio::ip::tcp::resolver resolver(io);
     asio::ip::tcp::socket s(io);
     asio::connect(s, resolver.resolve(endpoint_.host, std::to_string(endpoint_.port)));
-    struct timeval tv {
-      static_cast<time_t>(timeout_.count() / 1000), static_cast<suseconds_t>((timeout_.count() % 1000) * 1000)
-    };
-    ::setsockopt(s.native_handle(), SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
-    return exchange(s, endpoint_.host, method, target, body, headers);
+    set_receive_timeout(s.native_handle(), timeout_);
+    return exchange(s, endpoint_.host, method, target, body, all);
   } catch (const boost::system::system_error& e) {
+    if (e.code().category() == asio::error::get_ssl_category()) {
+      throw Error(ErrorClass::no_comms,
+                  "TLS with colorlabd at " + endpoint_.describe() + " failed: " + e.code().message(),
+                  "is its certificate issued for this host and by a CA you trust? pass the CA's certificate with "
+                  "--cacert FILE (or COLORLAB_CACERT)");
+    }
     throw Error(ErrorClass::no_comms, "cannot talk to colorlabd at " + endpoint_.describe() + ": " + e.code().message(),
                 "is colorlabd running? start it with: build/bin/colorlabd");
   }

@@ -1,6 +1,8 @@
 #pragma once
-// Talks to colorlabd. A non-2xx answer becomes ApiError carrying the server's problem+json, so
-// callers (the CLI, tests) see the server's own detail and hint.
+// Talks to colorlabd over a Unix socket, HTTP or HTTPS (the server's certificate verified against
+// a CA file or the system's store, and its name or address checked). A non-2xx answer becomes
+// ApiError carrying the server's problem+json, so callers (the CLI, tests) see the server's own
+// detail and hint. With an API key, every request carries "Authorization: Bearer <key>".
 #include <chrono>
 #include <map>
 #include <optional>
@@ -16,8 +18,11 @@ struct Endpoint {
   std::string host = "127.0.0.1";
   unsigned short port = 8765;
   std::string unix_socket;  // when set, used instead of host:port
+  bool tls = false;         // https://
+  std::string ca_file;      // PEM certificates the server's is verified against; empty: the system's store
 
-  // "http://HOST:PORT" → Endpoint; throws Error{bad_parameter}.
+  // "http://HOST:PORT" or "https://HOST:PORT" (an IPv6 address in brackets) → Endpoint; throws
+  // Error{bad_parameter}.
   static Endpoint from_url(const std::string& url);
   std::string describe() const;
 };
@@ -41,6 +46,11 @@ struct RawResponse {
 class ApiClient {
  public:
   explicit ApiClient(Endpoint endpoint, std::chrono::milliseconds timeout = std::chrono::seconds(30));
+  // Sends the key with every request (empty: none).
+  ApiClient& with_api_key(std::string key) {
+    api_key_ = std::move(key);
+    return *this;
+  }
 
   // Any request; throws Error{no_comms} when the daemon is unreachable.
   RawResponse request(const std::string& method, const std::string& target, const std::string& body = {},
@@ -57,6 +67,7 @@ class ApiClient {
   nlohmann::json expect_json(const RawResponse& r) const;
   Endpoint endpoint_;
   std::chrono::milliseconds timeout_;
+  std::string api_key_;
 };
 
 }  // namespace colorlab::client
