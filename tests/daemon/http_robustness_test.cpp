@@ -3,8 +3,10 @@
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
+#include <sys/un.h>
 #include <unistd.h>
 
+#include <cstdio>
 #include <fstream>
 #include <thread>
 
@@ -28,6 +30,8 @@ struct RawReply {
   std::string body;
 };
 
+RawReply exchange_raw(int fd, const std::string& bytes);
+
 RawReply send_raw(unsigned short port, const std::string& bytes) {
   int fd = ::socket(AF_INET, SOCK_STREAM, 0);
   sockaddr_in addr{};
@@ -35,6 +39,21 @@ RawReply send_raw(unsigned short port, const std::string& bytes) {
   addr.sin_port = htons(port);
   ::inet_pton(AF_INET, "127.0.0.1", &addr.sin_addr);
   EXPECT_EQ(::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+  return exchange_raw(fd, bytes);
+}
+
+// Requests that change state go over the Unix socket: loopback TCP without a key only reads
+// (docs/API.md, "Access"), and these tests are about what the routes make of bad input.
+RawReply send_raw_unix(const std::string& path, const std::string& bytes) {
+  int fd = ::socket(AF_UNIX, SOCK_STREAM, 0);
+  sockaddr_un addr{};
+  addr.sun_family = AF_UNIX;
+  std::snprintf(addr.sun_path, sizeof addr.sun_path, "%s", path.c_str());
+  EXPECT_EQ(::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+  return exchange_raw(fd, bytes);
+}
+
+RawReply exchange_raw(int fd, const std::string& bytes) {
   timeval tv{10, 0};
   ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
   ::send(fd, bytes.data(), bytes.size(), MSG_NOSIGNAL);
@@ -99,7 +118,7 @@ TEST_F(DaemonHttp, GarbageInsteadOfHttpIsA400) {
 
 TEST_F(DaemonHttp, MalformedJsonIsA400) {
   std::string body = "{\"campaign\": \"luminance-spot\", ";
-  expect_problem(send_raw(port, "POST /v1/executions HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\n"
+  expect_problem(send_raw_unix(socket_path, "POST /v1/executions HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\n"
                                 "Connection: close\r\nContent-Length: " +
                                     std::to_string(body.size()) + "\r\n\r\n" + body),
                  400, "bad-json");
@@ -108,7 +127,7 @@ TEST_F(DaemonHttp, MalformedJsonIsA400) {
 
 TEST_F(DaemonHttp, WrongShapesAndMediaTypesAreRefused) {
   auto post = [&](const std::string& ct, const std::string& body) {
-    return send_raw(port, "POST /v1/executions HTTP/1.1\r\nHost: x\r\nContent-Type: " + ct +
+    return send_raw_unix(socket_path, "POST /v1/executions HTTP/1.1\r\nHost: x\r\nContent-Type: " + ct +
                               "\r\nConnection: close\r\nContent-Length: " + std::to_string(body.size()) + "\r\n\r\n" + body);
   };
   expect_problem(post("text/plain", "{}"), 415, "unsupported-media-type");
@@ -127,7 +146,7 @@ TEST_F(DaemonHttp, UnknownRoutesAndMethodsAre404And405) {
                  "not_found");
   expect_problem(send_raw(port, "GET /v1/runs?limit=100000 HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n"), 400,
                  "bad_parameter");
-  auto r = send_raw(port, "DELETE /v1/runs HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n");
+  auto r = send_raw_unix(socket_path, "DELETE /v1/runs HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n");
   expect_problem(r, 405, "method-not-allowed");
   EXPECT_NE(r.headers.find("Allow: GET"), std::string::npos) << r.headers;
   expect_still_serving();

@@ -22,10 +22,11 @@ class EmbeddedDaemon {
       : daemon_({colorlab::testing::bin_path("colorlabd"), "--state", (dir_ / "state").string(), "--listen",
                  "127.0.0.1:0"},
                 dir_ / "colorlabd.log") {
-    url_ = colorlab::testing::wait_for_endpoint(dir_ / "state", daemon_.pid())["url"];
+    // The Unix socket: campaigns are started, which loopback TCP allows only with a key.
+    socket_ = colorlab::testing::wait_for_endpoint(dir_ / "state", daemon_.pid())["unix_socket"];
   }
   colorlab::testing::RunResult cli(std::vector<std::string> args) {
-    std::vector<std::string> argv{colorlab::testing::bin_path("colorlab"), "--url", url_, "--json"};
+    std::vector<std::string> argv{colorlab::testing::bin_path("colorlab"), "--socket", socket_, "--json"};
     argv.insert(argv.end(), args.begin(), args.end());
     return colorlab::testing::run_command(argv, std::chrono::seconds(120));
   }
@@ -34,7 +35,7 @@ class EmbeddedDaemon {
  private:
   colorlab::testing::TempDir dir_;
   Process daemon_;
-  std::string url_;
+  std::string socket_;
 };
 
 }  // namespace

@@ -46,7 +46,9 @@ void LabFixture::start_daemon() {
   daemon_ = std::make_unique<Process>(
       std::vector<std::string>{bin_path("colorlabd"), "--config", (dir / "colorlabd.toml").string()},
       dir / "colorlabd.log");
-  url_ = wait_for_endpoint(dir / "state", daemon_->pid())["url"];
+  auto endpoint = wait_for_endpoint(dir / "state", daemon_->pid());
+  url_ = endpoint["url"];
+  unix_socket_ = endpoint["unix_socket"];
 }
 
 void LabFixture::kill_daemon() {
@@ -59,7 +61,7 @@ json LabFixture::sim_control(const json& command) {
 }
 
 RunResult LabFixture::cli(std::vector<std::string> args, std::chrono::milliseconds timeout) {
-  std::vector<std::string> argv{bin_path("colorlab"), "--url", url_};
+  std::vector<std::string> argv{bin_path("colorlab"), "--socket", unix_socket_};
   argv.insert(argv.end(), args.begin(), args.end());
   return run_command(argv, timeout);
 }

@@ -23,7 +23,7 @@ class LabFixture {
   void kill_daemon();  // SIGKILL, no cleanup
 
   nlohmann::json sim_control(const nlohmann::json& command);
-  // Runs the `colorlab` CLI against the daemon.
+  // Runs the `colorlab` CLI against the daemon, over its Unix socket (every scope).
   RunResult cli(std::vector<std::string> args, std::chrono::milliseconds timeout = std::chrono::seconds(60));
   nlohmann::json cli_json(std::vector<std::string> args);
 
@@ -35,6 +35,7 @@ class LabFixture {
   std::unique_ptr<Process> sim_;
   std::unique_ptr<Process> daemon_;
   std::string url_;
+  std::string unix_socket_;
 };
 
 }  // namespace colorlab::testing

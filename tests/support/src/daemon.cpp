@@ -40,6 +40,7 @@ void DaemonProcess::start() {
   process_ = std::make_unique<Process>(argv, log_);
   auto endpoint = wait_for_endpoint(state_dir_, process_->pid());
   url_ = endpoint["url"];
+  unix_socket_ = endpoint["unix_socket"];
   simulator_pid_ = endpoint.value("simulator_pid", -1);
 }
 

@@ -33,6 +33,9 @@ class DaemonProcess {
   int terminate();    // SIGTERM and wait; returns the exit code
   bool running();
   const std::string& url() const { return url_; }
+  // The Unix socket has every scope (docs/API.md, "Access"): tests that drive the lab use it; loopback
+  // TCP without a key only reads.
+  const std::string& unix_socket() const { return unix_socket_; }
   Process& process() { return *process_; }
   const std::filesystem::path& state_dir() const { return state_dir_; }
 
@@ -44,6 +47,7 @@ class DaemonProcess {
 
   std::unique_ptr<Process> process_;
   std::string url_;
+  std::string unix_socket_;
   pid_t simulator_pid_ = -1;
 };
 
