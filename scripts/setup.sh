@@ -19,7 +19,9 @@ packages=(
   argyll aravis-tools aravis-tools-cli libraw-bin dcraw python3-numpy hyperfine sqlite3 curl util-linux procps strace
   imagemagick
   # the data service: load benches against nginx, fuzzing with clang's libFuzzer, the Python client
-  wrk nginx-light clang libfuzzer-14-dev python3-requests python3-pandas
+  wrk nginx-light clang libfuzzer-14-dev python3-requests python3-pandas openssl
+  # clang only recommends its fuzzer and sanitizer runtimes, and this script installs without recommends
+  libclang-rt-14-dev
 )
 
 missing=()

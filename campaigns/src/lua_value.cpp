@@ -1,6 +1,7 @@
 #include "colorlab/campaigns/lua_value.hpp"
 
 #include <cmath>
+#include <string_view>
 #include <vector>
 
 #include <lua5.4/lua.hpp>
@@ -48,6 +49,48 @@ void push_json(lua_State* L, const json& value) {
 
 namespace {
 
+// Well-formed UTF-8 (Unicode 15, table 3-7): no overlong forms, surrogates or code points past U+10FFFF.
+bool valid_utf8(std::string_view s) {
+  for (std::size_t i = 0; i < s.size();) {
+    const auto b = static_cast<unsigned char>(s[i]);
+    std::size_t len = 0;
+    unsigned char lo = 0x80, hi = 0xBF;
+    if (b < 0x80) {
+      ++i;
+      continue;
+    } else if (b >= 0xC2 && b <= 0xDF) {
+      len = 2;
+    } else if (b >= 0xE0 && b <= 0xEF) {
+      len = 3;
+      if (b == 0xE0) lo = 0xA0;
+      if (b == 0xED) hi = 0x9F;
+    } else if (b >= 0xF0 && b <= 0xF4) {
+      len = 4;
+      if (b == 0xF0) lo = 0x90;
+      if (b == 0xF4) hi = 0x8F;
+    } else {
+      return false;
+    }
+    if (i + len > s.size()) return false;
+    for (std::size_t k = 1; k < len; ++k) {
+      const auto c = static_cast<unsigned char>(s[i + k]);
+      if (c < (k == 1 ? lo : 0x80) || c > (k == 1 ? hi : 0xBF)) return false;
+    }
+    i += len;
+  }
+  return true;
+}
+
+// Lua strings are bytes; JSON (the store, the API) holds UTF-8 text, and cannot even write anything else.
+std::string text_of(lua_State* L, int index, const std::string& where) {
+  std::size_t n = 0;
+  const char* s = lua_tolstring(L, index, &n);
+  if (!valid_utf8({s, n})) {
+    throw Error(ErrorClass::script_error, where + " is not UTF-8 text", "save the script as UTF-8");
+  }
+  return std::string(s, n);
+}
+
 json convert(lua_State* L, int index, const std::string& where, int depth) {
   index = lua_absindex(L, index);
   if (depth > 64) throw Error(ErrorClass::script_error, where + " is nested too deeply (a cycle?)");
@@ -62,11 +105,7 @@ json convert(lua_State* L, int index, const std::string& where, int depth) {
         if (!std::isfinite(d)) return nullptr;
         return d;
       }
-    case LUA_TSTRING: {
-      std::size_t n = 0;
-      const char* s = lua_tolstring(L, index, &n);
-      return std::string(s, n);
-    }
+    case LUA_TSTRING: return text_of(L, index, where);
     case LUA_TTABLE: {
       luaL_checkstack(L, 4, "table too deeply nested");
       lua_Integer n = static_cast<lua_Integer>(lua_rawlen(L, index));
@@ -94,7 +133,7 @@ json convert(lua_State* L, int index, const std::string& where, int depth) {
       while (lua_next(L, index) != 0) {
         std::string key;
         if (lua_type(L, -2) == LUA_TSTRING) {
-          key = lua_tostring(L, -2);
+          key = text_of(L, -2, where + "'s key");
         } else if (lua_type(L, -2) == LUA_TNUMBER) {
           lua_pushvalue(L, -2);
           key = lua_tostring(L, -1);

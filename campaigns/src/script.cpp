@@ -41,11 +41,15 @@ const std::vector<std::string> kTypes = {"integer", "number", "string", "boolean
 
 void check_parameter_spec(const std::string& script, const std::string& name, json& spec) {
   if (!spec.is_object()) bad_declaration(script, "parameter '" + name + "' must be a table");
+  // json's value() throws its own type_error for a field of another type: each is checked first.
+  for (const char* key : {"type", "items", "description", "unit"}) {
+    if (spec.contains(key) && !spec[key].is_string()) bad_declaration(script, "parameter '" + name + "'." + key + " must be a string");
+  }
   std::string type = spec.value("type", std::string());
   if (std::find(kTypes.begin(), kTypes.end(), type) == kTypes.end()) {
     bad_declaration(script, "parameter '" + name + "' has type '" + type + "'; use integer, number, string, boolean or array");
   }
-  for (const char* key : {"min", "max"}) {
+  for (const char* key : {"min", "max", "min_items", "max_items"}) {
     if (spec.contains(key) && !spec[key].is_number()) bad_declaration(script, "parameter '" + name + "'." + key + " must be a number");
   }
   if (spec.contains("values") && !spec["values"].is_array()) bad_declaration(script, "parameter '" + name + "'.values must be a list");
@@ -183,6 +187,7 @@ CampaignScript parse_campaign_script(const std::string& name, const std::string&
   if (decl.contains("name") && decl["name"] != name) {
     bad_declaration(name, "declares name '" + decl["name"].dump() + "' but its file is " + name + ".lua");
   }
+  if (decl.contains("description") && !decl["description"].is_string()) bad_declaration(name, "`description` must be a string");
   s.description = decl.value("description", std::string());
   // Lua cannot tell an empty list from an empty table: `needs = {}` arrives as {}.
   if (decl.contains("needs") && decl["needs"].is_object() && decl["needs"].empty()) decl["needs"] = json::array();

@@ -3,6 +3,7 @@
 // ImageMagick write, used by `analyze averaging`.
 #include <cstdint>
 #include <filesystem>
+#include <istream>
 #include <vector>
 
 namespace colorlab::cli::detail {
@@ -14,5 +15,7 @@ struct GrayFrame {
 };
 
 GrayFrame read_pgm(const std::filesystem::path& path);
+// The same from a stream; `path` names it in errors.
+GrayFrame read_pgm(std::istream& in, const std::filesystem::path& path);
 
 }  // namespace colorlab::cli::detail

@@ -58,8 +58,12 @@ json SocketHidTransport::call(const json& request) {
                   "driver and simulator disagree about the HID socket protocol (docs/simulator.md)");
     }
     if (answer["ok"] == true) return answer;
-    const std::string code = answer.value("error", std::string("?"));
-    const std::string message = "relay board " + info_.path + ": " + answer.value("message", code);
+    // value() throws json's type_error for a field of another type: read only what is text.
+    auto text = [&](const char* key, const std::string& otherwise) {
+      return answer.contains(key) && answer[key].is_string() ? answer[key].get<std::string>() : otherwise;
+    };
+    const std::string code = text("error", "?");
+    const std::string message = "relay board " + info_.path + ": " + text("message", code);
     if (code == "no_device") throw Error(ErrorClass::no_comms, message, "reconnect the USB cable");
     throw Error(ErrorClass::protocol_error, message, "driver and simulator disagree about the HID socket protocol");
   } catch (const Error&) {

@@ -2,6 +2,7 @@
 
 #include <cctype>
 #include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 
@@ -69,7 +70,8 @@ Reply parse_reply(std::string_view raw) {
   while (!field.empty() && field.back() == ' ') field.remove_suffix(1);
   double v = 0;
   auto [ptr, ec] = std::from_chars(field.data(), field.data() + field.size(), v);
-  if (ec != std::errc() || ptr != field.data() + field.size()) {
+  // from_chars also reads "inf" and "nan", which the meter never sends: garbled, not a reading.
+  if (ec != std::errc() || ptr != field.data() + field.size() || !std::isfinite(v)) {
     throw Error(ErrorClass::coms_fail, "LS-110 value is not a number: '" + std::string(line) + "'",
                 "line noise or a partial frame; the measurement is retried");
   }

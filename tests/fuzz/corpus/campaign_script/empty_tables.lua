@@ -1,0 +1,1 @@
+return { needs = {}, parameters = {}, run = function(p) end }

@@ -1,0 +1,58 @@
+# The libFuzzer build (COLORLAB_FUZZ=ON, `cmake --preset fuzz`): included by the top-level
+# CMakeLists.txt in place of the whole project, so a clang + ASan + UBSan build compiles only what
+# the parsers need — the small libraries they live in, or, where the library around a parser drags
+# in devices and databases, just the parser's own source files. Every target is <name>_fuzz in
+# build-fuzz/fuzz/; `cmake --build build-fuzz --target fuzz_all` builds them all.
+if(NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
+  message(FATAL_ERROR "COLORLAB_FUZZ needs clang's libFuzzer: cmake --preset fuzz (apt-get install clang libfuzzer-14-dev libclang-rt-14-dev)")
+endif()
+
+# Coverage for libFuzzer and both sanitizers on the parsers and the libraries they live in; the
+# fuzzer's main only on the targets. UBSan stops at the first report so it counts as a crash.
+set(COLORLAB_FUZZ_FLAGS -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined
+                        -fno-omit-frame-pointer -O1)
+add_link_options(-fsanitize=address,undefined)
+# Boost 1.74's Asio looks for clang's coroutines in <experimental/coroutine>, which libstdc++ lacks;
+# clang 14 has C++20 coroutines in <coroutine> (as GCC, where Asio finds them), so say so.
+add_compile_definitions(BOOST_ASIO_HAS_CO_AWAIT=1)
+
+include(CheckCXXSourceCompiles)
+set(CMAKE_REQUIRED_LINK_OPTIONS -fsanitize=fuzzer)
+check_cxx_source_compiles([[
+#include <cstddef>
+#include <cstdint>
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t*, std::size_t) { return 0; }
+]] COLORLAB_HAVE_LIBFUZZER)
+unset(CMAKE_REQUIRED_LINK_OPTIONS)
+if(NOT COLORLAB_HAVE_LIBFUZZER)
+  message(FATAL_ERROR "clang cannot link -fsanitize=fuzzer: apt-get install libclang-rt-14-dev (clang only recommends it)")
+endif()
+
+find_package(OpenSSL REQUIRED COMPONENTS Crypto)
+add_subdirectory(core)
+add_subdirectory(protocol)
+add_subdirectory(drivers/wire)
+foreach(lib colorlab_core colorlab_protocol colorlab_wire_protocols)
+  target_compile_options(${lib} PRIVATE ${COLORLAB_FUZZ_FLAGS})
+endforeach()
+# The colour science behind the `lab.analysis` functions a campaign script's top level could call: not
+# a parser and not fuzzed here, so built plain and unoptimised — Eigen at -O1 under the sanitizers
+# would be most of this build's time (ASan's allocator still sees its memory).
+add_subdirectory(analysis)
+target_compile_options(colorlab_analysis PRIVATE -O0 -g0)
+set(COLORLAB_FUZZ_PLAIN_SOURCES ${PROJECT_SOURCE_DIR}/campaigns/src/characterize.cpp)
+set_source_files_properties(${COLORLAB_FUZZ_PLAIN_SOURCES} PROPERTIES COMPILE_OPTIONS "-fno-sanitize=all;-O0;-g0")
+
+include(${CMAKE_CURRENT_LIST_DIR}/fuzz_parsers.cmake)
+add_custom_target(fuzz_all)
+foreach(name IN LISTS COLORLAB_FUZZ_TARGETS)
+  add_executable(${name}_fuzz ${CMAKE_CURRENT_LIST_DIR}/${name}_fuzz.cpp)
+  set_target_properties(${name}_fuzz PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/fuzz)
+  target_include_directories(${name}_fuzz PRIVATE ${CMAKE_CURRENT_LIST_DIR})
+  target_compile_definitions(${name}_fuzz PRIVATE COLORLAB_LIBFUZZER COLORLAB_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+  target_compile_options(${name}_fuzz PRIVATE ${COLORLAB_FUZZ_FLAGS})
+  target_link_options(${name}_fuzz PRIVATE -fsanitize=fuzzer)
+  colorlab_fuzz_parser(${name}_fuzz ${name})
+  colorlab_warnings(${name}_fuzz)
+  add_dependencies(fuzz_all ${name}_fuzz)
+endforeach()
