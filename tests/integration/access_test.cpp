@@ -96,6 +96,11 @@ TEST(access_daemon, LoopbackReadsAreOpenControlNeedsAKeyTheUnixSocketHasEverySco
   EXPECT_NE(body["detail"].get<std::string>().find("loopback"), std::string::npos) << body;
   EXPECT_EQ(call(open, "GET", "/v1/keys").first, 401);
 
+  // The socket's file permissions are its guard: owner and group only.
+  auto perms = std::filesystem::status(daemon.unix_socket()).permissions();
+  EXPECT_EQ(perms & std::filesystem::perms::all,
+            std::filesystem::perms::owner_read | std::filesystem::perms::owner_write |
+                std::filesystem::perms::group_read | std::filesystem::perms::group_write);
   auto local = unix_socket(daemon);
   EXPECT_EQ(call(local, "POST", "/v1/queue/start", json::object()).first, 200);
   EXPECT_EQ(call(local, "POST", "/v1/queue/stop", json::object()).first, 200);
