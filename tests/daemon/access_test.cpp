@@ -163,12 +163,15 @@ TEST_F(AccessTest, EachScopeAndRouteClassGetsTheDocumentedAnswer) {
         auto r = access.check(request(transport, route.method, route.target, key));
         std::string what = route.method + " " + route.target + " key " + key_name + " transport " +
                            std::to_string(static_cast<int>(transport));
-        if (!granted) {
+        if ((!granted || *granted < route.needs) && key_name == "none") {
+          // No key where one is needed: 401, saying which scope the key must have.
           ASSERT_TRUE(r) << what;
           EXPECT_EQ(r->status, 401) << what;
           EXPECT_EQ(r->content_type, "application/problem+json");
           EXPECT_EQ(r->headers["WWW-Authenticate"].rfind("Bearer", 0), 0u) << what;
-          EXPECT_EQ(json::parse(r->body)["code"], "key-required");
+          auto body = json::parse(r->body);
+          EXPECT_EQ(body["code"], "key-required");
+          EXPECT_EQ(body["required_scope"], std::string(to_string(route.needs))) << what;
         } else if (*granted < route.needs) {
           ASSERT_TRUE(r) << what;
           EXPECT_EQ(r->status, 403) << what;
@@ -241,7 +244,7 @@ TEST_F(AccessTest, LoopbackScopeIsASetting) {
   options.loopback_scope = Scope::control;
   Access access(store, io.get_executor(), options);
   EXPECT_FALSE(access.check(request(Transport::loopback, "POST", "/v1/queue/start")));
-  EXPECT_EQ(access.check(request(Transport::loopback, "GET", "/v1/keys"))->status, 403);
+  EXPECT_EQ(access.check(request(Transport::loopback, "GET", "/v1/keys"))->status, 401);
   EXPECT_EQ(access.check(request(Transport::remote, "GET", "/v1/runs"))->status, 401);
 }
 
@@ -338,6 +341,7 @@ TEST_F(AccessTest, AControlRequestWhileAnotherHoldsTheLockIs409AfterTheScopeChec
   EXPECT_FALSE(access.check(request(Transport::remote, "POST", "/v1/queue/start", anna)));
   EXPECT_EQ(access.check(request(Transport::remote, "POST", "/v1/queue/start", ben))->status, 409);
   EXPECT_EQ(access.check(request(Transport::remote, "POST", "/v1/queue/start", reader))->status, 403);
+  EXPECT_EQ(access.check(request(Transport::loopback, "POST", "/v1/queue/start"))->status, 401);
   EXPECT_EQ(access.check(request(Transport::unix_socket, "POST", "/v1/executions"))->status, 409);
   // Reads are never locked; the lock's own routes decide for themselves (force).
   EXPECT_FALSE(access.check(request(Transport::remote, "GET", "/v1/runs", ben)));

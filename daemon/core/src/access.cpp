@@ -100,10 +100,13 @@ std::string_view transport_name(Transport t) {
   return "a network listener";
 }
 
-HttpResponse unauthorized(const std::string& code, const std::string& detail, bool invalid_token) {
+HttpResponse unauthorized(const std::string& code, const std::string& detail, bool invalid_token,
+                          const nlohmann::json& extra = nlohmann::json::object()) {
   auto r = problem_response(401, code, "Unauthorized", detail,
-                            "send Authorization: Bearer <key>; an admin creates keys with: colorlab keys create NAME "
-                            "--scope read|control|admin (over the daemon's Unix socket)");
+                            "send Authorization: Bearer <key> (colorlab --key KEY or COLORLAB_API_KEY); an admin "
+                            "creates keys with: colorlab keys create NAME --scope read|control|admin (over the "
+                            "daemon's Unix socket)",
+                            extra);
   r.headers["WWW-Authenticate"] =
       invalid_token ? R"(Bearer realm="colorlab", error="invalid_token")" : R"(Bearer realm="colorlab")";
   return r;
@@ -183,20 +186,18 @@ std::optional<HttpResponse> Access::check(const HttpRequest& req) {
     case KeyState::none: break;
   }
   Scope needed = required_scope(req);
-  if (!caller.scope) {
+  if (!caller.may(needed) && caller.key_id.empty()) {
+    // No key where one would help: authentication is missing (401), not a key's scope too small (403).
     return unauthorized("key-required",
                         req.method + " " + req.path + " over " + std::string(transport_name(caller.transport)) +
-                            " needs an API key",
-                        false);
+                            " needs an API key with the '" + std::string(to_string(needed)) + "' scope",
+                        false, {{"required_scope", to_string(needed)}});
   }
-  if (*caller.scope < needed) {
-    std::string who = caller.key_id.empty()
-                          ? "a request over " + std::string(transport_name(caller.transport)) + " without a key has"
-                          : "the key '" + caller.key_name + "' has";
+  if (!caller.may(needed)) {
     auto r = problem_response(
         403, "scope-insufficient", "Forbidden",
-        req.method + " " + req.path + " needs the '" + std::string(to_string(needed)) + "' scope; " + who + " '" +
-            std::string(to_string(*caller.scope)) + "'",
+        req.method + " " + req.path + " needs the '" + std::string(to_string(needed)) + "' scope; the key '" +
+            caller.key_name + "' has '" + std::string(to_string(*caller.scope)) + "'",
         "use a key with the " + std::string(to_string(needed)) +
             " scope (colorlab --key KEY or COLORLAB_API_KEY), or the daemon's Unix socket",
         {{"required_scope", to_string(needed)}, {"scope", to_string(*caller.scope)}});
