@@ -70,7 +70,22 @@ def run(url, campaign, params):
     if e["status"] != "finished_ok":
         raise SystemExit(f"{campaign}: {e['status']}: {e.get('reason')}")
     r = requests.get(url + "/v1/runs/" + e["run_id"]).json()
+    r["measurements"] = measurements(url, e["run_id"])
     return wall, r
+
+
+def measurements(url, run_id):
+    """Every page of a run's measurements (the run document itself stays small)."""
+    items, cursor = [], None
+    while True:
+        params = {"limit": 5000}
+        if cursor:
+            params["cursor"] = cursor
+        page = requests.get(url + "/v1/runs/" + run_id + "/measurements", params=params).json()
+        items += page["items"]
+        cursor = page.get("next_cursor")
+        if not cursor:
+            return items
 
 
 def camera_phases(log, t0, t1):

@@ -53,7 +53,7 @@ for trial in range(TRIALS):
         state = os.path.join(tmp, "state")
         p, url = start(state)
         e = post(url, "/v1/executions", {"campaign": "luminance-spot", "params": {"readings": 30}})
-        while len(get(url, "/v1/runs/" + e["run_id"])["measurements"]) < 3:
+        while len(get(url, "/v1/runs/" + e["run_id"] + "/measurements?limit=5000")["items"]) < 3:
             time.sleep(0.01)
         p.send_signal(signal.SIGKILL)
         p.wait()
@@ -61,7 +61,7 @@ for trial in range(TRIALS):
         t0 = time.time()
         p, url = start(state)
         while True:
-            ms = get(url, "/v1/runs/" + e["run_id"])["measurements"]
+            ms = get(url, "/v1/runs/" + e["run_id"] + "/measurements?limit=5000")["items"]
             fresh = [m for m in ms if stamp(m["measured_at"]) > t0]
             if fresh:
                 break

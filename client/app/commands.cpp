@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "colorlab/client/api_client.hpp"
+#include "colorlab/client/runs.hpp"
 #include "colorlab/core/error.hpp"
 #include "colorlab/protocol/states.hpp"
 #include "client_support.hpp"
@@ -68,7 +69,7 @@ int run_campaign(const GlobalOptions& g, const RunOptions& o) {
     if (status && protocol::is_terminal(*status)) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
   }
-  json run = api.get("/v1/runs/" + run_id);
+  json run = client::fetch_run(api, run_id);
   bool ok = execution["status"] == "finished_ok";
   if (o.id_only) {
     std::cout << run_id << "\n";
@@ -158,7 +159,7 @@ void add_daemon_commands(CLI::App& app, GlobalOptions& global) {
   auto run_id = std::make_shared<std::string>();
   auto* show = app.add_subcommand("show", "Show one run with its measurements");
   show->add_option("run", *run_id, "run id")->required();
-  show->callback([&global, run_id] { print(global, make_client(global).get("/v1/runs/" + *run_id), format_run); });
+  show->callback([&global, run_id] { print(global, client::fetch_run(make_client(global), *run_id), format_run); });
 }
 
 }  // namespace colorlab::cli

@@ -8,6 +8,8 @@
 #include "colorlab/core/error.hpp"
 #include "commands.hpp"
 #include "queue_commands.hpp"
+#include "export_commands.hpp"
+#include "access_commands.hpp"
 #ifdef COLORLAB_HAVE_ANALYZE
 #include "colorlab/cli/analyze_command.hpp"
 #endif
@@ -20,8 +22,14 @@ int main(int argc, char** argv) {
   app.add_option("--url", global.url, "daemon URL")->envname("COLORLAB_URL")->capture_default_str();
   app.add_option("--socket", global.socket, "daemon Unix socket (instead of --url)")->envname("COLORLAB_SOCKET");
   app.add_flag("--json", global.json, "print JSON instead of text");
+  app.add_option("--key", global.key, "API key (needed beyond the Unix socket for control, admin and remote reads)")
+      ->envname("COLORLAB_API_KEY");
+  app.add_option("--cacert", global.cacert, "CA certificate (PEM) to verify an https:// daemon against")
+      ->envname("COLORLAB_CACERT");
   colorlab::cli::add_daemon_commands(app, global);
   colorlab::cli::add_queue_commands(app, global);
+  colorlab::cli::add_export_command(app, global);
+  colorlab::cli::add_access_commands(app, global);
 #ifdef COLORLAB_HAVE_ANALYZE
   colorlab::cli::add_analyze_command(app);
 #endif

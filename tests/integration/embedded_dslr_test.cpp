@@ -37,7 +37,7 @@ TEST(EmbeddedLabDslr, TheDaemonConnectsTheAnnouncedDslrAndCapturesThroughIt) {
   auto e = api.post("/v1/executions", {{"campaign", "frame-average"}, {"params", {{"frames", 4}}}});
   auto done = wait_terminal(api, e["id"]);
   ASSERT_EQ(done["status"], "finished_ok") << done.dump();
-  json run = api.get("/v1/runs/" + e["run_id"].get<std::string>());
+  json run = colorlab::client::fetch_run(api, e["run_id"].get<std::string>());
   EXPECT_EQ(run["measurements"].size(), 9u);  // subsets 1, 2, 4 × R, G, B
   for (const auto& m : run["measurements"]) EXPECT_TRUE(m["simulated"]);
 }

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "colorlab/client/api_client.hpp"
+#include "colorlab/client/runs.hpp"
 #include "colorlab/testing/notify_socket.hpp"
 #include "resume_support.hpp"
 
@@ -36,7 +37,7 @@ json wait_status(const ApiClient& api, const std::string& id, const std::string&
 }
 
 std::size_t measurement_count(const ApiClient& api, const json& execution) {
-  return api.get("/v1/runs/" + execution["run_id"].get<std::string>())["measurements"].size();
+  return colorlab::client::fetch_run(api, execution["run_id"].get<std::string>())["measurements"].size();
 }
 
 void wait_measurements(const ApiClient& api, const json& execution, std::size_t n) {
@@ -76,7 +77,7 @@ return {
   auto e = start(api, "twice", {{"label", "centre"}});
   auto done = wait_terminal(api, e["id"]);
   ASSERT_EQ(done["status"], "finished_ok") << done.dump();
-  json run = api.get("/v1/runs/" + e["run_id"].get<std::string>());
+  json run = colorlab::client::fetch_run(api, e["run_id"].get<std::string>());
   ASSERT_EQ(run["measurements"].size(), 2u);
   EXPECT_EQ(run["measurements"][0]["step"], "centre/a");
   EXPECT_EQ(run["measurements"][0]["instrument_id"], "ls110");
@@ -180,7 +181,7 @@ TEST(EngineInDaemon, PauseResumeAndAbortLandAtSafePoints) {
   auto aborted = wait_terminal(api, id);
   EXPECT_EQ(aborted["status"], "aborted");
   EXPECT_EQ(aborted["reason"], "aborted by a client");
-  json run = api.get("/v1/runs/" + e["run_id"].get<std::string>());
+  json run = colorlab::client::fetch_run(api, e["run_id"].get<std::string>());
   EXPECT_EQ(run["status"], "aborted");
   EXPECT_LT(run["measurements"].size(), 200u);
   // Nothing to pause or abort any more: a conflict, as problem+json.
@@ -210,7 +211,7 @@ TEST(EngineInDaemon, SigtermSuspendsTheRunningStepAndTheNextStartResumesIt) {
   EXPECT_TRUE(suspended) << "SIGTERM must leave the execution suspended with its reason";
   auto done = wait_terminal(api, id);
   EXPECT_EQ(done["status"], "finished_ok") << done.dump();
-  json run = api.get("/v1/runs/" + e["run_id"].get<std::string>());
+  json run = colorlab::client::fetch_run(api, e["run_id"].get<std::string>());
   ASSERT_EQ(run["measurements"].size(), 20u);
   for (int i = 0; i < 20; ++i) EXPECT_EQ(run["measurements"][i]["step"], "reading/" + std::to_string(i));
 }
@@ -279,7 +280,7 @@ return {
   api.post("/v1/executions/" + id + "/resume", json::object());
   auto done = wait_terminal(api, id);
   EXPECT_EQ(done["status"], "finished_ok") << done.dump();
-  json run = api.get("/v1/runs/" + e["run_id"].get<std::string>());
+  json run = colorlab::client::fetch_run(api, e["run_id"].get<std::string>());
   ASSERT_EQ(run["measurements"].size(), 40u);
   // The lamp was relit and waited for: no reading after the resume comes from a dark or cold lamp.
   double first = run["measurements"][0]["value"];
@@ -314,7 +315,7 @@ return {
   auto e = start(api, "warm", json::object());
   auto done = wait_terminal(api, e["id"], std::chrono::seconds(120));
   ASSERT_EQ(done["status"], "finished_ok") << done.dump();
-  json r = api.get("/v1/runs/" + e["run_id"].get<std::string>())["summary"]["script"];
+  json r = colorlab::client::fetch_run(api, e["run_id"].get<std::string>())["summary"]["script"];
   double cold = r["cold"], warm = r["warm"], waited = r["waited_s"];
   EXPECT_NEAR(cold / warm, 0.85, 0.03) << r.dump();
   // Drift over 60 s below 0.5 % needs 0.15·e^(−t/120)·60/120 < 0.005, i.e. t > 2.7 τ ≈ 324 s.
@@ -357,7 +358,7 @@ return {
     }
     auto done = wait_terminal(api, e["id"], std::chrono::seconds(120));
     EXPECT_EQ(done["status"], "finished_ok") << done.dump();
-    json run = api.get("/v1/runs/" + e["run_id"].get<std::string>());
+    json run = colorlab::client::fetch_run(api, e["run_id"].get<std::string>());
     json restored = nullptr;
     json events = api.get("/v1/events?topic=execution&limit=300");
     for (const auto& ev : events["items"]) {
@@ -388,7 +389,7 @@ TEST(EngineInDaemon, CliPausesResumesAndAbortsAndSaysWhyItCannot) {
   TempDir dir;
   DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), 4, 1));
   auto cli = [&](std::vector<std::string> args) {
-    std::vector<std::string> argv{bin_path("colorlab"), "--url", daemon.url(), "--json"};
+    std::vector<std::string> argv{bin_path("colorlab"), "--socket", daemon.unix_socket(), "--json"};
     argv.insert(argv.end(), args.begin(), args.end());
     return run_command(argv, std::chrono::seconds(60));
   };

@@ -187,7 +187,7 @@ TEST(NightCampaigns, OperatorRequestAnsweredThroughTheApiAndOneLeftToItsDefault)
   api.post("/v1/requests/" + pending["id"].get<std::string>(), {{"answer", "closed"}, {"by", "anna"}});
   auto done = wait_terminal(api, e["id"]);
   ASSERT_EQ(done["status"], "finished_ok") << done.dump(2);
-  json run = api.get("/v1/runs/" + e["run_id"].get<std::string>());
+  json run = colorlab::client::fetch_run(api, e["run_id"].get<std::string>());
   const auto& result = run["summary"]["script"];
   EXPECT_EQ(result["first"], "closed");
   EXPECT_EQ(result["first_by"], "anna");

@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "colorlab/client/api_client.hpp"
+#include "colorlab/client/runs.hpp"
 #include "resume_support.hpp"
 
 using namespace colorlab::testing;
@@ -69,7 +70,7 @@ std::size_t run_count(const ApiClient& api) { return api.get("/v1/runs?limit=300
 
 json run_of(const ApiClient& api, const json& item) {
   auto execution = api.get("/v1/executions/" + item["execution_id"].get<std::string>());
-  return api.get("/v1/runs/" + execution["run_id"].get<std::string>());
+  return colorlab::client::fetch_run(api, execution["run_id"].get<std::string>());
 }
 
 // Sequence numbers in the event log: when an execution was created and when it ended.
@@ -92,7 +93,7 @@ std::map<std::string, Span> execution_spans(const ApiClient& api) {
 
 std::size_t measurement_count(const ApiClient& api, const std::string& execution_id) {
   auto e = api.get("/v1/executions/" + execution_id);
-  return api.get("/v1/runs/" + e["run_id"].get<std::string>())["measurements"].size();
+  return colorlab::client::fetch_run(api, e["run_id"].get<std::string>())["measurements"].size();
 }
 
 // The running item's execution id once it has committed `n` measurements.
@@ -413,7 +414,7 @@ TEST(queue_daemon, CliAddsListsMovesRemovesStartsAndStops) {
   TempDir dir;
   DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), 20, 1));
   auto cli = [&](std::vector<std::string> args) {
-    std::vector<std::string> argv{bin_path("colorlab"), "--url", daemon.url()};
+    std::vector<std::string> argv{bin_path("colorlab"), "--socket", daemon.unix_socket()};
     argv.insert(argv.end(), args.begin(), args.end());
     return run_command(argv, std::chrono::seconds(60));
   };

@@ -35,7 +35,7 @@ json run_frame_average(std::uint64_t seed, int max_delay_ms, int& kills_done) {
   }
   auto done = wait_terminal(api, e["id"]);
   EXPECT_EQ(done["status"], "finished_ok") << done.dump();
-  return api.get("/v1/runs/" + e["run_id"].get<std::string>());
+  return colorlab::client::fetch_run(api, e["run_id"].get<std::string>());
 }
 
 }  // namespace

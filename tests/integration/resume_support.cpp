@@ -28,7 +28,10 @@ std::filesystem::path write_daemon_config(const std::filesystem::path& dir, doub
 }
 
 client::ApiClient api_for(const DaemonProcess& daemon) {
-  return client::ApiClient(client::Endpoint::from_url(daemon.url()), std::chrono::seconds(30));
+  // The Unix socket: these tests start and control executions, which loopback TCP allows only with a key.
+  client::Endpoint socket;
+  socket.unix_socket = daemon.unix_socket();
+  return client::ApiClient(socket, std::chrono::seconds(30));
 }
 
 nlohmann::json wait_terminal(const client::ApiClient& api, const std::string& execution_id, std::chrono::seconds timeout) {
@@ -62,7 +65,7 @@ nlohmann::json run_to_end(const client::ApiClient& api, const std::string& campa
   auto e = api.post("/v1/executions", {{"campaign", campaign}, {"params", params}});
   auto done = wait_terminal(api, e["id"], timeout);
   EXPECT_EQ(done["status"], "finished_ok") << done.dump(2);
-  return api.get("/v1/runs/" + e["run_id"].get<std::string>());
+  return colorlab::client::fetch_run(api, e["run_id"].get<std::string>());
 }
 
 namespace {
@@ -129,7 +132,7 @@ void kill_and_compare(const KillNineCase& c) {
     }
     auto done = wait_terminal(api, e["id"], c.timeout);
     ASSERT_EQ(done["status"], "finished_ok") << c.campaign << " seed " << seed << ": " << done.dump(2);
-    auto run = api.get("/v1/runs/" + e["run_id"].get<std::string>());
+    auto run = colorlab::client::fetch_run(api, e["run_id"].get<std::string>());
     std::vector<std::string> steps;
     for (const auto& m : run["measurements"]) {
       steps.push_back(m["step"]);

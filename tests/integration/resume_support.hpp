@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "colorlab/client/api_client.hpp"
+#include "colorlab/client/runs.hpp"
 #include "colorlab/testing/daemon.hpp"
 #include "colorlab/testing/temp_dir.hpp"
 

@@ -33,7 +33,7 @@ Reference reference_run(const std::string& campaign, const json& params, std::ui
   auto e = api.post("/v1/executions", {{"campaign", campaign}, {"params", params}});
   auto done = wait_terminal(api, e["id"]);
   EXPECT_EQ(done["status"], "finished_ok") << done.dump();
-  json run = api.get("/v1/runs/" + e["run_id"].get<std::string>());
+  json run = colorlab::client::fetch_run(api, e["run_id"].get<std::string>());
   Reference r;
   for (const auto& m : run["measurements"]) {
     r.steps.push_back(m["step"]);
@@ -69,7 +69,7 @@ json interrupted_run(const std::string& campaign, const json& params, std::uint6
   auto done = wait_terminal(api, e["id"]);
   EXPECT_EQ(done["status"], "finished_ok") << done.dump();
   EXPECT_EQ(done["resume_attempts"], 0);  // reset by the steps committed after the resume
-  json run = api.get("/v1/runs/" + e["run_id"].get<std::string>());
+  json run = colorlab::client::fetch_run(api, e["run_id"].get<std::string>());
   daemon.kill9();
   EXPECT_EQ(integrity_check(daemon.state_dir()), "ok");
   return run;

@@ -37,7 +37,7 @@ json control(const DaemonProcess& daemon, const json& command) {
 }
 
 std::size_t measurements_of(const client::ApiClient& api, const json& execution) {
-  return api.get("/v1/runs/" + execution["run_id"].get<std::string>())["measurements"].size();
+  return colorlab::client::fetch_run(api, execution["run_id"].get<std::string>())["measurements"].size();
 }
 
 void wait_for_measurements(const client::ApiClient& api, const json& execution, std::size_t n) {
@@ -87,7 +87,7 @@ TEST(SuspendNotFail, AnInstrumentThatStopsAnsweringSuspendsTheRunUntilItIsBack) 
   ASSERT_EQ(done["status"], "finished_ok") << done.dump(2);
   EXPECT_LT(stored, 40u) << "the fault came too late to interrupt anything";
   json truth = control(daemon, {{"cmd", "truth"}});
-  expect_undisturbed(api.get("/v1/runs/" + e["run_id"].get<std::string>()), "reading/", 0, 40,
+  expect_undisturbed(colorlab::client::fetch_run(api, e["run_id"].get<std::string>()), "reading/", 0, 40,
                      truth["ls110"]["luminance"], truth["ls110"]["noise_sigma"]);
   // The suspension and its end are in the event log.
   bool suspended = false, resumed = false;
@@ -134,7 +134,7 @@ TEST(SuspendNotFail, ALampThatGoesOutSuspendsTheRunUntilItIsBackAndStable) {
   ASSERT_EQ(done["status"], "finished_ok") << done.dump(2);
   json truth = control(daemon, {{"cmd", "truth"}});
   // No reading in the dark and none of a lamp still warming up: all equal the warm lamp's truth.
-  expect_undisturbed(api.get("/v1/runs/" + e["run_id"].get<std::string>()), "r/", 1, 30, truth["ls110"]["luminance"],
+  expect_undisturbed(colorlab::client::fetch_run(api, e["run_id"].get<std::string>()), "r/", 1, 30, truth["ls110"]["luminance"],
                      truth["ls110"]["noise_sigma"]);
   daemon.kill9();
 }
@@ -183,7 +183,7 @@ TEST(SuspendNotFail, ALampThatDriftsMidGridSuspendsItUntilTheLightIsStableAndThe
   json truth = control(daemon, {{"cmd", "truth"}});
   EXPECT_DOUBLE_EQ(truth["drift"]["D65"]["factor"].get<double>(), 1.0) << truth["drift"].dump();
   EXPECT_EQ(truth["drift"]["D65"]["start_s"], drift["lamp_drift"]["start_s"]);
-  json run = api.get("/v1/runs/" + e["run_id"].get<std::string>());
+  json run = colorlab::client::fetch_run(api, e["run_id"].get<std::string>());
   // Every step once, in the grid's order (spot-major; the lamp stays lit, so from the second spot on its
   // levels run the other way round).
   std::vector<std::string> expected_steps{"L/D65/D100/r0c0", "L/D65/D50/r0c0"};
@@ -255,7 +255,7 @@ TEST(SuspendNotFail, AFullDiskSuspendsTheRunAndNothingIsLost) {
   auto done = wait_terminal(api, e["id"]);
   ASSERT_EQ(done["status"], "finished_ok") << done.dump(2);
   json truth = control(daemon, {{"cmd", "truth"}});
-  expect_undisturbed(api.get("/v1/runs/" + e["run_id"].get<std::string>()), "reading/", 0, 60,
+  expect_undisturbed(colorlab::client::fetch_run(api, e["run_id"].get<std::string>()), "reading/", 0, 60,
                      truth["ls110"]["luminance"], truth["ls110"]["noise_sigma"]);
   daemon.kill9();
   EXPECT_EQ(integrity_check(daemon.state_dir()), "ok");

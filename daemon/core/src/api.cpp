@@ -3,8 +3,12 @@
 #include <nlohmann/json.hpp>
 
 #include "colorlab/core/error.hpp"
+#include "colorlab/daemon/access.hpp"
+#include "colorlab/daemon/access_api.hpp"
 #include "colorlab/daemon/blob_api.hpp"
+#include "colorlab/daemon/export_api.hpp"
 #include "colorlab/daemon/queue_api.hpp"
+#include "colorlab/daemon/read_connections.hpp"
 #include "colorlab/protocol/api.hpp"
 #include "colorlab/protocol/problem.hpp"
 
@@ -17,6 +21,8 @@ namespace colorlab::daemon {
 using http::HttpRequest;
 using http::HttpResponse;
 using nlohmann::json;
+
+store::Store& ApiContext::reads() { return readers ? readers->for_this_thread() : store; }
 
 namespace {
 
@@ -37,17 +43,17 @@ HttpResponse method_not_allowed(const HttpRequest& req, const std::string& allow
   return r;
 }
 
-unsigned page_limit(const HttpRequest& req) {
+unsigned page_limit(const HttpRequest& req, unsigned fallback = protocol::kDefaultPageLimit,
+                    unsigned most = protocol::kMaxPageLimit) {
   auto it = req.query.find("limit");
-  if (it == req.query.end()) return protocol::kDefaultPageLimit;
+  if (it == req.query.end()) return fallback;
   try {
     std::size_t used = 0;
     long v = std::stol(it->second, &used);
-    if (used != it->second.size() || v < 1 || v > static_cast<long>(protocol::kMaxPageLimit)) throw std::out_of_range("limit");
+    if (used != it->second.size() || v < 1 || v > static_cast<long>(most)) throw std::out_of_range("limit");
     return static_cast<unsigned>(v);
   } catch (const std::exception&) {
-    throw Error(ErrorClass::bad_parameter,
-                "limit must be an integer from 1 to " + std::to_string(protocol::kMaxPageLimit));
+    throw Error(ErrorClass::bad_parameter, "limit must be an integer from 1 to " + std::to_string(most));
   }
 }
 
@@ -99,10 +105,11 @@ HttpResponse post_execution_control(ApiContext& ctx, const std::string& id, cons
 }
 
 HttpResponse get_run_script(ApiContext& ctx, const std::string& id) {
-  auto r = ctx.store.run(id);
+  auto& reads = ctx.reads();
+  auto r = reads.run(id);
   if (!r) throw Error(ErrorClass::not_found, "no run with id '" + id + "'");
   if (r->script_sha256.empty()) throw Error(ErrorClass::not_found, "run '" + id + "' predates stored scripts");
-  auto source = ctx.store.script_source(r->script_sha256);
+  auto source = reads.script_source(r->script_sha256);
   if (!source) throw Error(ErrorClass::not_found, "the script of run '" + id + "' is missing");
   HttpResponse resp;
   resp.status = 200;
@@ -183,7 +190,7 @@ HttpResponse get_events(ApiContext& ctx, const HttpRequest& req) {
   }
   std::optional<std::string> topic;
   if (auto it = req.query.find("topic"); it != req.query.end()) topic = it->second;
-  auto events = ctx.store.events(after, page_limit(req), topic);
+  auto events = ctx.reads().events(after, page_limit(req), topic);
   json items = json::array();
   for (const auto& e : events) items.push_back({{"seq", e.seq}, {"time", e.time}, {"topic", e.topic}, {"payload", e.payload}});
   std::int64_t last = events.empty() ? after : events.back().seq;
@@ -194,7 +201,7 @@ HttpResponse get_runs(ApiContext& ctx, const HttpRequest& req) {
   unsigned limit = page_limit(req);
   std::optional<std::string> cursor;
   if (auto it = req.query.find("cursor"); it != req.query.end()) cursor = it->second;
-  auto page = ctx.store.runs(limit, cursor);
+  auto page = ctx.reads().runs(limit, cursor);
   json items = json::array();
   for (const auto& r : page.runs) items.push_back(r.to_json());
   json links = json::object();
@@ -204,22 +211,76 @@ HttpResponse get_runs(ApiContext& ctx, const HttpRequest& req) {
   return HttpResponse::json(200, {{"items", items}, {"links", links}, {"next_cursor", page.next_cursor ? json(*page.next_cursor) : json(nullptr)}});
 }
 
+// The run document stays small however many measurements the run holds: they are paged.
 HttpResponse get_run(ApiContext& ctx, const std::string& id) {
-  auto r = ctx.store.run(id);
+  auto& reads = ctx.reads();
+  auto r = reads.run(id);
   if (!r) throw Error(ErrorClass::not_found, "no run with id '" + id + "'");
   json j = r->to_json();
-  json ms = json::array();
-  for (const auto& m : ctx.store.measurements(id)) ms.push_back(m.to_json());
-  j["measurements"] = ms;
+  j["measurement_count"] = reads.measurement_count(id);
+  const std::string self = std::string(protocol::kPrefix) + "/runs/" + id;
+  j["links"] = {{"measurements", self + "/measurements"}, {"blobs", self + "/blobs"}, {"export", self + "/export"}};
   return HttpResponse::json(200, j);
 }
 
+HttpResponse get_run_measurements(ApiContext& ctx, const HttpRequest& req, const std::string& id) {
+  auto& reads = ctx.reads();
+  unsigned limit = page_limit(req, protocol::kDefaultMeasurementPageLimit, protocol::kMaxMeasurementPageLimit);
+  std::int64_t after = 0;
+  if (auto it = req.query.find("cursor"); it != req.query.end()) {
+    try {
+      std::size_t used = 0;
+      after = std::stoll(it->second, &used);
+      if (used != it->second.size() || after < 0) throw std::invalid_argument("cursor");
+    } catch (const std::exception&) {
+      throw Error(ErrorClass::bad_parameter, "cursor must be the next_cursor of the previous page");
+    }
+  }
+  store::MeasurementFilter filter;
+  auto take = [&req](const char* name, std::string& into) {
+    if (auto it = req.query.find(name); it != req.query.end()) into = it->second;
+  };
+  take("step_prefix", filter.step_prefix);
+  take("quantity", filter.quantity);
+  take("instrument", filter.instrument_id);
+  // An unknown run is a 404, not an empty page.
+  if (!reads.run(id)) throw Error(ErrorClass::not_found, "no run with id '" + id + "'");
+  auto page = reads.measurements_page(id, filter, after, limit);
+  json items = json::array();
+  for (const auto& m : page.items) items.push_back(m.to_json());
+  json next = nullptr;
+  json next_link = nullptr;
+  if (page.next_after) {
+    next = std::to_string(*page.next_after);
+    std::string link = std::string(protocol::kPrefix) + "/runs/" + id + "/measurements?limit=" + std::to_string(limit) +
+                       "&cursor=" + next.get<std::string>();
+    for (const auto& [k, v] : req.query) {
+      if (k != "limit" && k != "cursor") link += "&" + k + "=" + http::percent_encode(v);
+    }
+    next_link = link;
+  }
+  return HttpResponse::json(200, {{"items", items}, {"next_cursor", next}, {"links", {{"next", next_link}}}});
+}
+
 }  // namespace
+
+bool serves_stored_data(const HttpRequest& req) {
+  if (req.method != "GET" && req.method != "HEAD") return false;
+  if (wants_event_stream(req)) return false;  // its snapshot is the main thread's state
+  const std::string prefix(protocol::kPrefix);
+  const std::string& p = req.path;
+  return p == prefix + "/runs" || p.rfind(prefix + "/runs/", 0) == 0 || p == prefix + "/events" ||
+         p.rfind(prefix + "/blobs/", 0) == 0;
+}
 
 HttpResponse handle_api(ApiContext& ctx, const HttpRequest& req) {
   const std::string& p = req.path;
   const std::string prefix(protocol::kPrefix);
   try {
+    if (ctx.access) {
+      if (auto denied = ctx.access->check(req)) return *denied;
+    }
+    if (auto r = handle_access_api(ctx, req)) return *r;
     if (auto r = handle_operator_api(ctx, req)) return *r;
     if (p == prefix || p == prefix + "/") {
       if (req.method != "GET") return method_not_allowed(req, "GET");
@@ -233,6 +294,7 @@ HttpResponse handle_api(ApiContext& ctx, const HttpRequest& req) {
       if (req.method != "GET") return method_not_allowed(req, "GET");
       return get_ports(ctx);
     }
+    if (wants_event_stream(req)) return get_event_stream(ctx, req);
     if (p == prefix + "/events") {
       if (req.method != "GET") return method_not_allowed(req, "GET");
       return get_events(ctx, req);
@@ -263,6 +325,7 @@ HttpResponse handle_api(ApiContext& ctx, const HttpRequest& req) {
     }
     if (auto queue = handle_queue_api(ctx, req)) return *queue;
     if (auto blob = handle_blob_api(ctx, req)) return *blob;
+    if (auto exported = handle_export_api(ctx, req)) return *exported;
     if (p == prefix + "/runs") {
       if (req.method != "GET") return method_not_allowed(req, "GET");
       return get_runs(ctx, req);
@@ -272,6 +335,11 @@ HttpResponse handle_api(ApiContext& ctx, const HttpRequest& req) {
         p.find('/', run_prefix.size()) == p.size() - 7) {
       if (req.method != "GET") return method_not_allowed(req, "GET");
       return get_run_script(ctx, p.substr(run_prefix.size(), p.size() - 7 - run_prefix.size()));
+    }
+    if (p.rfind(run_prefix, 0) == 0 && p.ends_with("/measurements") &&
+        p.find('/', run_prefix.size()) == p.size() - 13 && p.size() > run_prefix.size() + 13) {
+      if (req.method != "GET") return method_not_allowed(req, "GET");
+      return get_run_measurements(ctx, req, p.substr(run_prefix.size(), p.size() - 13 - run_prefix.size()));
     }
     if (p.rfind(run_prefix, 0) == 0 && p.size() > run_prefix.size() && p.find('/', run_prefix.size()) == std::string::npos) {
       if (req.method != "GET") return method_not_allowed(req, "GET");

@@ -34,9 +34,8 @@ std::optional<std::uint64_t> number(std::string_view s) {
   return v;
 }
 
-// Read routes run on the server's pool with their own read-only connection.
-// TODO(lead): ctx.reads() once ApiContext has it; until then the writer connection.
-store::Store& reads(ApiContext& ctx) { return ctx.store; }
+// Served on the HTTP pool: the calling thread's own read connection, never the writer.
+store::Store& reads(ApiContext& ctx) { return ctx.reads(); }
 
 BlobService& service(ApiContext& ctx) {
   if (!ctx.blobs) throw Error(ErrorClass::unsupported, "this daemon keeps no blob store");

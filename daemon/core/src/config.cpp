@@ -92,15 +92,26 @@ void parse_blobs(const toml::node& node, BlobConfig& b, const std::filesystem::p
 
 }  // namespace
 
-DaemonConfig load_config(const std::filesystem::path& file) {
-  toml::table root;
+// The file, or text read from it, as a TOML table; a syntax error names the file and line.
+static toml::table parse_toml(const std::filesystem::path& file, const std::optional<std::string_view>& text) {
   try {
-    root = toml::parse_file(file.string());
+    return text ? toml::parse(*text, file.string()) : toml::parse_file(file.string());
   } catch (const toml::parse_error& e) {
     throw Error(ErrorClass::bad_parameter,
                 file.string() + ":" + std::to_string(e.source().begin.line) + ": " + std::string(e.description()),
                 "fix the TOML syntax");
   }
+}
+
+static DaemonConfig from_toml(const toml::table& root, const std::filesystem::path& file);
+
+DaemonConfig load_config(const std::filesystem::path& file) { return from_toml(parse_toml(file, std::nullopt), file); }
+
+DaemonConfig parse_config(std::string_view text, const std::filesystem::path& file) {
+  return from_toml(parse_toml(file, text), file);
+}
+
+static DaemonConfig from_toml(const toml::table& root, const std::filesystem::path& file) {
   DaemonConfig c;
   auto base = file.parent_path();
   auto resolve = [&](const std::string& p) { return std::filesystem::path(p).is_absolute() ? std::filesystem::path(p) : base / p; };
@@ -131,7 +142,8 @@ DaemonConfig load_config(const std::filesystem::path& file) {
       if (!t) bad(file, node.source(), "[campaigns] must be a table");
       for (const auto& [ckey, cnode] : *t) {
         std::string ck(ckey.str());
-        auto number = [&](double& out, double lo, double hi) {
+        // cnode by init-capture: clang before 16 cannot capture a structured binding (the fuzz build).
+        auto number = [&, &cnode = cnode](double& out, double lo, double hi) {
           auto v = cnode.value<double>();
           if (!v || *v < lo || *v > hi) {
             bad(file, cnode.source(), "campaigns." + ck + " must be a number from " + std::to_string(lo) + " to " + std::to_string(hi));
@@ -172,6 +184,29 @@ DaemonConfig load_config(const std::filesystem::path& file) {
           bad(file, cnode.source(), "unknown key 'campaigns." + ck + "'");
         }
       }
+    } else if (k == "api") {
+      auto t = node.as_table();
+      if (!t) bad(file, node.source(), "[api] must be a table");
+      for (const auto& [akey, anode] : *t) {
+        std::string ak(akey.str());
+        auto v = anode.value<double>();
+        // anode by init-capture: clang before 16 cannot capture a structured binding (the fuzz build).
+        auto in = [&, &anode = anode](double lo, double hi) {
+          if (!v || *v < lo || *v > hi) {
+            bad(file, anode.source(), "api." + ak + " must be a number from " + std::to_string(lo) + " to " + std::to_string(hi));
+          }
+          return *v;
+        };
+        if (ak == "threads") {
+          c.api.threads = static_cast<unsigned>(in(1, 64));
+        } else if (ak == "stream_write_timeout_s") {
+          c.api.stream_write_timeout_s = in(0.1, 3600);
+        } else if (ak == "max_connections") {
+          c.api.max_connections = static_cast<unsigned>(in(16, 100000));
+        } else {
+          bad(file, anode.source(), "unknown key 'api." + ak + "'");
+        }
+      }
     } else if (k == "queue") {
       auto t = node.as_table();
       if (!t) bad(file, node.source(), "[queue] must be a table");
@@ -184,6 +219,36 @@ DaemonConfig load_config(const std::filesystem::path& file) {
         } else {
           bad(file, qnode.source(), "unknown key 'queue." + qk + "'");
         }
+      }
+    } else if (k == "access") {
+      auto t = node.as_table();
+      if (!t) bad(file, node.source(), "[access] must be a table");
+      for (const auto& [akey, anode] : *t) {
+        std::string ak(akey.str());
+        if (ak == "loopback_scope") {
+          auto v = anode.value<std::string>();
+          if (!v || (*v != "read" && *v != "control" && *v != "admin")) {
+            bad(file, anode.source(), "access.loopback_scope must be \"read\", \"control\" or \"admin\"");
+          }
+          c.access.loopback_scope = *v;
+        } else if (ak == "allow_plaintext") {
+          auto v = anode.value<bool>();
+          if (!v) bad(file, anode.source(), "access.allow_plaintext must be true or false");
+          c.access.allow_plaintext = *v;
+        } else if (ak == "tls_certificate" || ak == "tls_private_key") {
+          auto v = anode.value<std::string>();
+          if (!v || v->empty()) bad(file, anode.source(), "access." + ak + " must be the path of a PEM file");
+          (ak == "tls_certificate" ? c.access.tls_certificate : c.access.tls_private_key) = resolve(*v);
+        } else if (ak == "control_lease_s") {
+          auto v = anode.value<double>();
+          if (!v || *v < 1 || *v > 7 * 86400) bad(file, anode.source(), "access.control_lease_s must be a number from 1 to 604800");
+          c.access.control_lease_s = *v;
+        } else {
+          bad(file, anode.source(), "unknown key 'access." + ak + "'");
+        }
+      }
+      if (c.access.tls_certificate.has_value() != c.access.tls_private_key.has_value()) {
+        bad(file, node.source(), "[access] needs both tls_certificate and tls_private_key, or neither");
       }
     } else if (k == "blobs") {
       parse_blobs(node, c.blobs, file);

@@ -16,9 +16,12 @@
 #include "colorlab/core/log.hpp"
 #include "colorlab/campaigns/catalogue.hpp"
 #include "colorlab/campaigns/lab.hpp"
+#include "colorlab/daemon/access.hpp"
 #include "colorlab/daemon/api.hpp"
 #include "colorlab/daemon/blob_service.hpp"
 #include "colorlab/daemon/embedded_sim.hpp"
+#include "colorlab/daemon/event_hub.hpp"
+#include "colorlab/daemon/read_connections.hpp"
 #include "colorlab/daemon/executions.hpp"
 #include "colorlab/daemon/simulator_hands.hpp"
 #include "colorlab/daemon/night_queue.hpp"
@@ -37,6 +40,7 @@ struct Daemon::Impl {
   std::unique_ptr<EmbeddedSim> sim;
   std::unique_ptr<store::Store> store;
   std::unique_ptr<BlobService> blobs;  // the image store (blob_service.hpp)
+  AccessControl access;  // the policy and the control lock (access.hpp)
   campaigns::InstrumentSet instruments;
   std::unique_ptr<campaigns::ScriptCatalogue> catalogue;
   std::unique_ptr<campaigns::Lab> lab;
@@ -45,6 +49,8 @@ struct Daemon::Impl {
   std::unique_ptr<StoreRunReader> run_reader;  // lab.runs.* (characterize-camera's reference)
   std::unique_ptr<Executions> executions;
   std::unique_ptr<NightQueue> queue;
+  std::unique_ptr<ReadConnections> readers;
+  std::unique_ptr<EventHub> events;
   std::unique_ptr<ApiContext> api;
   std::unique_ptr<http::Server> server;
   std::unique_ptr<drivers::Discovery> discovery;
@@ -99,6 +105,8 @@ Daemon::Daemon(DaemonConfig config) : impl_(std::make_unique<Impl>()) {
   d.store = std::make_unique<store::Store>(d.config.database_path());
   d.blobs = std::make_unique<BlobService>(d.io, *d.store, d.config.state_dir, d.config.blobs);
   d.blobs->start_check();  // files without rows, rows without files: reported, never deleted
+  // Then access control: an insecure listener is refused before anything starts.
+  d.access = make_access_control(d.config, *d.store, d.io);
 
   auto instrument_configs = d.config.instruments;
   if (d.config.simulator.enabled) {
@@ -163,18 +171,38 @@ Daemon::Daemon(DaemonConfig config) : impl_(std::make_unique<Impl>()) {
                                               [&d](const std::string& text) { d.notifier.status(text); });
   d.queue = std::make_unique<NightQueue>(d.io, *d.store, *d.executions, *d.catalogue, *d.lab,
                                          QueueOptions{d.config.queue.autostart});
+  d.readers = std::make_unique<ReadConnections>(d.config.database_path());
+  d.events = std::make_unique<EventHub>(
+      [readers = d.readers.get()] { return readers->for_this_thread().last_event_seq(); },
+      std::chrono::milliseconds(20));
+  d.events->start();
   d.api = std::make_unique<ApiContext>(ApiContext{*d.store, d.instruments, *d.catalogue, *d.executions,
                                                   d.config.simulator.enabled, now_iso8601(), d.discovery.get(), "",
                                                   &d.desk, d.queue.get()});
+  d.api->readers = d.readers.get();
+  d.api->events = d.events.get();
+  d.api->access = d.access.access.get();
+  d.api->control = d.access.lock.get();
   d.api->blobs = d.blobs.get();
 
   http::ServerOptions so;
   so.tcp_host = d.config.listen_host;
   so.tcp_port = d.config.listen_port;
   so.unix_socket = d.config.socket_path();
-  d.server = std::make_unique<http::Server>(d.io, so, [api = d.api.get()](const http::HttpRequest& req) {
-    return handle_api(*api, req);
-  });
+  so.tls_certificate = d.config.access.tls_certificate.value_or("");
+  so.tls_private_key = d.config.access.tls_private_key.value_or("");
+  so.threads = d.config.api.threads;
+  so.max_connections = d.config.api.max_connections;
+  so.stream_write_timeout = std::chrono::milliseconds(static_cast<long>(d.config.api.stream_write_timeout_s * 1000));
+  // Stored data is served on the HTTP pool through read connections, so a commit's fsync never
+  // stalls it; whatever touches live state (executions, instruments, the queue) runs on the main thread.
+  auto handler = [api = d.api.get(), &io = d.io](http::HttpRequest& req) -> asio::awaitable<http::HttpResponse> {
+    if (serves_stored_data(req)) co_return handle_api(*api, req);
+    co_return co_await asio::co_spawn(
+        io, [api, &req]() -> asio::awaitable<http::HttpResponse> { co_return handle_api(*api, req); },
+        asio::use_awaitable);
+  };
+  d.server = std::make_unique<http::Server>(d.io, so, http::AsyncHandler(handler));
   d.server->start();
 }
 
@@ -189,7 +217,7 @@ std::filesystem::path endpoint_file_path(const DaemonConfig& config) { return co
 void Daemon::write_endpoint_file() {
   auto& d = *impl_;
   nlohmann::json j{{"pid", ::getpid()},
-                   {"url", "http://" + d.config.listen_host + ":" + std::to_string(d.server->bound_port())},
+                   {"url", std::string(d.config.access.tls_certificate ? "https://" : "http://") + d.config.listen_host + ":" + std::to_string(d.server->bound_port())},
                    {"port", d.server->bound_port()},
                    {"unix_socket", d.config.socket_path().string()}};
   if (d.sim) {

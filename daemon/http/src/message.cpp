@@ -1,5 +1,7 @@
 #include "colorlab/http/message.hpp"
 
+#include <cctype>
+
 #include <nlohmann/json.hpp>
 
 #include "colorlab/protocol/api.hpp"
@@ -83,8 +85,24 @@ HttpResponse HttpResponse::problem(int status, const std::string& code, const st
   HttpResponse r;
   r.status = status;
   r.content_type = std::string(protocol::kContentProblem);
-  r.body = p.to_json().dump();
+  // A detail may quote the client's bytes (a target that is not UTF-8): replaced, never a throw.
+  r.body = p.to_json().dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
   return r;
+}
+
+std::string percent_encode(std::string_view text) {
+  static constexpr char kHex[] = "0123456789ABCDEF";
+  std::string out;
+  for (unsigned char c : text) {
+    if (std::isalnum(c) || c == '-' || c == '_' || c == '.' || c == '~') {
+      out += static_cast<char>(c);
+    } else {
+      out += '%';
+      out += kHex[c >> 4];
+      out += kHex[c & 15];
+    }
+  }
+  return out;
 }
 
 }  // namespace colorlab::http

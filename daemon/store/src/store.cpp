@@ -117,6 +117,13 @@ Store::Store(const fs::path& database_path) {
   }
 }
 
+Store::Store(const fs::path& database_path, ReadOnly) {
+  db_ = Database(database_path.string(), true);
+  db_.exec("PRAGMA busy_timeout = 5000");
+  db_.exec("PRAGMA query_only = ON");
+  db_.exec("PRAGMA temp_store = MEMORY");
+}
+
 Store::Created Store::create_execution(const NewRun& run) {
   if (run.idempotency_key) {
     auto st = db_.prepare("SELECT id FROM executions WHERE idempotency_key = ?1");
@@ -516,26 +523,68 @@ std::optional<RunRecord> Store::run(const std::string& id) {
   return read_run(st);
 }
 
+namespace {
+
+MeasurementRecord read_measurement(Statement& st) {
+  MeasurementRecord m;
+  m.seq = st.int64(0);
+  m.step = st.text(1);
+  m.instrument_id = st.text(2);
+  m.simulated = st.int64(3) != 0;
+  m.quantity = st.text(4);
+  if (!st.is_null(5)) m.value = st.real(5);
+  m.unit = st.text(6);
+  m.data = parse_json_column(st.text(7));
+  m.measured_at = st.text(8);
+  return m;
+}
+
+constexpr const char* kMeasurementColumns =
+    "seq, step, instrument_id, simulated, quantity, value, unit, data, measured_at";
+
+}  // namespace
+
 std::vector<MeasurementRecord> Store::measurements(const std::string& run_id) {
-  auto st = db_.prepare(
-      "SELECT seq, step, instrument_id, simulated, quantity, value, unit, data, measured_at FROM measurements "
-      "WHERE run_id = ?1 ORDER BY seq");
+  auto st = db_.prepare(std::string("SELECT ") + kMeasurementColumns + " FROM measurements WHERE run_id = ?1 ORDER BY seq");
   st.bind(1, std::string_view(run_id));
   std::vector<MeasurementRecord> out;
-  while (st.step()) {
-    MeasurementRecord m;
-    m.seq = st.int64(0);
-    m.step = st.text(1);
-    m.instrument_id = st.text(2);
-    m.simulated = st.int64(3) != 0;
-    m.quantity = st.text(4);
-    if (!st.is_null(5)) m.value = st.real(5);
-    m.unit = st.text(6);
-    m.data = parse_json_column(st.text(7));
-    m.measured_at = st.text(8);
-    out.push_back(std::move(m));
-  }
+  while (st.step()) out.push_back(read_measurement(st));
   return out;
+}
+
+MeasurementPage Store::measurements_page(const std::string& run_id, const MeasurementFilter& filter,
+                                         std::int64_t after_seq, unsigned limit) {
+  // One row more than asked says whether another page follows. The (run_id, seq) index orders it;
+  // the filters are checked on the rows it walks (a run holds at most some 10^5 of them).
+  auto st = db_.prepare(std::string("SELECT ") + kMeasurementColumns +
+                        " FROM measurements WHERE run_id = ?1 AND seq > ?2"
+                        " AND (?3 = '' OR substr(step, 1, length(?3)) = ?3)"
+                        " AND (?4 = '' OR quantity = ?4) AND (?5 = '' OR instrument_id = ?5)"
+                        " ORDER BY seq LIMIT ?6");
+  st.bind(1, std::string_view(run_id))
+      .bind(2, after_seq)
+      .bind(3, std::string_view(filter.step_prefix))
+      .bind(4, std::string_view(filter.quantity))
+      .bind(5, std::string_view(filter.instrument_id))
+      .bind(6, static_cast<std::int64_t>(limit) + 1);
+  MeasurementPage page;
+  while (st.step()) page.items.push_back(read_measurement(st));
+  if (page.items.size() > limit) {
+    page.items.pop_back();
+    page.next_after = page.items.back().seq;
+  }
+  return page;
+}
+
+std::int64_t Store::measurement_count(const std::string& run_id) {
+  auto st = db_.prepare("SELECT count(*) FROM measurements WHERE run_id = ?1");
+  st.bind(1, std::string_view(run_id));
+  return st.step() ? st.int64(0) : 0;
+}
+
+std::int64_t Store::last_event_seq() {
+  auto st = db_.prepare("SELECT coalesce(max(seq), 0) FROM event_log");
+  return st.step() ? st.int64(0) : 0;
 }
 
 RunPage Store::runs(unsigned limit, const std::optional<std::string>& cursor) {

@@ -15,6 +15,9 @@ inline constexpr std::string_view kContentProblem = "application/problem+json";
 inline constexpr std::size_t kMaxRequestBody = 1 << 20;
 inline constexpr unsigned kDefaultPageLimit = 50;
 inline constexpr unsigned kMaxPageLimit = 300;
+// A run's measurements are small rows read in bulk (a cabinet grid holds thousands).
+inline constexpr unsigned kDefaultMeasurementPageLimit = 1000;
+inline constexpr unsigned kMaxMeasurementPageLimit = 5000;
 
 // Default endpoints of the embedded (simulated-lab) configuration.
 inline constexpr std::string_view kDefaultListen = "127.0.0.1:8765";

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "colorlab/drivers/factory.hpp"
@@ -40,11 +41,28 @@ struct QueueConfig {
   bool autostart = false;  // start the queue with the daemon (unless a failed item halted it)
 };
 
+// [access]: who may do what over the API (docs/API.md, "Access"), TLS for a listener beyond
+// loopback, and how long the control lock lasts without being renewed.
+struct AccessConfig {
+  std::string loopback_scope = "read";  // what loopback TCP may do without a key: read | control | admin
+  bool allow_plaintext = false;         // a listener beyond loopback without TLS (then warned about)
+  std::optional<std::filesystem::path> tls_certificate;  // PEM; with tls_private_key, TCP speaks TLS
+  std::optional<std::filesystem::path> tls_private_key;
+  double control_lease_s = 600;
+};
+
 // [blobs]: the image store under <state_dir>/blobs (docs/configuration.md).
 struct BlobConfig {
   double retention_days = 0;      // 0: blobs are kept for ever
   std::vector<std::string> keep;  // kinds retention never removes ("raw", "average", …)
   bool verify_hashes = true;      // the start-up check hashes every file (false: sizes only)
+};
+
+// [api]: how the HTTP API serves (docs/configuration.md).
+struct ApiConfig {
+  unsigned threads = 2;                // HTTP pool threads serving stored data (runs, blobs, the event log)
+  double stream_write_timeout_s = 10;  // a live event stream whose client stalls this long is dropped
+  unsigned max_connections = 1024;
 };
 
 struct DaemonConfig {
@@ -56,7 +74,9 @@ struct DaemonConfig {
   SimulatorConfig simulator;
   CampaignConfig campaigns;
   QueueConfig queue;
+  ApiConfig api;
   BlobConfig blobs;
+  AccessConfig access;
 
   std::filesystem::path database_path() const;
   std::filesystem::path socket_path() const;
@@ -67,6 +87,8 @@ struct DaemonConfig {
 DaemonConfig embedded_default_config();
 // Throws Error{bad_parameter} naming the file, line and key for anything invalid.
 DaemonConfig load_config(const std::filesystem::path& file);
+// The same from text read from `file` (which only names it in errors and anchors relative paths).
+DaemonConfig parse_config(std::string_view text, const std::filesystem::path& file);
 // "HOST:PORT" → host and port; throws Error{bad_parameter}.
 void apply_listen(DaemonConfig& c, const std::string& host_port);
 

@@ -67,4 +67,7 @@ struct HttpResponse {
 
 using Handler = std::function<HttpResponse(const HttpRequest&)>;
 
+// For a query value in a link the server hands back: everything but unreserved characters escaped.
+std::string percent_encode(std::string_view text);
+
 }  // namespace colorlab::http

@@ -135,12 +135,28 @@ struct RunPage {
   std::optional<std::string> next_cursor;
 };
 
+// Which of a run's measurements a page holds; empty fields match everything.
+struct MeasurementFilter {
+  std::string step_prefix;
+  std::string quantity;
+  std::string instrument_id;
+};
+
+struct MeasurementPage {
+  std::vector<MeasurementRecord> items;
+  std::optional<std::int64_t> next_after;  // the seq to continue after, when more rows match
+};
+
 class Store {
  public:
   // Creates the directory and database as needed, migrates and checks integrity. Executions a
   // previous process left unfinished stay as they were, for the daemon to resume; only those
   // without a stored script (made before scripts were stored) are marked `interrupted`.
   explicit Store(const std::filesystem::path& database_path);
+  // A reader's own connection to an existing database: never migrates, never writes
+  // (query_only), and in WAL mode never waits for the writer's commits. One per reading thread.
+  struct ReadOnly {};
+  Store(const std::filesystem::path& database_path, ReadOnly);
 
   // Creates a run and its execution in one transaction. With an idempotency key already used,
   // returns the existing execution and created = false (a retried POST must not start a campaign twice).
@@ -189,6 +205,11 @@ class Store {
   std::optional<ExecutionRecord> execution(const std::string& id);
   std::optional<RunRecord> run(const std::string& id);
   std::vector<MeasurementRecord> measurements(const std::string& run_id);
+  // Keyset page of a run's measurements in seq order, after `after_seq` (0: from the start).
+  MeasurementPage measurements_page(const std::string& run_id, const MeasurementFilter& filter,
+                                    std::int64_t after_seq, unsigned limit);
+  std::int64_t measurement_count(const std::string& run_id);
+  std::int64_t last_event_seq();
   // Newest first; `cursor` is the opaque next_cursor of the previous page.
   RunPage runs(unsigned limit, const std::optional<std::string>& cursor);
 
@@ -201,6 +222,7 @@ class Store {
   // The queue's rows live in their own file and share this connection (one writer, one thread).
   friend class QueueStore;
   friend class BlobIndex;  // blob_index.hpp: the blob store's rows
+  friend class ApiKeyStore;  // api_keys.hpp: keys on the same writer connection
   RunRecord read_run(Statement& st);
   ExecutionRecord read_execution(Statement& st);
 
