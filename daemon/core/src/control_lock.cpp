@@ -14,10 +14,14 @@ std::string iso_in(ControlLock::Clock::duration from_now) {
                      std::chrono::duration_cast<std::chrono::system_clock::duration>(from_now));
 }
 
+// A key's id, or null for the Unix socket and keyless loopback (as in the status).
+json key_json(const std::string& key_id) { return key_id.empty() ? json(nullptr) : json(key_id); }
+
 http::HttpResponse force_needs_admin(const char* what) {
-  return problem_response(403, "scope-insufficient", "Forbidden",
-                          std::string("breaking another client's control lock (") + what + " with force) needs the admin scope",
-                          "use the daemon's Unix socket or an admin key", {{"required_scope", "admin"}});
+  return problem_response(
+      403, "scope-insufficient", "Forbidden",
+      std::string("breaking another client's control lock (") + what + " with force) needs the admin scope",
+      "use the daemon's Unix socket or an admin key", {{"required_scope", "admin"}});
 }
 
 }  // namespace
@@ -31,7 +35,10 @@ void ControlLock::emit(json event) const {
 
 std::optional<ControlLock::Holder>& ControlLock::current(Clock::time_point now) {
   if (holder_ && now >= holder_->expires) {
-    emit({{"event", "expired"}, {"holder", holder_->name}, {"key_id", holder_->key_id}, {"since", holder_->since}});
+    emit({{"event", "expired"},
+          {"holder", holder_->name},
+          {"key_id", key_json(holder_->key_id)},
+          {"since", holder_->since}});
     holder_.reset();
   }
   return holder_;
@@ -41,7 +48,7 @@ json ControlLock::status_locked(Clock::time_point now) const {
   json j{{"held", holder_.has_value()}, {"lease_s", lease_.count()}};
   if (holder_) {
     j["holder"] = holder_->name;
-    j["key_id"] = holder_->key_id.empty() ? json(nullptr) : json(holder_->key_id);
+    j["key_id"] = key_json(holder_->key_id);
     j["since"] = holder_->since;
     j["expires_at"] = iso_in(holder_->expires - now);
   } else {
@@ -72,7 +79,7 @@ ControlLock::Outcome ControlLock::acquire(const Caller& caller, const std::strin
   if (h && h->identity != caller.identity()) {
     if (!force) return {false, nullptr, locked_by(*h, "cannot acquire")};
     if (!caller.may(Scope::admin)) return {false, nullptr, force_needs_admin("acquire")};
-    emit({{"event", "broken"}, {"holder", h->name}, {"key_id", h->key_id}, {"by", name}});
+    emit({{"event", "broken"}, {"holder", h->name}, {"key_id", key_json(h->key_id)}, {"by", name}});
     h.reset();
   }
   if (h) {
@@ -81,7 +88,7 @@ ControlLock::Outcome ControlLock::acquire(const Caller& caller, const std::strin
     h->name = name;
   } else {
     h = Holder{caller.identity(), name, caller.key_id, now_iso8601(), now + lease_};
-    emit({{"event", "acquired"}, {"holder", name}, {"key_id", caller.key_id}, {"since", h->since}});
+    emit({{"event", "acquired"}, {"holder", name}, {"key_id", key_json(caller.key_id)}, {"since", h->since}});
   }
   return {true, status_locked(now), {}};
 }
@@ -93,10 +100,10 @@ ControlLock::Outcome ControlLock::release(const Caller& caller, bool force) {
   if (h && h->identity != caller.identity()) {
     if (!force) return {false, nullptr, locked_by(*h, "cannot release another client's lock")};
     if (!caller.may(Scope::admin)) return {false, nullptr, force_needs_admin("release")};
-    emit({{"event", "broken"}, {"holder", h->name}, {"key_id", h->key_id}, {"by", caller.name()}});
+    emit({{"event", "broken"}, {"holder", h->name}, {"key_id", key_json(h->key_id)}, {"by", caller.name()}});
     h.reset();
   } else if (h) {
-    emit({{"event", "released"}, {"holder", h->name}, {"key_id", h->key_id}, {"since", h->since}});
+    emit({{"event", "released"}, {"holder", h->name}, {"key_id", key_json(h->key_id)}, {"since", h->since}});
     h.reset();
   }
   return {true, status_locked(now), {}};
