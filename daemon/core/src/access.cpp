@@ -37,6 +37,8 @@ std::optional<Scope> scope_from_string(std::string_view s) {
 Scope required_scope(const HttpRequest& req) {
   const std::string keys = std::string(protocol::kPrefix) + "/keys";
   if (req.path == keys || req.path.rfind(keys + "/", 0) == 0) return Scope::admin;
+  // Retention deletes kept frames' files: not something a campaign operator's key should do.
+  if (req.method == "POST" && req.path == std::string(protocol::kPrefix) + "/blobs/retention") return Scope::admin;
   // Unknown methods need control too: nothing reaches a route that changes state with only read.
   if (req.method == "GET" || req.method == "HEAD" || req.method == "OPTIONS") return Scope::read;
   return Scope::control;

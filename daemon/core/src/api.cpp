@@ -60,7 +60,8 @@ unsigned page_limit(const HttpRequest& req, unsigned fallback = protocol::kDefau
 HttpResponse get_root(ApiContext& ctx) {
   json features = json::array({"instruments", "ports", "events", "campaigns", "lua-campaigns", "executions",
                                "execution-control", "resume-after-restart", "runs", "run-script", "problem+json",
-                               "cursor-paging", "idempotency-key", "operator-requests", "queue"});
+                               "cursor-paging", "idempotency-key", "operator-requests", "queue", "measurement-pages",
+                               "event-stream", "blobs", "exports", "api-keys", "control-lock", "tls"});
   return HttpResponse::json(200, {{"server", "colorlabd"},
                                   {"server_version", COLORLAB_VERSION},
                                   {"api_version", protocol::kApiVersion},
