@@ -3,6 +3,8 @@
 #include <cmath>
 #include <fstream>
 #include <iterator>
+#include <limits>
+#include <type_traits>
 
 #include <nlohmann/json.hpp>
 
@@ -22,10 +24,29 @@ std::string clip(std::string s) {
   return s;
 }
 
+// json's value() throws its type_error for a field of another type: a field is read only if it is text.
+std::string text_field(const json& answer, const char* key, const std::string& otherwise) {
+  return answer.contains(key) && answer[key].is_string() ? answer[key].get<std::string>() : otherwise;
+}
+
+// json's get<int>() of 1e300 is undefined behaviour and of 2.5 a silent truncation: integers in range only.
+template <class T>
+T integer_of(const json& v, const std::string& what) {
+  if (v.is_number_unsigned() && v.get<std::uint64_t>() <= static_cast<std::uint64_t>(std::numeric_limits<T>::max())) {
+    return static_cast<T>(v.get<std::uint64_t>());
+  }
+  if (v.is_number_integer() && !v.is_number_unsigned() && v.get<std::int64_t>() >= 0 &&
+      static_cast<std::uint64_t>(v.get<std::int64_t>()) <= static_cast<std::uint64_t>(std::numeric_limits<T>::max())) {
+    return static_cast<T>(v.get<std::int64_t>());
+  }
+  throw Error(ErrorClass::protocol_error, "simulated DSLR: " + what + " is " + v.dump() + ", not a count",
+              "driver and simulator disagree about the tethered-camera protocol");
+}
+
 // The protocol's error codes (docs/simulator.md, "Tethered-camera protocol") as colorlab errors.
 Error answer_error(const json& answer, const std::string& camera, const std::string& cmd) {
-  const std::string code = answer.value("error", std::string("?"));
-  const std::string text = camera + ": " + cmd + " refused: " + answer.value("message", code);
+  const std::string code = text_field(answer, "error", "?");
+  const std::string text = camera + ": " + cmd + " refused: " + text_field(answer, "message", code);
   if (code == "busy") {
     return Error(ErrorInfo{.cls = ErrorClass::conflict, .message = text,
                            .hint = "the camera is still writing to its card; wait and retry",
@@ -71,14 +92,20 @@ template <class T>
 std::vector<T> list_of(const json& limits, const char* key) {
   std::vector<T> out;
   if (limits.contains(key)) {
-    for (const auto& v : limits.at(key)) out.push_back(v.get<T>());
+    for (const auto& v : limits.at(key)) {
+      if constexpr (std::is_integral_v<T>) {
+        out.push_back(integer_of<T>(v, std::string("limits.") + key));
+      } else {
+        out.push_back(v.get<T>());
+      }
+    }
   }
   return out;
 }
 
 CameraSettings settings_from(const json& s) {
   CameraSettings c;
-  if (s.contains("iso")) c.iso = s["iso"].get<int>();
+  if (s.contains("iso")) c.iso = integer_of<int>(s["iso"], "settings.iso");
   if (s.contains("shutter")) c.shutter_s = parse_shutter_label(s["shutter"].get<std::string>());
   if (s.contains("aperture")) c.aperture_f = s["aperture"].get<double>();
   if (s.contains("image_format")) c.image_format = image_format_from_string(s["image_format"].get<std::string>());
@@ -195,7 +222,7 @@ CapturedFrame SimDslrCamera::do_capture_frame(std::size_t index) {
     for (const auto& f : answer.at("files")) {
       const std::string file_name = f.at("name").get<std::string>();
       const std::filesystem::path path = f.at("path").get<std::string>();
-      auto bytes = read_whole_file(path, f.at("bytes").get<std::uint64_t>());
+      auto bytes = read_whole_file(path, integer_of<std::uint64_t>(f.at("bytes"), "a file's bytes"));
       names.push_back(file_name);
       std::filesystem::path kept = path;
       if (!options_.keep_dir.empty()) {

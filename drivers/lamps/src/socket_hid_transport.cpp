@@ -78,8 +78,17 @@ void SocketHidTransport::open() {
   link_->connect(socket_path_);
   const json a = call({{"op", "open"}});
   try {
-    info_.vendor_id = a.at("vendor_id").get<std::uint16_t>();
-    info_.product_id = a.at("product_id").get<std::uint16_t>();
+    // json's get<uint16_t>() of 1e300 is undefined behaviour and of 70000 a silent wrap: USB ids only.
+    auto usb_id = [&](const char* key) {
+      const json& v = a.at(key);
+      if (!v.is_number_unsigned() || v.get<std::uint64_t>() > 0xFFFF) {
+        link_->close();
+        throw Error(ErrorClass::protocol_error, "HID relay socket " + socket_path_ + ": " + key + " " + v.dump() + " is not a USB id");
+      }
+      return static_cast<std::uint16_t>(v.get<std::uint64_t>());
+    };
+    info_.vendor_id = usb_id("vendor_id");
+    info_.product_id = usb_id("product_id");
     info_.manufacturer = a.at("manufacturer").get<std::string>();
     info_.product = a.at("product").get<std::string>();
     info_.serial = a.value("serial", std::string());
