@@ -191,9 +191,11 @@ class AccessTest(unittest.TestCase):
     def test_loopback_reads_without_a_key_and_needs_one_to_start(self):
         with self.daemon.tcp_client() as anonymous:
             self.assertIn("items", anonymous.conn.get("/v1/runs"))
-            with self.assertRaises(colorlab.Forbidden) as caught:
+            # No key where one is needed is missing authentication (401), not too small a scope (403).
+            with self.assertRaises(colorlab.Unauthorized) as caught:
                 anonymous.start("luminance-spot", readings=1)
-            self.assertEqual(caught.exception.status, 403)
+            self.assertEqual(caught.exception.status, 401)
+            self.assertIn("control", caught.exception.detail)
             self.assertTrue(caught.exception.hint)
         with self.daemon.tcp_client(key="clk_not_a_key") as stranger:
             with self.assertRaises(colorlab.Unauthorized):
