@@ -116,6 +116,15 @@ TEST_F(DaemonHttp, GarbageInsteadOfHttpIsA400) {
   expect_still_serving();
 }
 
+// A path that is not UTF-8 is quoted back in the problem; JSON must not refuse to write it (a 500).
+TEST_F(DaemonHttp, APathThatIsNotUtf8IsStillA404Problem) {
+  expect_problem(send_raw(port, "GET /v1/runs/%FF%FE HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n"), 404,
+                 "not_found");
+  expect_problem(send_raw(port, "GET /v1/nowhere/%C3%28 HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n"), 404,
+                 "not-found");
+  expect_still_serving();
+}
+
 TEST_F(DaemonHttp, MalformedJsonIsA400) {
   std::string body = "{\"campaign\": \"luminance-spot\", ";
   expect_problem(send_raw_unix(socket_path, "POST /v1/executions HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\n"

@@ -32,7 +32,7 @@ HttpResponse from_error(const Error& e, const std::string& instance) {
   HttpResponse r;
   r.status = p.status;
   r.content_type = std::string(protocol::kContentProblem);
-  r.body = p.to_json().dump();
+  r.body = p.to_json().dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);  // the instance may not be UTF-8
   return r;
 }
 

@@ -26,7 +26,7 @@ inline http::HttpResponse problem_response(int status, const std::string& code, 
   http::HttpResponse r;
   r.status = status;
   r.content_type = std::string(protocol::kContentProblem);
-  r.body = body.dump();
+  r.body = body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
   return r;
 }
 

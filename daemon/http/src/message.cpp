@@ -69,7 +69,7 @@ HttpResponse HttpResponse::json(int status, const nlohmann::json& body) {
   HttpResponse r;
   r.status = status;
   r.content_type = std::string(protocol::kContentJson);
-  r.body = body.dump();
+  r.body = body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);  // a path quoted back may not be UTF-8
   return r;
 }
 
