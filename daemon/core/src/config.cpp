@@ -145,7 +145,8 @@ static DaemonConfig from_toml(const toml::table& root, const std::filesystem::pa
         // cnode by init-capture: clang before 16 cannot capture a structured binding (the fuzz build).
         auto number = [&, &cnode = cnode](double& out, double lo, double hi) {
           auto v = cnode.value<double>();
-          if (!v || *v < lo || *v > hi) {
+          // Written so that nan fails too: it compares false either way, and int(nan) is undefined.
+          if (!v || !(*v >= lo && *v <= hi)) {
             bad(file, cnode.source(), "campaigns." + ck + " must be a number from " + std::to_string(lo) + " to " + std::to_string(hi));
           }
           out = *v;
@@ -192,7 +193,7 @@ static DaemonConfig from_toml(const toml::table& root, const std::filesystem::pa
         auto v = anode.value<double>();
         // anode by init-capture: clang before 16 cannot capture a structured binding (the fuzz build).
         auto in = [&, &anode = anode](double lo, double hi) {
-          if (!v || *v < lo || *v > hi) {
+          if (!v || !(*v >= lo && *v <= hi)) {
             bad(file, anode.source(), "api." + ak + " must be a number from " + std::to_string(lo) + " to " + std::to_string(hi));
           }
           return *v;
@@ -241,7 +242,7 @@ static DaemonConfig from_toml(const toml::table& root, const std::filesystem::pa
           (ak == "tls_certificate" ? c.access.tls_certificate : c.access.tls_private_key) = resolve(*v);
         } else if (ak == "control_lease_s") {
           auto v = anode.value<double>();
-          if (!v || *v < 1 || *v > 7 * 86400) bad(file, anode.source(), "access.control_lease_s must be a number from 1 to 604800");
+          if (!v || !(*v >= 1 && *v <= 7 * 86400)) bad(file, anode.source(), "access.control_lease_s must be a number from 1 to 604800");
           c.access.control_lease_s = *v;
         } else {
           bad(file, anode.source(), "unknown key 'access." + ak + "'");
