@@ -1,0 +1,80 @@
+"""python3 -m colorlab.report RUN_ID... [-o report.html] [--url URL | --socket PATH] [--key KEY]
+
+Writes one self-contained HTML report of the stored runs and prints its path as the last line of stdout.
+Exit codes: 0 written, 2 bad usage, 3 a run not found or the daemon unreachable (with the reason on stderr).
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+
+import colorlab
+
+EXIT_OK, EXIT_USAGE, EXIT_NOT_FOUND = 0, 2, 3
+
+
+def parse(argv):
+    p = argparse.ArgumentParser(prog="python3 -m colorlab.report",
+                                description="Write an HTML report (tables beside the dissertation's, SVG plots) of stored runs.")
+    p.add_argument("runs", nargs="+", metavar="RUN_ID", help="stored runs, in the order their sections appear")
+    p.add_argument("-o", "--output", help="HTML file to write (default: report-<first run id>.html here)")
+    where = p.add_mutually_exclusive_group()
+    where.add_argument("--url", help="the daemon's URL (default: COLORLAB_URL, then the local daemon's endpoint file)")
+    where.add_argument("--socket", help="the daemon's Unix socket (default: COLORLAB_SOCKET)")
+    p.add_argument("--key", help="API key (default: COLORLAB_API_KEY); reading needs the read scope")
+    return p.parse_args(argv)
+
+
+def connect(args):
+    if args.socket or (not args.url and os.environ.get("COLORLAB_SOCKET")):
+        return colorlab.Client(socket=args.socket or os.environ["COLORLAB_SOCKET"], key=args.key)
+    if args.url or os.environ.get("COLORLAB_URL"):
+        return colorlab.Client(args.url, key=args.key)
+    try:
+        return colorlab.Client.local(key=args.key)
+    except Exception:  # no endpoint file here: the documented default URL
+        return colorlab.Client(key=args.key)
+
+
+def main(argv=None) -> int:
+    try:
+        args = parse(sys.argv[1:] if argv is None else argv)
+    except SystemExit as e:  # argparse: 0 for --help, 2 for bad usage
+        return int(e.code or 0)
+    from . import build
+    try:
+        client = connect(args)
+    except Exception as e:
+        print(f"colorlab report: cannot reach the daemon: {e}", file=sys.stderr)
+        return EXIT_NOT_FOUND
+    try:
+        runs = build.load_runs(client, args.runs)
+    except colorlab.NotFound as e:
+        print(f"colorlab report: run not found: {e.detail or e}", file=sys.stderr)
+        return EXIT_NOT_FOUND
+    except colorlab.ConnectionFailed as e:
+        print(f"colorlab report: the daemon is not reachable ({client.url}): {e}", file=sys.stderr)
+        return EXIT_NOT_FOUND
+    except (colorlab.Unauthorized, colorlab.Forbidden) as e:
+        print(f"colorlab report: the daemon refused: {e.title}: {e.detail} {e.hint or ''}".rstrip(), file=sys.stderr)
+        return EXIT_NOT_FOUND
+    except colorlab.BadRequest as e:
+        print(f"colorlab report: {e.detail or e}", file=sys.stderr)
+        return EXIT_USAGE
+    finally:
+        client.close()
+    out = Path(args.output or f"report-{args.runs[0]}.html")
+    html = build.render(runs)
+    if out.parent and not out.parent.exists():
+        out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = out.with_name(out.name + ".tmp")
+    tmp.write_text(html, encoding="utf-8")
+    os.replace(tmp, out)  # whole or not at all: a reader never sees half a report
+    print(out.resolve())
+    return EXIT_OK
+
+
+if __name__ == "__main__":
+    sys.exit(main())

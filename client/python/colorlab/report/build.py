@@ -1,0 +1,57 @@
+"""The report: one section per run, by the run's kind, in one self-contained HTML document."""
+from __future__ import annotations
+
+import datetime as dt
+
+from . import common, fetch, frame_average, summaries
+from .html import document, esc
+
+TITLES = {
+    "frame-average": "Noise against frames averaged (§6.1.3)",
+    "cabinet-grid": "Light-cabinet uniformity (§6.2)",
+    "characterize-camera": "Camera characterization (chapter 7)",
+    "chart-read": "Chart reference values (§6.3)",
+    "luminance-spot": "Spot luminance",
+    "other": "Run summary",
+}
+
+
+def _sections():
+    # Imported late so that a kind whose module is missing or broken costs only its own sections.
+    from . import cabinet_grid, characterization
+    return {"frame-average": frame_average.section, "cabinet-grid": cabinet_grid.section,
+            "characterize-camera": characterization.section}
+
+
+def section_for(run) -> str:
+    kind = fetch.kind_of(run)
+    make = _sections().get(kind)
+    body = make(run) if make else summaries.section(run, kind)
+    first = ""
+    return (f'<section id="{run.short}" class="run" data-run="{esc(run.id)}" data-kind="{esc(kind)}">'
+            f'<h2{first}>{esc(TITLES[kind])} — {esc(run.campaign)} {esc(run.id)}</h2>'
+            + common.header(run) + body + "</section>")
+
+
+def render(runs) -> str:
+    now = dt.datetime.now(dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    sections = [section_for(r) for r in runs]
+    if sections:
+        sections[0] = sections[0].replace("<h2>", '<h2 class="first">', 1)
+    intro = (f"<h1>colorlab report</h1><p class=\"note\">Generated {esc(now)} from {len(runs)} stored run(s). "
+             "Each table stands beside the numbers Ulbricht (2006) published, with the difference; each published "
+             "number names its table or figure and its place in the dissertation. Cells shown as — have no "
+             "published counterpart (or are illegible in the dissertation's text).</p>")
+    return document("colorlab report", intro + "\n".join(sections))
+
+
+def load_runs(client, run_ids):
+    runs = [fetch.load(client, r) for r in run_ids]
+    for run in runs:
+        ref = (run.doc.get("params") or {}).get("reference_run")
+        if fetch.kind_of(run) == "characterize-camera" and ref:
+            try:
+                run.extra["reference"] = fetch.load(client, ref)
+            except Exception:  # the reference only adds the L*a*b* comparisons; the section says when it lacks it
+                run.extra["reference"] = None
+    return runs

@@ -1,0 +1,130 @@
+"""The report of frame-average, chart-read and luminance-spot runs on the simulated lab: made through the CLI,
+its numbers against the runs as stored in the daemon's SQLite file (and the dissertation's text), opened in
+headless Chromium. Also the CLI's failure paths (exit codes 2 and 3)."""
+from __future__ import annotations
+
+import os
+import re
+import subprocess
+import sys
+import unittest
+from pathlib import Path
+
+import numpy as np
+
+from daemon_fixture import SOURCE_DIR, Daemon
+from report_support import check_in_browser, make_report, parse
+
+THESIS = Path(os.environ.get("COLORLAB_DISSERTATION", "/work/shared/seed/ulbricht-2006-dissertation.txt"))
+
+
+def thesis_table2():
+    """Table 2 read straight from the dissertation's text: {('R', 'median'): [6 values for N = 1…25]}."""
+    if not THESIS.exists():
+        raise unittest.SkipTest(f"{THESIS} absent")
+    out = {}
+    for line in THESIS.read_text().splitlines():
+        m = re.match(r"^([RGB]) (Median|Mean Value)\t(.*)$", line)
+        if m:
+            out[(m[1], "median" if m[2] == "Median" else "mean")] = [float(x) for x in m[3].split("\t")]
+    assert len(out) == 6, out
+    return out
+
+
+class FrameAverageReport(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.daemon = Daemon(time_scale=500, seed=11)
+        try:
+            cls.fa = cls.daemon.run_to_end("frame-average", frames=25)["run_id"]
+            cls.ls = cls.daemon.run_to_end("luminance-spot", readings=6)["run_id"]
+            cls.cr = cls.daemon.run_to_end("chart-read")["run_id"]
+        except BaseException:
+            cls.daemon.cleanup()
+            raise
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.daemon.cleanup()
+
+    def report(self):
+        if not hasattr(type(self), "_path"):
+            type(self)._path = make_report(self, self.daemon, [self.fa, self.ls, self.cr], "frame-average")
+        return type(self)._path
+
+    def short(self, run_id):
+        return "r" + run_id.replace("-", "")[-12:]
+
+    def test_table2_is_the_stored_noise_beside_the_published(self):
+        tables, _ = parse(self.report())
+        t = tables[f"{self.short(self.fa)}-table2"]
+        rel = tables[f"{self.short(self.fa)}-table2-relative"]
+        stored = {}
+        for m in self.daemon.stored_measurements(self.fa):
+            _, n, ch = m["step"].split("/")
+            stored.setdefault(ch, {})[int(n[1:])] = m["value"]
+        self.assertEqual(set(stored), {"R", "G", "B"})
+        self.assertEqual(sorted(stored["R"]), [1, 2, 4, 8, 16, 25])
+        published = thesis_table2()
+        for ch, per_n in stored.items():
+            for k, n in enumerate([1, 2, 4, 8, 16, 25]):
+                col = str(n)
+                self.assertEqual(t[(f"{ch}-measured", col, "measured")], per_n[n])
+                for stat in ("median", "mean"):
+                    p = published[(ch, stat)][k]
+                    self.assertEqual(t[(f"{ch}-published-{stat}", col, "published")], p)
+                    self.assertAlmostEqual(t[(f"{ch}-diff-{stat}", col, "difference")], per_n[n] - p, places=9)
+                r = per_n[n] / per_n[1]
+                self.assertAlmostEqual(rel[(f"{ch}-measured", col, "measured")], r, places=12)
+                pr = published[(ch, "median")][k] / published[(ch, "median")][0]
+                self.assertAlmostEqual(rel[(f"{ch}-published-median", col, "published")], pr, places=12)
+                self.assertAlmostEqual(rel[(f"{ch}-diff", col, "difference")], r - pr, places=12)
+                self.assertAlmostEqual(rel[(f"{ch}-model", col, "model")], 1 / np.sqrt(n), places=12)
+
+    def test_summaries_of_the_other_runs(self):
+        tables, _ = parse(self.report())
+        for run_id, quantity in ((self.ls, "luminance"), (self.cr, "reflectance_spectrum")):
+            v = np.array([m["value"] for m in self.daemon.stored_measurements(run_id) if m["quantity"] == quantity])
+            t = tables[f"{self.short(run_id)}-summary"]
+            self.assertEqual(t[(quantity, "count", "measured")], len(v))
+            for col, expect in (("min", v.min()), ("median", np.median(v)), ("mean", v.mean()),
+                                ("stdev", v.std(ddof=1)), ("max", v.max())):
+                self.assertAlmostEqual(t[(quantity, col, "measured")], expect, places=9, msg=col)
+
+    def test_says_which_instruments_were_simulated(self):
+        html = self.report().read_text()
+        run = self.daemon.client.run(self.fa)
+        camera = {m["instrument_id"] for m in self.daemon.stored_measurements(self.fa)}
+        self.assertEqual(len(camera), 1)
+        for inst in run["instruments"]:
+            flag = "true" if inst["simulated"] else "false"
+            self.assertIn(f'data-instrument="{inst["id"]}" data-simulated="{flag}"', html)
+        self.assertIn('class="simulated" data-simulated="true"', html)
+        self.assertIn(f"({camera.pop()})", html)
+
+    def test_opens_in_chromium_with_every_figure(self):
+        s = self.short
+        check_in_browser(self, self.report(), [f"{s(self.fa)}-fig34", f"{s(self.ls)}-series", f"{s(self.cr)}-chart-lab"],
+                         "frame-average")
+
+    def test_cli_failure_paths(self):
+        env = dict(os.environ, PYTHONPATH=str(SOURCE_DIR / "client" / "python"))
+
+        def cli(*args):
+            return subprocess.run([sys.executable, "-m", "colorlab.report", *args], capture_output=True, text=True,
+                                  env=env, timeout=60)
+
+        p = cli()
+        self.assertEqual(p.returncode, 2, p.stderr)
+        p = cli("--url", self.daemon.url, "--socket", "/tmp/x.sock", self.fa)
+        self.assertEqual(p.returncode, 2, p.stderr)
+        p = cli("--url", self.daemon.url, "no-such-run", "-o", os.devnull)
+        self.assertEqual(p.returncode, 3)
+        self.assertIn("not found", p.stderr)
+        p = cli("--url", "http://127.0.0.1:9", self.fa)  # discard port: nobody listens
+        self.assertEqual(p.returncode, 3)
+        self.assertIn("not reachable", p.stderr)
+
+
+if __name__ == "__main__":
+    unittest.main()
