@@ -1,0 +1,117 @@
+// Wires the pieces: the key form, the access probe, the event stream into the store, and hash routing
+// between the four pages (#lab, #queue, #now, #runs[/RUN_ID]) — one page, so the stream stays open.
+import { EventStream } from "./events.js";
+import { Store } from "./store.js";
+import { probeAccess } from "./access.js";
+import { getKey, setKey, remembered } from "./key.js";
+import { get } from "./api.js";
+import { h } from "./dom.js";
+import * as lab from "./pages/lab.js";
+import * as queue from "./pages/queue.js";
+import * as now from "./pages/now.js";
+import * as runs from "./pages/runs.js";
+
+const store = new Store();
+const ctx = {
+  store,
+  access: { control: false, read: true, why: "checking access…" },
+  toast,
+  // A control request refused for access reasons means what we knew about the key is stale: ask again.
+  accessChanged(e) { if (e && [401, 403, 409].includes(e.status)) checkAccess(); },
+  refreshQueue: null,
+};
+
+const pages = {
+  lab: lab.mount(document.getElementById("page-lab"), ctx),
+  queue: queue.mount(document.getElementById("page-queue"), ctx),
+  now: now.mount(document.getElementById("page-now"), ctx),
+  runs: runs.mount(document.getElementById("page-runs"), ctx),
+};
+let currentPage = null;
+
+function route() {
+  const [name, arg] = (location.hash.replace(/^#/, "") || "now").split("/");
+  const page = pages[name] ? name : "now";
+  if (currentPage && currentPage !== page) pages[currentPage].hide();
+  for (const [n] of Object.entries(pages)) {
+    document.getElementById(`page-${n}`).hidden = n !== page;
+    const link = document.querySelector(`nav a[href="#${n}"]`);
+    if (n === page) link.setAttribute("aria-current", "page"); else link.removeAttribute("aria-current");
+  }
+  currentPage = page;
+  pages[page].show(arg ? decodeURIComponent(arg) : undefined);
+  document.title = `colorlab · ${page}`;
+}
+window.addEventListener("hashchange", route);
+
+function toast(text, bad = false) {
+  const box = document.getElementById("toasts");
+  const t = h("p", { class: bad ? "toast bad" : "toast", role: bad ? "alert" : "status" }, text);
+  box.append(t);
+  while (box.children.length > 4) box.firstChild.remove();
+  setTimeout(() => t.remove(), 6000);
+}
+
+async function checkAccess() {
+  ctx.access = await probeAccess();
+  const note = document.getElementById("access-note");
+  document.body.classList.toggle("read-only", !ctx.access.control);
+  note.textContent = ctx.access.control ? "control: this console may start, pause, abort and answer" : ctx.access.why;
+  note.className = ctx.access.control ? "access ok" : "access ro";
+  document.getElementById("access-word").textContent = ctx.access.control ? "CONTROL" : ctx.access.read ? "READ-ONLY" : "NO ACCESS";
+  for (const p of Object.values(pages)) p.update({ kind: "access" });
+}
+
+// Queue events arrive in bursts (enqueued, started, done…): one re-read per burst is enough.
+let queueTimer = null;
+function queueChanged() {
+  clearTimeout(queueTimer);
+  queueTimer = setTimeout(async () => {
+    try { store.queue = await get("/v1/queue"); store.queueDirty = false; } catch { return; }
+    for (const p of Object.values(pages)) p.update({ kind: "event", event: { topic: "queue" } });
+  }, 200);
+}
+
+const conn = document.getElementById("conn");
+const stream = new EventStream({
+  onSnapshot: s => store.applySnapshot(s),
+  onEvent: ev => store.applyEvent(ev),
+  onStatus: (state, why) => {
+    conn.textContent = state === "live" ? "LIVE" : state.toUpperCase();
+    conn.className = `conn conn-${state}`;
+    conn.title = why || "";
+  },
+});
+store.subscribe(what => {
+  if (what.event && what.event.topic === "queue") queueChanged();
+  for (const p of Object.values(pages)) p.update(what);
+});
+
+// The key form: applied at once (access re-probed, stream reopened with the key from where it was).
+const keyInput = document.getElementById("key");
+const keyRemember = document.getElementById("key-remember");
+keyInput.value = getKey();
+keyRemember.checked = remembered();
+document.getElementById("key-form").addEventListener("submit", ev => {
+  ev.preventDefault();
+  setKey(keyInput.value, keyRemember.checked);
+  checkAccess();
+  stream.restart();
+});
+document.getElementById("key-clear").addEventListener("click", () => {
+  keyInput.value = "";
+  setKey("", false);
+  checkAccess();
+  stream.restart();
+});
+
+// For the tests and for curious operators: the live figures, read-only.
+window.colorlabConsole = {
+  stream, store,
+  get access() { return ctx.access; },
+  seen: () => store.seen.slice(),
+};
+
+route();
+checkAccess();
+stream.start();

@@ -1,0 +1,137 @@
+// Runs: the stored runs, newest first, cursor-paged as the API pages them; one run with its measurements
+// (paged too), its kept frames as previews, downloads, exports and — where the daemon has one — its report.
+import { get, exists } from "../api.js";
+import { h, replace, badge, errorBox, fmtTime, fmtNumber, fmtBytes, short } from "../dom.js";
+import { image, download, revokeAll } from "../files.js";
+
+const RUNS_PAGE = 25, MEAS_PAGE = 50;
+
+export function mount(section, ctx) {
+  const listView = h("div", { id: "runs-list" });
+  const detailView = h("div", { id: "run-detail" });
+  section.append(h("h2", {}, "Runs"), listView, detailView);
+
+  // Paging keeps the cursors of the pages before, so "Newer" needs no cursor the API does not give.
+  let cursors = [null], page = 0, filter = { campaign: "", status: "" };
+
+  async function showList() {
+    detailView.hidden = true;
+    listView.hidden = false;
+    revokeAll();
+    const fCampaign = h("input", { id: "filter-campaign", type: "search", value: filter.campaign, placeholder: "e.g. luminance-spot" });
+    const fStatus = h("select", { id: "filter-status" }, ["", "running", "finished_ok", "finished_error", "aborted", "interrupted"]
+      .map(s => h("option", { value: s, selected: s === filter.status }, s || "any")));
+    const table = h("div", { class: "table-wrap" }, h("p", { class: "muted" }, "…"));
+    const pager = h("div", { class: "buttons pager" });
+    const apply = () => { filter = { campaign: fCampaign.value.trim(), status: fStatus.value }; load(); };
+    fCampaign.addEventListener("input", apply);
+    fStatus.addEventListener("change", apply);
+    replace(listView,
+      h("div", { class: "filters" },
+        h("div", { class: "field" }, h("label", { for: "filter-campaign" }, "campaign contains"), fCampaign),
+        h("div", { class: "field" }, h("label", { for: "filter-status" }, "status"), fStatus),
+        h("small", { class: "help" }, "Filters apply to the page shown (the API pages runs newest first, unfiltered).")),
+      table, pager);
+
+    let runs = [], next = null;
+    async function fetchPage() {
+      const cursor = cursors[page];
+      const r = await get(`/v1/runs?limit=${RUNS_PAGE}${cursor ? `&cursor=${encodeURIComponent(cursor)}` : ""}`);
+      runs = r.items;
+      next = r.next_cursor;
+    }
+    function load() {
+      const shown = runs.filter(r => (!filter.campaign || (r.campaign || "").includes(filter.campaign))
+        && (!filter.status || r.status === filter.status));
+      replace(table, shown.length ? h("table", { class: "runs" },
+        h("thead", {}, h("tr", {}, ["run", "campaign", "status", "data", "started", "finished"].map(c => h("th", { scope: "col" }, c)))),
+        h("tbody", {}, shown.map(r => h("tr", {},
+          h("td", {}, h("a", { href: `#runs/${r.id}`, class: "mono" }, short(r.id))),
+          h("td", {}, r.campaign), h("td", {}, badge(r.status)),
+          h("td", {}, r.simulated ? h("span", { class: "tag sim" }, "SIMULATED") : h("span", { class: "tag real" }, "real")),
+          h("td", {}, fmtTime(r.started_at || r.created_at)), h("td", {}, fmtTime(r.finished_at))))))
+        : h("p", { class: "muted" }, runs.length ? "No run on this page matches." : "No runs stored yet."));
+      replace(pager,
+        h("button", { type: "button", id: "runs-newer", disabled: page === 0, onclick: async () => { page--; await refresh(); } }, "← Newer"),
+        h("span", { class: "muted" }, `page ${page + 1}`),
+        h("button", { type: "button", id: "runs-older", disabled: !next, onclick: async () => { cursors[page + 1] = next; page++; await refresh(); } }, "Older →"));
+    }
+    async function refresh() {
+      try { await fetchPage(); load(); } catch (e) { replace(table, errorBox(e)); }
+    }
+    await refresh();
+  }
+
+  async function showRun(id) {
+    listView.hidden = true;
+    detailView.hidden = false;
+    revokeAll();
+    replace(detailView, h("p", { class: "muted" }, "…"));
+    let run;
+    try { run = await get(`/v1/runs/${id}`); } catch (e) { replace(detailView, h("p", {}, h("a", { href: "#runs" }, "← all runs")), errorBox(e)); return; }
+    const meas = h("div", { id: "measurements" });
+    const blobs = h("div", { id: "blobs" });
+    const report = h("span", { id: "report-link" });
+    const base = `/v1/runs/${id}`;
+    const name = `${run.campaign}-${id}`;
+    const summary = run.summary && run.summary.measurements ? Object.entries(run.summary.measurements) : [];
+    replace(detailView,
+      h("p", {}, h("a", { href: "#runs" }, "← all runs")),
+      h("h3", {}, `${run.campaign} `, h("span", { class: "mono muted" }, id)),
+      h("p", {}, badge(run.status), " ", run.simulated ? h("span", { class: "tag sim" }, "SIMULATED data") : h("span", { class: "tag real" }, "real instruments"),
+        ` · started ${fmtTime(run.started_at || run.created_at)} · finished ${fmtTime(run.finished_at)} · ${run.measurement_count ?? "?"} measurements`),
+      run.error ? h("p", { class: "error" }, run.error.detail || run.error.title || JSON.stringify(run.error)) : null,
+      h("details", {}, h("summary", {}, "parameters"), h("pre", {}, JSON.stringify(run.params, null, 2))),
+      summary.length ? h("table", { class: "summary" },
+        h("thead", {}, h("tr", {}, ["quantity", "count", "mean", "stdev", "min", "max", "unit"].map(c => h("th", { scope: "col" }, c)))),
+        h("tbody", {}, summary.map(([q, s]) => h("tr", {}, h("td", {}, q), h("td", {}, String(s.count)),
+          ["mean", "stdev", "min", "max"].map(k => h("td", {}, fmtNumber(s[k]))), h("td", {}, s.unit || ""))))) : null,
+      h("p", { class: "buttons downloads" }, "Export: ",
+        download(`${base}/export?format=csv`, "CSV", `${name}.csv`), " ",
+        download(`${base}/export?format=json`, "JSON", `${name}.json`), " ",
+        download(`${base}/export?format=ti3`, ".ti3", `${name}.ti3`), " ",
+        download(`${base}/script`, "script", `${name}.lua`), " ", report),
+      h("h4", {}, "Measurements"), meas,
+      h("h4", {}, "Frames"), blobs);
+
+    exists(`${base}/report`).then(ok => {
+      if (ok) replace(report, h("a", { href: `${base}/report`, id: "report" }, "report"));
+    });
+
+    const mCursors = [null];
+    let mPage = 0;
+    async function loadMeasurements() {
+      try {
+        const c = mCursors[mPage];
+        const r = await get(`${base}/measurements?limit=${MEAS_PAGE}${c ? `&cursor=${encodeURIComponent(c)}` : ""}`);
+        replace(meas,
+          h("div", { class: "table-wrap" }, h("table", { class: "measurements" },
+            h("thead", {}, h("tr", {}, ["seq", "step", "instrument", "quantity", "value", "unit", "measured"].map(x => h("th", { scope: "col" }, x)))),
+            h("tbody", {}, r.items.map(m => h("tr", {},
+              h("td", {}, String(m.seq)), h("td", {}, m.step), h("td", {}, m.instrument_id, m.simulated ? " (sim)" : ""),
+              h("td", {}, m.quantity), h("td", { class: "num" }, fmtNumber(m.value, 6)), h("td", {}, m.unit || ""),
+              h("td", {}, fmtTime(m.measured_at))))))),
+          h("div", { class: "buttons pager" },
+            h("button", { type: "button", id: "meas-prev", disabled: mPage === 0, onclick: () => { mPage--; loadMeasurements(); } }, "← Previous"),
+            h("span", { class: "muted" }, `page ${mPage + 1}`),
+            h("button", { type: "button", id: "meas-next", disabled: !r.next_cursor,
+                          onclick: () => { mCursors[mPage + 1] = r.next_cursor; mPage++; loadMeasurements(); } }, "Next →")));
+      } catch (e) { replace(meas, errorBox(e)); }
+    }
+    loadMeasurements();
+
+    try {
+      const b = await get(`${base}/blobs`);
+      replace(blobs, b.items.length ? h("div", { class: "cards" }, b.items.map(x => h("figure", { class: "card blob" },
+        image(`/v1/blobs/${x.sha256}/preview.png`, `${x.name} preview`),
+        h("figcaption", {}, `${x.name} · ${x.kind} · ${fmtBytes(x.size)} `, download(`/v1/blobs/${x.sha256}`, "download", x.name)))))
+        : h("p", { class: "muted" }, "This run kept no frames."));
+    } catch (e) { replace(blobs, errorBox(e)); }
+  }
+
+  return {
+    show(arg) { if (arg) showRun(arg); else showList(); },
+    hide() { revokeAll(); },
+    update() {},
+  };
+}
