@@ -17,14 +17,16 @@ CHROMIUM = Path("/usr/bin/chromium")
 CHROMEDRIVER = Path("/usr/bin/chromedriver")
 
 
-def make_report(test: unittest.TestCase, daemon, run_ids, name: str) -> Path:
+def make_report(daemon, run_ids, name: str) -> Path:
     ARTIFACTS.mkdir(parents=True, exist_ok=True)
     out = ARTIFACTS / f"{name}.html"
     env = dict(os.environ, PYTHONPATH=str(SOURCE_DIR / "client" / "python"))
     p = subprocess.run([sys.executable, "-m", "colorlab.report", *run_ids, "-o", str(out), "--url", daemon.url],
                        capture_output=True, text=True, env=env, timeout=120)
-    test.assertEqual(p.returncode, 0, p.stderr)
-    test.assertEqual(p.stdout.strip().splitlines()[-1], str(out.resolve()))
+    if p.returncode != 0:
+        raise AssertionError(f"colorlab.report exited {p.returncode}: {p.stderr}")
+    if p.stdout.strip().splitlines()[-1] != str(out.resolve()):
+        raise AssertionError(f"the last line of stdout is not the report's path: {p.stdout!r}")
     return out
 
 

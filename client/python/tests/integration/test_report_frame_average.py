@@ -49,7 +49,7 @@ class FrameAverageReport(unittest.TestCase):
 
     def report(self):
         if not hasattr(type(self), "_path"):
-            type(self)._path = make_report(self, self.daemon, [self.fa, self.ls, self.cr], "frame-average")
+            type(self)._path = make_report(self.daemon, [self.fa, self.ls, self.cr], "frame-average")
         return type(self)._path
 
     def short(self, run_id):
