@@ -100,7 +100,7 @@ def summary_table(run, maps, uni) -> str:
 def window_tables(run, uni) -> str:
     out = []
     for lamp, levels in uni.items():
-        for level_key, u in levels.items():
+        for level_key, u in sorted(levels.items(), key=lambda kv: -float(kv[0])):
             ws = np.array(u["window_stdev"], dtype=float)
             level = float(level_key)
             number = WINDOW_TABLE.get(int(level)) if lamp == "D65" and level == int(level) else None
