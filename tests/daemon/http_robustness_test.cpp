@@ -121,7 +121,7 @@ TEST_F(DaemonHttp, APathThatIsNotUtf8IsStillA404Problem) {
   expect_problem(send_raw(port, "GET /v1/runs/%FF%FE HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n"), 404,
                  "not_found");
   expect_problem(send_raw(port, "GET /v1/nowhere/%C3%28 HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n"), 404,
-                 "not-found");
+                 "not_found");
   expect_still_serving();
 }
 
@@ -150,7 +150,7 @@ TEST_F(DaemonHttp, WrongShapesAndMediaTypesAreRefused) {
 }
 
 TEST_F(DaemonHttp, UnknownRoutesAndMethodsAre404And405) {
-  expect_problem(send_raw(port, "GET /v2/runs HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n"), 404, "not-found");
+  expect_problem(send_raw(port, "GET /v2/runs HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n"), 404, "not_found");
   expect_problem(send_raw(port, "GET /v1/runs/no-such-run HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n"), 404,
                  "not_found");
   expect_problem(send_raw(port, "GET /v1/runs?limit=100000 HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n"), 400,

@@ -88,6 +88,9 @@ std::string tool(const std::string& name) {
   return path.empty() ? name : path;
 }
 
+#define REQUIRE_TOOL_CURL() \
+  if (!on_path("curl")) GTEST_SKIP() << "curl is not installed: scripts/setup.sh installs it"
+
 #define REQUIRE_ARGYLL(tool)                                                          \
   if (!on_path(tool)) GTEST_SKIP() << tool << " (ArgyllCMS) is not installed: scripts/setup.sh installs argyll"
 
@@ -264,3 +267,21 @@ TEST_F(Exports, CliWritesTheApisBytesToStdoutOrAFile) {
 }
 
 }  // namespace
+
+// HEAD is GET without the body on every route that answers GET (RFC 9110 §9.3.2): here an export and
+// the run list, through curl, an independent client.
+TEST_F(Exports, HeadAnswersAsGetWithoutTheBody) {
+  REQUIRE_TOOL_CURL();
+  const std::string id = lab->chart_read["id"];
+  const auto get = lab->export_of(lab->chart_read, "format=csv");
+  for (const std::string& target : {"/v1/runs/" + id + "/export?format=csv", std::string("/v1/runs")}) {
+    auto head = run_command({tool("curl"), "-sS", "-I", lab->daemon->url() + target});
+    ASSERT_EQ(head.exit_code, 0) << head.err;
+    EXPECT_EQ(head.out.rfind("HTTP/1.1 200", 0), 0u) << target << "\n" << head.out;
+    // curl -I prints the headers alone: a body would follow a blank line.
+    EXPECT_EQ(head.out.find("\r\n\r\n") + 4, head.out.size()) << target;
+  }
+  auto head = run_command({tool("curl"), "-sS", "-I", lab->daemon->url() + "/v1/runs/" + id + "/export?format=csv"});
+  EXPECT_NE(head.out.find("text/csv"), std::string::npos) << head.out;
+  EXPECT_NE(head.out.find("ontent-Length: " + std::to_string(get.body.size())), std::string::npos) << head.out;
+}

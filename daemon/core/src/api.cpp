@@ -6,6 +6,7 @@
 #include "colorlab/daemon/access.hpp"
 #include "colorlab/daemon/access_api.hpp"
 #include "colorlab/daemon/blob_api.hpp"
+#include "colorlab/daemon/console_files.hpp"
 #include "colorlab/daemon/export_api.hpp"
 #include "colorlab/daemon/queue_api.hpp"
 #include "colorlab/daemon/read_connections.hpp"
@@ -270,11 +271,21 @@ bool serves_stored_data(const HttpRequest& req) {
   if (wants_event_stream(req)) return false;  // its snapshot is the main thread's state
   const std::string prefix(protocol::kPrefix);
   const std::string& p = req.path;
+  if (p != prefix && p.rfind(prefix + "/", 0) != 0) return true;  // the console's static files
   return p == prefix + "/runs" || p.rfind(prefix + "/runs/", 0) == 0 || p == prefix + "/events" ||
          p.rfind(prefix + "/blobs/", 0) == 0;
 }
 
 HttpResponse handle_api(ApiContext& ctx, const HttpRequest& req) {
+  // HEAD is GET without the body (the server drops it), on every route that answers GET.
+  if (req.method == "HEAD") {
+    HttpRequest as_get = req;
+    as_get.method = "GET";
+    return handle_api(ctx, as_get);
+  }
+  if (!ctx.console_dir.empty()) {
+    if (auto r = serve_console(req, ctx.console_dir)) return *r;
+  }
   const std::string& p = req.path;
   const std::string prefix(protocol::kPrefix);
   try {
@@ -284,24 +295,24 @@ HttpResponse handle_api(ApiContext& ctx, const HttpRequest& req) {
     if (auto r = handle_access_api(ctx, req)) return *r;
     if (auto r = handle_operator_api(ctx, req)) return *r;
     if (p == prefix || p == prefix + "/") {
-      if (req.method != "GET") return method_not_allowed(req, "GET");
+      if (req.method != "GET") return method_not_allowed(req, "GET, HEAD");
       return get_root(ctx);
     }
     if (p == prefix + "/instruments") {
-      if (req.method != "GET") return method_not_allowed(req, "GET");
+      if (req.method != "GET") return method_not_allowed(req, "GET, HEAD");
       return get_instruments(ctx);
     }
     if (p == prefix + "/ports") {
-      if (req.method != "GET") return method_not_allowed(req, "GET");
+      if (req.method != "GET") return method_not_allowed(req, "GET, HEAD");
       return get_ports(ctx);
     }
     if (wants_event_stream(req)) return get_event_stream(ctx, req);
     if (p == prefix + "/events") {
-      if (req.method != "GET") return method_not_allowed(req, "GET");
+      if (req.method != "GET") return method_not_allowed(req, "GET, HEAD");
       return get_events(ctx, req);
     }
     if (p == prefix + "/campaigns") {
-      if (req.method != "GET") return method_not_allowed(req, "GET");
+      if (req.method != "GET") return method_not_allowed(req, "GET, HEAD");
       return get_campaigns(ctx);
     }
     if (p == prefix + "/executions") {
@@ -310,7 +321,7 @@ HttpResponse handle_api(ApiContext& ctx, const HttpRequest& req) {
     }
     const std::string exec_prefix = prefix + "/executions/";
     if (p.rfind(exec_prefix, 0) == 0 && p.size() > exec_prefix.size() && p.find('/', exec_prefix.size()) == std::string::npos) {
-      if (req.method != "GET") return method_not_allowed(req, "GET");
+      if (req.method != "GET") return method_not_allowed(req, "GET, HEAD");
       return get_execution(ctx, p.substr(exec_prefix.size()));
     }
     if (p.rfind(exec_prefix, 0) == 0) {
@@ -328,25 +339,25 @@ HttpResponse handle_api(ApiContext& ctx, const HttpRequest& req) {
     if (auto blob = handle_blob_api(ctx, req)) return *blob;
     if (auto exported = handle_export_api(ctx, req)) return *exported;
     if (p == prefix + "/runs") {
-      if (req.method != "GET") return method_not_allowed(req, "GET");
+      if (req.method != "GET") return method_not_allowed(req, "GET, HEAD");
       return get_runs(ctx, req);
     }
     const std::string run_prefix = prefix + "/runs/";
     if (p.rfind(run_prefix, 0) == 0 && p.size() > run_prefix.size() + 7 && p.ends_with("/script") &&
         p.find('/', run_prefix.size()) == p.size() - 7) {
-      if (req.method != "GET") return method_not_allowed(req, "GET");
+      if (req.method != "GET") return method_not_allowed(req, "GET, HEAD");
       return get_run_script(ctx, p.substr(run_prefix.size(), p.size() - 7 - run_prefix.size()));
     }
     if (p.rfind(run_prefix, 0) == 0 && p.ends_with("/measurements") &&
         p.find('/', run_prefix.size()) == p.size() - 13 && p.size() > run_prefix.size() + 13) {
-      if (req.method != "GET") return method_not_allowed(req, "GET");
+      if (req.method != "GET") return method_not_allowed(req, "GET, HEAD");
       return get_run_measurements(ctx, req, p.substr(run_prefix.size(), p.size() - 13 - run_prefix.size()));
     }
     if (p.rfind(run_prefix, 0) == 0 && p.size() > run_prefix.size() && p.find('/', run_prefix.size()) == std::string::npos) {
-      if (req.method != "GET") return method_not_allowed(req, "GET");
+      if (req.method != "GET") return method_not_allowed(req, "GET, HEAD");
       return get_run(ctx, p.substr(run_prefix.size()));
     }
-    return HttpResponse::problem(404, "not-found", "Not found", "no route for " + req.method + " " + p,
+    return HttpResponse::problem(404, "not_found", "Not found", "no route for " + req.method + " " + p,
                                  "GET /v1 lists the API's features; see docs/API.md");
   } catch (const Error& e) {
     return from_error(e, req.path);

@@ -28,7 +28,7 @@ std::optional<HttpResponse> handle_operator_api(ApiContext& ctx, const HttpReque
   }
   std::string id = p.substr(base.size() + 1);
   if (id.empty() || id.find('/') != std::string::npos) {
-    return HttpResponse::problem(404, "not-found", "Not found", "no route for " + req.method + " " + p);
+    return HttpResponse::problem(404, "not_found", "Not found", "no route for " + req.method + " " + p);
   }
   if (req.method == "GET") {
     auto r = ctx.desk->find(id);

@@ -1,3 +1,4 @@
+#include "colorlab/daemon/console_files.hpp"
 #include "colorlab/daemon/daemon.hpp"
 
 #include <unistd.h>
@@ -184,6 +185,7 @@ Daemon::Daemon(DaemonConfig config) : impl_(std::make_unique<Impl>()) {
   d.api->access = d.access.access.get();
   d.api->control = d.access.lock.get();
   d.api->blobs = d.blobs.get();
+  d.api->console_dir = shipped_console_dir();
 
   http::ServerOptions so;
   so.tcp_host = d.config.listen_host;

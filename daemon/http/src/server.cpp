@@ -185,7 +185,7 @@ asio::awaitable<void> write_file_response(Stream& stream, const HttpResponse& r,
   FileDescriptor file{::open(r.file->path.c_str(), O_RDONLY | O_CLOEXEC)};
   if (file.fd < 0) {
     // Checked by the handler a moment ago; gone now (retention, or someone's rm).
-    auto gone = HttpResponse::problem(404, "not-found", "Not found", "the file behind this response is gone");
+    auto gone = HttpResponse::problem(404, "not_found", "Not found", "the file behind this response is gone");
     co_await write_response(stream, gone, version, keep_alive, head, shared, ec);
     co_return;
   }

@@ -26,7 +26,7 @@ class Handler(BaseHTTPRequestHandler):
             fake.requests.append((self.command, self.route_path, dict(self.query), dict(self.headers), self.body))
         fn = fake.routes.get((self.command, self.route_path))
         if fn is None:
-            self.send_problem(404, "not-found", "Not found", f"no route for {self.command} {self.route_path}")
+            self.send_problem(404, "not_found", "Not found", f"no route for {self.command} {self.route_path}")
             return
         fn(self)
 

@@ -1,4 +1,5 @@
 #pragma once
+#include <filesystem>
 // The v1 HTTP API (docs/API.md): routes requests to the store, the instruments and the
 // executions. Every error leaves as RFC 9457 problem+json.
 #include <optional>
@@ -39,6 +40,7 @@ struct ApiContext {
   store::Store& reads();
   Access* access = nullptr;       // checked first for every request (access.hpp)
   ControlLock* control = nullptr;  // /v1/control (control_api.cpp)
+  std::filesystem::path console_dir;  // the web console's static files, served at / (console_files.cpp)
 };
 
 http::HttpResponse handle_api(ApiContext& ctx, const http::HttpRequest& req);
