@@ -7,11 +7,22 @@ import re
 import numpy as np
 
 D50 = np.array([0.9642, 1.0, 0.8249])
-# Adobe RGB (1998) primaries adapted to D50 by Bradford, as its ICC profile (and so lcms, which the daemon
-# uses) holds them; the encoding's gamma is 563/256.
-ADOBE_D50 = np.array([[0.6097559, 0.2052401, 0.1492240],
-                      [0.3111242, 0.6256560, 0.0632197],
-                      [0.0194811, 0.0608902, 0.7448387]])
+BRADFORD = np.array([[0.8951, 0.2664, -0.1614], [-0.7502, 1.7135, 0.0367], [0.0389, -0.0685, 1.0296]])
+
+
+def rgb_to_xyz_d50(primaries_xy, white_xy) -> np.ndarray:
+    """An RGB space's matrix to XYZ, adapted to D50 by Bradford: what lcms (and so the daemon) builds from the
+    space's primaries and white, so the report's numbers and the daemon's agree to its precision."""
+    xyz = lambda x, y: np.array([x / y, 1.0, (1 - x - y) / y])  # noqa: E731
+    prim = np.column_stack([xyz(*p) for p in primaries_xy])
+    white = xyz(*white_xy)
+    m = prim * np.linalg.solve(prim, white)
+    cone = np.diag((BRADFORD @ D50) / (BRADFORD @ white))
+    return np.linalg.solve(BRADFORD, cone @ BRADFORD) @ m
+
+
+# Adobe RGB (1998): D65 white, its primaries, pure gamma 563/256 (analysis/src/rgb_spaces.cpp builds the same).
+ADOBE_D50 = rgb_to_xyz_d50([(0.64, 0.33), (0.21, 0.71), (0.15, 0.06)], (0.3127, 0.3290))
 ADOBE_GAMMA = 563 / 256
 
 
