@@ -116,6 +116,11 @@ class FrameAverageReport(unittest.TestCase):
 
         p = cli()
         self.assertEqual(p.returncode, 2, p.stderr)
+        out = Path(self.daemon.dir) / "over-socket.html"
+        p = cli("--socket", self.daemon.endpoint["unix_socket"], self.fa, "-o", str(out))
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertEqual(p.stdout.splitlines()[-1], str(out.resolve()))
+        self.assertIn(f'data-run="{self.fa}"', out.read_text())
         p = cli("--url", self.daemon.url, "--socket", "/tmp/x.sock", self.fa)
         self.assertEqual(p.returncode, 2, p.stderr)
         p = cli("--url", self.daemon.url, "no-such-run", "-o", os.devnull)
