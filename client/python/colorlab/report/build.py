@@ -2,8 +2,9 @@
 from __future__ import annotations
 
 import datetime as dt
+import sys
 
-from . import common, fetch, frame_average, summaries
+from . import cabinet_grid, characterization, common, fetch, frame_average, summaries
 from .html import document, esc
 
 TITLES = {
@@ -16,20 +17,21 @@ TITLES = {
 }
 
 
-def _sections():
-    # Imported late so that a kind whose module is missing or broken costs only its own sections.
-    from . import cabinet_grid, characterization
-    return {"frame-average": frame_average.section, "cabinet-grid": cabinet_grid.section,
+SECTIONS = {"frame-average": frame_average.section, "cabinet-grid": cabinet_grid.section,
             "characterize-camera": characterization.section}
 
 
 def section_for(run) -> str:
     kind = fetch.kind_of(run)
-    make = _sections().get(kind)
-    body = make(run) if make else summaries.section(run, kind)
-    first = ""
+    make = SECTIONS.get(kind)
+    try:
+        body = make(run) if make else summaries.section(run, kind)
+    except Exception as e:  # one odd run (aborted, hand-edited script) must not cost the other runs their sections
+        print(f"colorlab report: run {run.id}: the {kind} section failed: {type(e).__name__}: {e}", file=sys.stderr)
+        body = (f'<p class="warn" data-error="true">This section could not be made from the stored data '
+                f'({esc(type(e).__name__)}: {esc(e)}); the run\'s summary instead:</p>' + summaries.section(run, "other"))
     return (f'<section id="{run.short}" class="run" data-run="{esc(run.id)}" data-kind="{esc(kind)}">'
-            f'<h2{first}>{esc(TITLES[kind])} — {esc(run.campaign)} {esc(run.id)}</h2>'
+            f'<h2>{esc(TITLES[kind])} — {esc(run.campaign)} {esc(run.id)}</h2>'
             + common.header(run) + body + "</section>")
 
 

@@ -27,6 +27,8 @@ def make_report(daemon, run_ids, name: str) -> Path:
         raise AssertionError(f"colorlab.report exited {p.returncode}: {p.stderr}")
     if p.stdout.strip().splitlines()[-1] != str(out.resolve()):
         raise AssertionError(f"the last line of stdout is not the report's path: {p.stdout!r}")
+    if 'data-error="true"' in out.read_text(encoding="utf-8"):
+        raise AssertionError(f"a section of the report failed: {p.stderr}")
     return out
 
 

@@ -3,6 +3,8 @@ no script, no external resource — with each kind's tables and figures, and the
 when a lab renamed its copy of a campaign."""
 from __future__ import annotations
 
+import contextlib
+import io
 import re
 import unittest
 
@@ -63,6 +65,15 @@ class Render(unittest.TestCase):
         self.assertEqual(kind_of(run("x", [{"step": "reading/0", "quantity": "luminance", "value": 1.0}])),
                          "luminance-spot")
         self.assertEqual(kind_of(run("x", [{"step": "what", "quantity": "q", "value": 1.0}])), "other")
+
+    def test_a_broken_run_costs_only_its_own_section(self):
+        bad = run("frame-average", [{"step": "noise/Nx/R", "quantity": "pixel_stdev", "value": 1.0}],
+                  run_id="01a20a70-0000-7d8d-bc85-000000000001")
+        with contextlib.redirect_stderr(io.StringIO()) as err:
+            html = render([bad, noise_run()])
+        self.assertIn("section failed", err.getvalue())
+        self.assertEqual(html.count('data-error="true"'), 1)
+        self.assertIn('id="r7952b36f7605-table2"', html)
 
     def test_other_runs_get_a_summary(self):
         html = render([run("luminance-spot", [{"step": f"reading/{i}", "quantity": "luminance", "value": float(i),
