@@ -239,6 +239,9 @@ def figures(run, maps, uni, prop) -> str:
                        lambda ax: _heat(ax, dl[hi] - scaled, f"{hi:g} % − scaled", cmap="coolwarm")]
             caption += f", (b) at {lo:g} %, (c) at {lo:g} % scaled by {hi / lo:.3g}, (d) the difference of (a) and (c)"
         out.append(_fig(run, f"fig{fnum}" if fnum else f"lamp-{slug(lamp)}", fnum or "43-44", caption + ".", panels))
+        if len(lv) > 2:  # figs. 43/44 show two levels, as the dissertation measured; the map of every level
+            out.append(_fig(run, f"maps-{slug(lamp)}", "37-38", f"{esc(lamp)} at every dimmer level, each on its own scale.",
+                            [lambda ax, x=x: _heat(ax, dl[x], f"{lamp} {x:g} %") for x in lv]))
         w = [(x, np.array(uni[lamp][_level_key(x)]["window_stdev"], dtype=float)) for x in lv[:2]
              if _level_key(x) in uni.get(lamp, {})]
         if w:

@@ -29,6 +29,7 @@ figcaption { font-size: .92em; color: #333; }
   h2 { page-break-before: always; break-before: page; } h2.first { page-break-before: avoid; break-before: avoid; }
   table, figure { page-break-inside: avoid; break-inside: avoid; }
   .section-table { overflow: visible; }
+  table { font-size: 7.5pt; } th, td { padding: 1px 3px; }
   a { color: inherit; text-decoration: none; }
 }
 """
