@@ -62,8 +62,10 @@ class ConsoleTest(unittest.TestCase):
 
     def setUp(self):
         self.d = self.driver
+        self.started = time.monotonic()
 
     def tearDown(self):
+        print(f"  {self._testMethodName}: {time.monotonic() - self.started:.1f} s", flush=True)
         errors = self.log.errors(self.allowed + getattr(self, "extra_allowed", []))
         self.assertEqual(errors, [], "errors in the browser's console")
 
@@ -74,7 +76,19 @@ class ConsoleTest(unittest.TestCase):
     def all_css(self, css):
         return self.d.find_elements("css selector", css)
 
+    def click(self, css):
+        """Clicks what the selector names now: live updates replace elements under the test's hands."""
+        from selenium.common.exceptions import StaleElementReferenceException
+        for _ in range(20):
+            try:
+                self.by_css(css).click()
+                return
+            except StaleElementReferenceException:
+                time.sleep(0.05)
+        self.fail(f"{css} kept being replaced")
+
     def open(self, page):
+        self.d.get("about:blank")  # a new document each time: a fragment change alone would keep the old page
         self.d.get(f"{self.daemon.url}/#{page}")
         wait_for(self, "the event stream", lambda: self.by_css("#conn").text == "LIVE")
 
@@ -83,7 +97,7 @@ class ConsoleTest(unittest.TestCase):
         box.clear()
         if key:
             box.send_keys(key)
-        self.by_css("#key-apply").click()
+        self.click("#key-apply")
         wait_for(self, f"access {expect}", lambda: self.by_css("#access-word").text == expect)
 
     def execution_from_events(self, campaign, after=0):
@@ -114,7 +128,7 @@ class ConsoleTest(unittest.TestCase):
         # Validation before submit: nothing reaches the daemon.
         readings.clear()
         readings.send_keys("0")
-        self.by_css("#start").click()
+        self.click("#start")
         self.assertIn("at least 1", self.by_css("#p-luminance-spot-readings-err").text)
         self.assertEqual(readings.get_attribute("aria-invalid"), "true")
         self.assertEqual(self.execution_from_events("luminance-spot"), [], "an invalid form was submitted")
@@ -123,13 +137,13 @@ class ConsoleTest(unittest.TestCase):
         interval = self.by_css("#p-luminance-spot-interval_s")
         interval.clear()
         interval.send_keys("40")
-        self.by_css("#dry-run").click()
+        self.click("#dry-run")
         estimate = wait_for(self, "the dry run's estimate", lambda: self.by_css(".dry-run .estimate").text)
         self.assertNotEqual(estimate, "—")
         self.assertIn("ok", self.by_css(".dry-run h4").text)
         screenshot(self.d, "queue-dry-run")
         self.assertEqual(self.execution_from_events("luminance-spot"), [], "a dry run stored an execution")
-        self.by_css("#start").click()
+        self.click("#start")
         wait_for(self, "started", lambda: "Started luminance-spot" in self.by_css("#start-form .result").text)
         [created] = self.execution_from_events("luminance-spot")
         run = self.daemon.client.conn.get(f"/v1/runs/{created['run_id']}")
@@ -151,7 +165,7 @@ class ConsoleTest(unittest.TestCase):
         from selenium.webdriver.support.ui import Select
         wait_for(self, "console-ask offered", lambda: "console-ask" in self.by_css("#campaign").text)
         Select(self.by_css("#campaign")).select_by_value("console-ask")
-        self.by_css("#start").click()
+        self.click("#start")
         wait_for(self, "started", lambda: "Started console-ask" in self.by_css("#start-form .result").text)
         self.by_css('nav a[href="#now"]').click()
         wait_for(self, "the request", lambda: self.all_css(".request button.answer"))
@@ -163,12 +177,54 @@ class ConsoleTest(unittest.TestCase):
         self.assertRegex(countdown, r"\d+ (h|min|s)")
         screenshot(self.d, "now-operator-request")
         [ask] = self.execution_from_events("console-ask")
-        self.all_css(".request button.answer")[0].click()
+        self.click(".request button.answer[data-option=off]")
         done = self.daemon.wait_terminal(ask["id"], timeout=60)
         self.assertEqual(done["status"], "finished_ok")
         result = self.daemon.client.conn.get(f"/v1/runs/{done['run_id']}")["summary"]["script"]
         self.assertEqual((result["answer"], result["by"]), ("off", "console"))
         wait_for(self, "the request gone from the page", lambda: not self.all_css(".request"))
+
+    def test_3b_pause_resume_abort_and_the_queue(self):
+        from selenium.webdriver.support.ui import Select
+        self.open("queue")
+        self.use_key(self.control_key, "CONTROL")
+        wait_for(self, "luminance-spot offered", lambda: "luminance-spot" in self.by_css("#campaign").text)
+        Select(self.by_css("#campaign")).select_by_value("luminance-spot")
+        for name, value in (("readings", "200"), ("interval_s", "200")):
+            box = wait_for(self, name, lambda: self.by_css(f"#p-luminance-spot-{name}"))
+            box.clear()
+            box.send_keys(value)
+        self.click("#start")
+        wait_for(self, "started", lambda: "Started luminance-spot" in self.by_css("#start-form .result").text)
+        long = [e for e in self.execution_from_events("luminance-spot")
+                if self.daemon.client.conn.get(f"/v1/runs/{e['run_id']}")["params"]["readings"] == 200][0]
+        row = f'#executions li[data-execution="{long["id"]}"]'
+        state = lambda: self.by_css(f"{row} .badge").text  # noqa: E731
+        wait_for(self, "running", lambda: state() == "running")
+        self.click(f"{row} button[data-focus^=pause]")
+        wait_for(self, "paused", lambda: state() == "paused", timeout=30)
+        self.assertTrue(self.by_css(f"{row} button[data-focus^=resume]").is_enabled())
+        screenshot(self.d, "queue-paused")
+        self.click(f"{row} button[data-focus^=resume]")
+        wait_for(self, "running again", lambda: state() == "running", timeout=30)
+        self.click(f"{row} button[data-focus^=abort]")
+        self.d.switch_to.alert.accept()
+        wait_for(self, "aborted", lambda: state() == "aborted", timeout=30)
+        self.assertEqual(self.daemon.wait_terminal(long["id"])["status"], "aborted")
+        # The night's queue: an item added from the form, the queue started, the item done.
+        for name, value in (("readings", "2"), ("interval_s", "0")):
+            box = self.by_css(f"#p-luminance-spot-{name}")
+            box.clear()
+            box.send_keys(value)
+        self.click("#enqueue")
+        wait_for(self, "queued", lambda: "Queued luminance-spot at position 1" in self.by_css("#start-form .result").text)
+        wait_for(self, "the item listed", lambda: "queued" in self.by_css("#queue ol").text)
+        self.click("#queue-start")
+        wait_for(self, "the item done", lambda: "done" in self.by_css("#queue details").get_attribute("textContent"),
+                 timeout=60)
+        self.click("#queue-stop")
+        wait_for(self, "the queue stopped", lambda: "stopped" in self.by_css("#queue p").text)
+        screenshot(self.d, "queue-done")
 
     def test_4_open_the_run_with_measurements_and_exports(self):
         spot = self.spot
@@ -178,7 +234,7 @@ class ConsoleTest(unittest.TestCase):
         wait_for(self, "measurement rows", lambda: len(self.all_css("#measurements tbody tr")) == READINGS)
         values = [r.find_elements("css selector", "td")[4].text for r in self.all_css("#measurements tbody tr")]
         stored = [m["value"] for m in self.daemon.stored_measurements(spot["run_id"])]
-        self.assertEqual([float(v) for v in values], [float(f"{v:.6g}") for v in stored])
+        self.assertEqual([float(v) for v in values], stored)
         self.assertIn("SIMULATED", self.by_css("#run-detail").text)
         exports = {a.text: a.get_attribute("href") for a in self.all_css("#run-detail a.download")}
         self.assertTrue(exports["CSV"].endswith(f"/v1/runs/{spot['run_id']}/export?format=csv"))
@@ -198,6 +254,15 @@ class ConsoleTest(unittest.TestCase):
             # The browser logs the HEAD's 404: that is how the page learns there is no report.
             self.extra_allowed = [r"/report - Failed to load resource: the server responded with a status of 404"]
         screenshot(self.d, "run-detail")
+        # A run with frames: previews through the key (fetched with the Authorization header), downloads.
+        frames = self.daemon.run_to_end("frame-average", frames=2)
+        self.d.get(f"{self.daemon.url}/#runs/{frames['run_id']}")
+        wait_for(self, "every preview drawn", lambda: (imgs := self.all_css("#blobs img")) and all(
+            self.d.execute_script("return arguments[0].complete && arguments[0].naturalWidth > 0", i) for i in imgs))
+        blobs = self.daemon.client.conn.get(f"/v1/runs/{frames['run_id']}/blobs")["items"]
+        self.assertEqual(len(self.all_css("#blobs img")), len(blobs))
+        self.assertEqual(len(self.all_css("#blobs a.download")), len(blobs))
+        screenshot(self.d, "run-frames")
 
     def test_5_a_dropped_stream_resumes_with_nothing_lost(self):
         # Requests to the stopped daemon fail in the browser's log: the restart is on purpose.
@@ -238,8 +303,7 @@ class ConsoleTest(unittest.TestCase):
             # Keyboard: the first Tab reaches the skip link, then the page links, all real anchors.
             from selenium.webdriver.common.action_chains import ActionChains
             from selenium.webdriver.common.keys import Keys
-            self.d.get("about:blank")  # a fresh document: sequential focus starts at its top
-            self.open("now")
+            self.open("now")  # a fresh document: sequential focus starts at its top
             tabbed = []
             for _ in range(6):
                 ActionChains(self.d).send_keys(Keys.TAB).perform()

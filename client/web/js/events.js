@@ -13,13 +13,14 @@ export class EventStream {
     this.retryMs = 2000;
     this.controller = null;
     this.stopped = true;
+    this.generation = 0;       // a stop() then start() must not leave two loops reading
     this.stats = { connects: 0, drops: 0, events: 0, duplicates: 0, gaps: 0 };
   }
 
   start() {
     if (!this.stopped) return;
     this.stopped = false;
-    this._loop();
+    this._loop(++this.generation);
   }
 
   stop() {
@@ -38,8 +39,9 @@ export class EventStream {
     this.drop();
   }
 
-  async _loop() {
-    while (!this.stopped) {
+  async _loop(generation) {
+    const current = () => !this.stopped && generation === this.generation;
+    while (current()) {
       this.controller = new AbortController();
       const headers = authHeaders({ Accept: "text/event-stream" });
       if (this.lastSeq !== null) headers["Last-Event-ID"] = String(this.lastSeq);
@@ -50,17 +52,17 @@ export class EventStream {
         this.stats.connects++;
         this.onStatus("live");
         await this._read(res.body.getReader());
-        if (!this.stopped) this.onStatus("reconnecting", "the daemon closed the stream");
+        if (current()) this.onStatus("reconnecting", "the daemon closed the stream");
       } catch (e) {
-        if (this.stopped) break;
+        if (!current()) break;
         this.onStatus("reconnecting", e.name === "AbortError" ? "connection dropped" : e.message);
       }
       this.stats.drops++;
       const wait = this.immediate ? 0 : this.retryMs;
       this.immediate = false;
-      if (!this.stopped) await new Promise(r => setTimeout(r, wait));
+      if (current()) await new Promise(r => setTimeout(r, wait));
     }
-    this.onStatus("stopped");
+    if (generation === this.generation) this.onStatus(this.stopped ? "paused" : "stopped");
   }
 
   async _read(reader) {

@@ -112,6 +112,18 @@ window.colorlabConsole = {
   seen: () => store.seen.slice(),
 };
 
+// A browser gives one host six HTTP/1.1 connections; each console tab's stream holds one. A tab left in
+// the background gives its connection back after a minute, and a page being left (or frozen in the
+// back/forward cache) at once; coming back resumes from the last seq, so nothing is missed.
+let hiddenTimer = null;
+document.addEventListener("visibilitychange", () => {
+  clearTimeout(hiddenTimer);
+  if (document.hidden) hiddenTimer = setTimeout(() => stream.stop(), 60000);
+  else stream.start();
+});
+window.addEventListener("pagehide", () => stream.stop());
+window.addEventListener("pageshow", ev => { if (ev.persisted) stream.start(); });
+
 route();
 checkAccess();
 stream.start();

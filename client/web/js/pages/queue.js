@@ -168,10 +168,13 @@ export function mount(section, ctx) {
   }
   ctx.refreshQueue = refreshQueue;
 
+  // A hidden page does not redraw on every event of a busy night: show() draws it whole.
+  let visible = false;
   return {
-    show() { loadCampaigns(); refreshQueue(); render(); },
-    hide() {},
+    show() { visible = true; loadCampaigns(); refreshQueue(); render(); },
+    hide() { visible = false; },
     update(what) {
+      if (!visible) return;
       const t = what.event && what.event.topic;
       if (what.kind === "snapshot" || what.kind === "access" || t === "execution" || t === "progress" || t === "queue") render();
     },

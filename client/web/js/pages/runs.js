@@ -89,7 +89,9 @@ export function mount(section, ctx) {
       h("p", { class: "buttons downloads" }, "Export: ",
         download(`${base}/export?format=csv`, "CSV", `${name}.csv`), " ",
         download(`${base}/export?format=json`, "JSON", `${name}.json`), " ",
-        download(`${base}/export?format=ti3`, ".ti3", `${name}.ti3`), " ",
+        // .ti3 exists only for patch readings (422 otherwise): offered where the summary shows some.
+        summary.some(([q]) => q === "reflectance_spectrum" || q === "camera_rgb")
+          ? [download(`${base}/export?format=ti3`, ".ti3", `${name}.ti3`), " "] : null,
         download(`${base}/script`, "script", `${name}.lua`), " ", report),
       h("h4", {}, "Measurements"), meas,
       h("h4", {}, "Frames"), blobs);
@@ -109,7 +111,7 @@ export function mount(section, ctx) {
             h("thead", {}, h("tr", {}, ["seq", "step", "instrument", "quantity", "value", "unit", "measured"].map(x => h("th", { scope: "col" }, x)))),
             h("tbody", {}, r.items.map(m => h("tr", {},
               h("td", {}, String(m.seq)), h("td", {}, m.step), h("td", {}, m.instrument_id, m.simulated ? " (sim)" : ""),
-              h("td", {}, m.quantity), h("td", { class: "num" }, fmtNumber(m.value, 6)), h("td", {}, m.unit || ""),
+              h("td", {}, m.quantity), h("td", { class: "num" }, m.value === null || m.value === undefined ? "—" : String(m.value)), h("td", {}, m.unit || ""),
               h("td", {}, fmtTime(m.measured_at))))))),
           h("div", { class: "buttons pager" },
             h("button", { type: "button", id: "meas-prev", disabled: mPage === 0, onclick: () => { mPage--; loadMeasurements(); } }, "← Previous"),
@@ -123,8 +125,9 @@ export function mount(section, ctx) {
     try {
       const b = await get(`${base}/blobs`);
       replace(blobs, b.items.length ? h("div", { class: "cards" }, b.items.map(x => h("figure", { class: "card blob" },
-        image(`/v1/blobs/${x.sha256}/preview.png`, `${x.name} preview`),
-        h("figcaption", {}, `${x.name} · ${x.kind} · ${fmtBytes(x.size)} `, download(`/v1/blobs/${x.sha256}`, "download", x.name)))))
+        image((x.links && x.links.preview) || `/v1/blobs/${x.sha256}/preview.png`, `${x.name} preview`),
+        h("figcaption", {}, `${x.name} · ${x.kind} · ${fmtBytes(x.size)} `,
+          download(`/v1/blobs/${x.sha256}`, "download", x.name.split("/").pop())))))
         : h("p", { class: "muted" }, "This run kept no frames."));
     } catch (e) { replace(blobs, errorBox(e)); }
   }
