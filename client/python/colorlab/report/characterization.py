@@ -100,11 +100,12 @@ def approaches_table(run, formats) -> str:
             rows.append((f"{fmt} {name}" + (f" ({ap['method']})" if ap.get("method") else ""),
                          [t.get("mean"), cv.get("mean"), cv.get("median"), cv.get("p95"), cv.get("max"),
                           cv.get("mean_de76"), cv.get("max_de76")], "stored", f"{fmt}-{name}"))
-    sel = res_sel = run.result.get("selected") or {}
-    note = (f"As the campaign stored them (cross-validation {esc(next(iter(formats.values()), {}).get('cv_name', '') or run.doc.get('params', {}).get('cv', ''))}). "
-            f"Selected for use: {esc(sel.get('format'))}, {esc((res_sel.get('model') or {}).get('method'))}, "
-            f"CV mean ΔE00 {sel.get('cv_mean_de00', float('nan')):.3f}. The dissertation gives no ΔE00 and no "
-            "cross-validation, so nothing here has a published counterpart.") if sel else ""
+    sel = run.result.get("selected") or {}
+    cv = (run.doc.get("params") or {}).get("cv", "")
+    note = (f"As the campaign stored them (cross-validation: {esc(cv)}). Selected for use: {esc(sel.get('format'))}, "
+            f"{esc((sel.get('model') or {}).get('method'))}, CV mean ΔE00 {sel.get('cv_mean_de00', float('nan')):.3f}. "
+            "The dissertation gives no ΔE00 and no cross-validation, so nothing here has a published counterpart."
+            ) if sel else ""
     return table(f"{run.short}-approaches", "The four approaches per test case (§7.1-7.4), the lab's own fits",
                  cols, rows, corner="test case, approach", note=note)
 
