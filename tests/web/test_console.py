@@ -118,6 +118,18 @@ class ConsoleTest(unittest.TestCase):
         screenshot(self.d, "queue-read-only")
         self.use_key("", "READ-ONLY")
 
+    def test_1b_lab_shows_every_instrument(self):
+        self.open("lab")
+        instruments = self.api("/v1/instruments")["items"]
+        for i in instruments:
+            card = wait_for(self, f"{i['id']} shown", lambda: self.by_css(f'.instrument[data-instrument="{i["id"]}"]'))
+            wait_for(self, f"{i['id']}'s state", lambda: card.find_element("css selector", ".badge").text
+                     == i["state"].replace("_", " "))
+            self.assertIn("SIMULATED" if i["simulated"] else "real", card.text)
+            for c in i["calibration"]:
+                self.assertIn(("valid " if c["valid"] else "invalid ") + c["type"], card.text)
+        screenshot(self.d, "lab")
+
     def test_2_start_from_queue_and_follow_to_100_percent_on_now(self):
         self.open("queue")
         self.use_key(self.control_key, "CONTROL")

@@ -60,7 +60,11 @@ async function checkAccess() {
   note.className = ctx.access.control ? "access ok" : "access ro";
   document.getElementById("access-word").textContent = ctx.access.control ? "CONTROL" : ctx.access.read ? "READ-ONLY" : "NO ACCESS";
   for (const p of Object.values(pages)) p.update({ kind: "access" });
+  // A lock held by someone else is let go sooner or later (release, lease): look again while it is the reason.
+  clearTimeout(accessTimer);
+  if (/control lock/.test(ctx.access.why)) accessTimer = setTimeout(checkAccess, 30000);
 }
+let accessTimer = null;
 
 // Queue events arrive in bursts (enqueued, started, done…): one re-read per burst is enough.
 let queueTimer = null;

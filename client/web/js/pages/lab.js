@@ -10,8 +10,12 @@ function calibration(list) {
   return h("ul", { class: "plain" }, list.map(c => h("li", {},
     badge(c.valid ? "valid" : "invalid"), ` ${c.type || "calibration"}`,
     c.readings_left !== undefined ? ` · ${c.readings_left} readings left` : "",
-    c.expires_at ? ` · expires ${new Date(c.expires_at).toLocaleString()}` : "",
-    c.expiry ? ` · expires ${c.expiry}` : "")));
+    c.valid_until_unix_ms !== undefined ? expiry(c.valid_until_unix_ms) : "")));
+}
+
+function expiry(ms) {
+  const left = (ms - Date.now()) / 1000;
+  return ` · ${left > 0 ? "expires" : "expired"} ${new Date(ms).toLocaleString()}`;
 }
 
 function card(i) {
