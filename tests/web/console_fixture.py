@@ -55,6 +55,22 @@ def create_key(daemon: Daemon, name: str, scope: str) -> str:
     return json.loads(out)["secret"]
 
 
+def simulator(daemon: Daemon, command: dict) -> dict:
+    """A command to the embedded simulated lab's control socket (docs/simulator.md): one JSON line each way."""
+    import socket
+    with socket.socket(socket.AF_UNIX, socket.SOCK_STREAM) as s:
+        s.settimeout(10)
+        s.connect(daemon.endpoint["simulator_control"])
+        s.sendall((json.dumps(command) + "\n").encode())
+        answer = b""
+        while not answer.endswith(b"\n"):
+            chunk = s.recv(65536)
+            if not chunk:
+                break
+            answer += chunk
+    return json.loads(answer)
+
+
 def wait_for(test: unittest.TestCase, what: str, predicate, timeout: float = 30, interval: float = 0.1):
     deadline = time.monotonic() + timeout
     last = None

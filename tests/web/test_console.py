@@ -9,7 +9,7 @@ import unittest
 import urllib.request
 
 from console_fixture import (ConsoleLog, Daemon, browser, cleanup_artifacts, console_dir_is_built, create_key,
-                             free_port, screenshot, wait_for)
+                             free_port, screenshot, simulator, wait_for)
 
 # Asks the operator; the simulated lab's hands cannot answer it, so only the console can. Long timeout: the
 # default must not answer it first even at the test's time scale.
@@ -38,7 +38,9 @@ class ConsoleTest(unittest.TestCase):
         if not console_dir_is_built():
             raise unittest.SkipTest("the build has no share/colorlab/console (build the colorlab_console target)")
         cleanup_artifacts()
-        cls.daemon = Daemon(time_scale=TIME_SCALE, port=free_port())
+        # Suspensions retried and settled quickly, as tests/integration/suspend_test.cpp has them.
+        cls.daemon = Daemon(time_scale=TIME_SCALE, port=free_port(),
+                            extra="[campaigns]\nsuspend_retry_s = 20\nsuspend_settle_s = 20\n")
         cls.addClassCleanup(cls.daemon.cleanup)
         campaigns = cls.daemon.state / "campaigns"
         campaigns.mkdir(exist_ok=True)
@@ -237,6 +239,24 @@ class ConsoleTest(unittest.TestCase):
         self.click("#queue-stop")
         wait_for(self, "the queue stopped", lambda: "stopped" in self.by_css("#queue p").text)
         screenshot(self.d, "queue-done")
+
+    def test_3c_a_suspension_and_its_reason_on_now(self):
+        self.open("now")
+        e = self.daemon.client.conn.post("/v1/executions", {"campaign": "luminance-spot",
+                                                            "params": {"readings": 40, "interval_s": 20}})
+        card = f'.execution[data-execution="{e["id"]}"]'
+        wait_for(self, "a few readings", lambda: int(self.by_css(f"{card} .progress-text").text.split()[0]) >= 10)
+        self.assertTrue(simulator(self.daemon, {"cmd": "fault", "instrument": "ls110", "faults": {"silent": True}})["ok"])
+        try:
+            wait_for(self, "suspended on Now", lambda: self.by_css(f"{card} .badge").text == "suspended", timeout=60)
+            reason = self.by_css(f"{card} .reason").text
+            self.assertTrue(reason.startswith("instrument: "), reason)
+            self.assertIn("suspended because", self.by_css(card).text)
+            screenshot(self.d, "now-suspended")
+        finally:
+            simulator(self.daemon, {"cmd": "fault", "instrument": "ls110", "faults": {"silent": False}})
+        wait_for(self, "finished on Now", lambda: self.by_css(f"{card} .badge").text == "finished ok", timeout=60)
+        self.assertEqual(self.by_css(f"{card} .progress-text").text, "100 %")
 
     def test_4_open_the_run_with_measurements_and_exports(self):
         spot = self.spot

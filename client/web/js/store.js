@@ -56,6 +56,8 @@ export class Store {
       const e = this.executions.get(p.execution_id) || { id: p.execution_id, run_id: p.run_id, progress: 0 };
       if (p.status) e.status = p.status;
       if ("reason" in p) e.reason = p.reason;
+      // A suspension carries the failure it waits out (problem+json): the operator needs its hint.
+      if (p.status) e.problem = p.problem || p.error || null;
       if (p.requested) e.requested = p.requested;
       if (p.status && isTerminal(p.status)) {
         e.finished_at = Date.now();

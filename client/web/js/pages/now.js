@@ -78,9 +78,11 @@ export function mount(section, ctx) {
         h("span", { class: "progress-text" }, `${pct} %`)),
       h("dl", {},
         h("dt", {}, "step"), h("dd", { class: "step" }, e.step || "—"),
-        h("dt", {}, "ETA"), h("dd", {}, isTerminal(e.status) ? "ended" : eta === null ? "estimating…" : fmtDuration(eta)),
-        e.measurements !== undefined ? [h("dt", {}, "measurements"), h("dd", {}, String(e.measurements))] : null,
-        e.reason ? [h("dt", {}, e.status === "suspended" ? "suspended because" : "reason"), h("dd", { class: "reason" }, e.reason)] : null),
+        h("dt", {}, "ETA"), h("dd", {}, isTerminal(e.status) ? "ended" : e.status === "paused" || e.status === "suspended"
+          ? `on hold (${e.status})` : eta === null ? "estimating…" : fmtDuration(eta)),
+        e.reason ? [h("dt", {}, e.status === "suspended" ? "suspended because" : "reason"), h("dd", { class: "reason" }, e.reason)] : null,
+        e.problem ? [h("dt", {}, "problem"), h("dd", {}, e.problem.detail || e.problem.title || "",
+          e.problem.hint ? h("span", { class: "hint" }, ` — ${e.problem.hint}`) : null)] : null),
       e.run_id ? h("a", { href: `#runs/${e.run_id}` }, "open run") : null);
   }
 
