@@ -35,6 +35,7 @@ export class EventStream {
 
   // A new key: the stream must be reopened with it at once (no retry pause), resuming where it was.
   restart() {
+    if (this.stopped) { this.start(); return; }
     this.immediate = true;
     this.drop();
   }
@@ -48,6 +49,12 @@ export class EventStream {
       try {
         this.onStatus("connecting");
         const res = await fetch("/v1/events/stream", { headers, signal: this.controller.signal, cache: "no-store" });
+        if (res.status === 401 || res.status === 403) {
+          // Retrying cannot help until the key changes (restart() comes with a new one).
+          this.stopped = true;
+          this.onStatus("refused", `the stream needs a valid key (${res.status})`);
+          return;
+        }
         if (!res.ok || !res.body) throw new Error(`stream answered ${res.status}`);
         this.stats.connects++;
         this.onStatus("live");

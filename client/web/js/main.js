@@ -87,7 +87,10 @@ const stream = new EventStream({
   },
 });
 store.subscribe(what => {
-  if (what.event && what.event.topic === "queue") queueChanged();
+  const topic = what.event && what.event.topic;
+  if (topic === "queue") queueChanged();
+  // The lock taken or given back, a key revoked: what this page may do may have changed with it.
+  if (topic === "control" || topic === "access") checkAccess();
   for (const p of Object.values(pages)) p.update(what);
 });
 
