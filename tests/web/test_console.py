@@ -127,6 +127,20 @@ class ConsoleTest(unittest.TestCase):
         self.use_key("", "READ-ONLY")
         wait_for(self, "the stream back", lambda: self.by_css("#conn").text == "LIVE")
 
+    def test_1c_read_only_while_another_holds_the_control_lock(self):
+        self.open("queue")
+        self.use_key(self.control_key, "CONTROL")
+        conn = self.daemon.client.conn
+        conn.post("/v1/control/acquire", {"holder": "night-shift"})
+        try:
+            wait_for(self, "read-only under the lock", lambda: self.by_css("#access-word").text == "READ-ONLY")
+            self.assertIn("night-shift holds the control lock", self.by_css("#access-note").text)
+            self.assertFalse(self.by_css("#start").is_enabled())
+        finally:
+            conn.post("/v1/control/release", {})
+        wait_for(self, "control again", lambda: self.by_css("#access-word").text == "CONTROL")
+        self.assertTrue(self.by_css("#start").is_enabled())
+
     def test_1b_lab_shows_every_instrument(self):
         self.open("lab")
         instruments = self.api("/v1/instruments")["items"]
