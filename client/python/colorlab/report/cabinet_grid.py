@@ -56,7 +56,7 @@ def section(run) -> str:
         out.append(f'<p class="warn">{len(res["light_changes"])} spot(s) were read again after a lamp drifted '
                    '(the run\'s light_changes).</p>')
     out.append(summary_table(run, maps, uni))
-    out.append(window_tables(run, uni))
+    out.append(window_tables(run, uni, list(maps)))
     out.append(dimmer_table(run, res.get("dimmer_proportionality") or {}))
     out.append(lamps_table(run, res.get("lamps") or []))
     out.append(figures(run, maps, uni, res.get("dimmer_proportionality") or {}))
@@ -97,9 +97,10 @@ def summary_table(run, maps, uni) -> str:
                       "row and column index the window's corner, from the front left.")
 
 
-def window_tables(run, uni) -> str:
+def window_tables(run, uni, order) -> str:
     out = []
-    for lamp, levels in uni.items():
+    # The daemon's result object has its lamps in key order; the run's own order (D65 first by default) reads better.
+    for lamp, levels in sorted(uni.items(), key=lambda kv: order.index(kv[0]) if kv[0] in order else len(order)):
         for level_key, u in sorted(levels.items(), key=lambda kv: -float(kv[0])):
             ws = np.array(u["window_stdev"], dtype=float)
             level = float(level_key)
