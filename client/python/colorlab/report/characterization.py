@@ -31,18 +31,22 @@ def patches(run, fmt: str):
     return list(p["data.id"]), np.stack(p["data.rgb"].to_numpy()).astype(float)
 
 
-def reference_lab(run):
+def reference(run):
+    """{patch id: (L*a*b*, XYZ)} of the chart-read run the characterization was fitted against."""
     ref = run.extra.get("reference")
     if ref is None or ref.measurements.empty or "data.Lab" not in ref.measurements:
         return None
     m = ref.measurements[ref.measurements["data.Lab"].notna()]
-    return {i: np.asarray(v, float) for i, v in zip(m["data.id"], m["data.Lab"])}
+    xyz = m["data.XYZ"] if "data.XYZ" in m else [None] * len(m)
+    return {i: (np.asarray(v, float), None if x is None else np.asarray(x, float))
+            for i, v, x in zip(m["data.id"], m["data.Lab"], xyz)}
 
 
 def analyse(run) -> dict:
-    """Per-patch ΔE*ab of the camera's colour space per test case and of §7.3's polynomials on the 8-bit TIFF."""
-    ref = reference_lab(run)
-    out = {"space": {}, "poly": {}, "poly_format": None}
+    """Per-patch ΔE*ab of the camera's colour space and the lab's matrix/shaper profile per test case, and of
+    §7.3's polynomials on the 8-bit TIFF."""
+    ref = reference(run)
+    out = {"space": {}, "icc": {}, "poly": {}, "poly_format": None}
     if not ref:
         return out
     for fmt in TEST_CASES:
@@ -51,10 +55,16 @@ def analyse(run) -> dict:
         if not keep:
             continue
         ids = [ids[k] for k in keep]
-        measured = np.stack([ref[i] for i in ids])
+        measured = np.stack([ref[i][0] for i in ids])
         reproduced = colour.adobe_rgb_to_lab(rgb[keep] / FULL_SCALE[fmt])
         out["space"][fmt] = {"ids": ids, "measured": measured, "reproduced": reproduced,
                              "de": colour.delta_e76(reproduced, measured)}
+        ap = ((run.result.get("formats") or {}).get(fmt) or {}).get("approaches") or {}
+        if "icc_profile" in ap and all(ref[i][1] is not None for i in ids):
+            fitted = colour.fit_matrix_shaper(rgb[keep] / FULL_SCALE[fmt], np.stack([ref[i][1] for i in ids]),
+                                              ap["icc_profile"].get("gamma", 2.2))
+            out["icc"][fmt] = {"ids": ids, "measured": measured, "reproduced": fitted,
+                               "de": colour.delta_e76(fitted, measured)}
     fmt = next((f for f in TEST_CASES if f in out["space"]), None)
     if fmt:
         ids, rgb = patches(run, fmt)
@@ -79,7 +89,7 @@ def section(run) -> str:
                    '(Tables 9, 11, 12 and figs. 51-54, 58-60) cannot be computed.</p>')
     out.append(approaches_table(run, formats))
     out.append(table9(run, a, formats))
-    out.append(table10(run, formats))
+    out.append(table10(run, a, formats))
     out += poly_tables(run, a)
     out.append(table13(run, formats))
     out.append(stored_polynomials(run, formats))
@@ -137,20 +147,27 @@ def table9(run, a, formats) -> str:
                       "the reference run's L*a*b* (D50); the daemon's own figures, through lcms, are the last rows.")
 
 
-def table10(run, formats) -> str:
+def table10(run, a, formats) -> str:
     cols = [f for f in TEST_CASES if "icc_profile" in ((formats.get(f) or {}).get("approaches") or {})]
     if not cols:
         return ""
-    measured = {}
-    for f in cols:
-        t = formats[f]["approaches"]["icc_profile"].get("training") or {}
-        measured[f] = {"Max": t.get("max_de76"), "Mean": t.get("mean_de76")}
     kind = formats[cols[0]]["approaches"]["icc_profile"].get("kind", "")
-    return table(f"{run.short}-table10", "Table 10 — ΔE*ab using an ICC profile, 140 patches (training)", cols,
-                 _stats_rows(measured, pub.TABLE10, cols, kind="stored"), corner="statistic",
-                 note=f"Published: {esc(pub.TABLE10.ref())} (GretagMacbeth ProfileMaker). Stored: the lab's own "
-                      f"{esc(kind)} profile's training error; it keeps only the maximum and mean ΔE*ab, so min, median "
-                      "and stdev (and figs. 55-57) cannot be recomputed.")
+    stored = {f: formats[f]["approaches"]["icc_profile"].get("training") or {} for f in cols}
+    if all(f in a["icc"] for f in cols):
+        rows = _stats_rows({f: colour.stats(a["icc"][f]["de"]) for f in cols}, pub.TABLE10, cols)
+        how = ("Measured: the lab's profile rebuilt here (pure gamma, then a least-squares matrix to the reference "
+               "XYZ, D50) from the stored patch values; the run keeps only the profile's statistics, its own "
+               "figures (through lcms) are the last rows.")
+    else:
+        rows = _stats_rows({f: {"Max": stored[f].get("max_de76"), "Mean": stored[f].get("mean_de76")} for f in cols},
+                           pub.TABLE10, cols, kind="stored")
+        how = "Stored only (no reference XYZ to rebuild the profile): min, median and stdev are not stored."
+    rows += [("Max, the daemon's (lcms)", [stored[f].get("max_de76") for f in cols], "stored", "Max-stored"),
+             ("Mean, the daemon's (lcms)", [stored[f].get("mean_de76") for f in cols], "stored", "Mean-stored")]
+    return table(f"{run.short}-table10", "Table 10 — ΔE*ab using an ICC profile, 140 patches (training)", cols, rows,
+                 corner="statistic",
+                 note=f"Published: {esc(pub.TABLE10.ref())} (GretagMacbeth ProfileMaker). The lab's profile: "
+                      f"{esc(kind)}. {how}")
 
 
 def poly_tables(run, a):
@@ -225,6 +242,42 @@ def _fig(run, fid, item, caption, fig):
     return figure(f"{run.short}-{fid}", to_svg(fig, f"{run.short}-{fid}"), caption, item)
 
 
+def _histograms(run, fid, item, caption, cases):
+    fig, axes = subplots(len(cases), width=8, height=2.6)
+    top = max(float(s["de"].max()) for s in cases.values())
+    for ax, (fmt, s) in zip(axes, cases.items()):
+        ax.hist(s["de"], bins=np.arange(0, top + 1, 1), color="tab:blue", edgecolor="k", lw=0.3)
+        ax.set_title(CASE_NAME[fmt])
+        ax.set_xlabel("ΔE*ab")
+    axes[0].set_ylabel("patches")
+    return _fig(run, fid, item, caption, fig)
+
+
+def _chart_maps(run, fid, item, caption, panels):
+    fig, axes = subplots(len(panels), width=8, height=3)
+    for ax, (name, ids, de) in zip(axes, panels):
+        g = chart_grid(ids, de)
+        im = ax.imshow(g, cmap="gray", interpolation="nearest")
+        ax.set_xticks(range(g.shape[1]), [chr(65 + k) for k in range(g.shape[1])], fontsize=6)
+        ax.set_yticks(range(g.shape[0]), [str(k + 1) for k in range(g.shape[0])], fontsize=6)
+        ax.grid(False)
+        ax.set_title(name, fontsize=8)
+        ax.figure.colorbar(im, ax=ax, shrink=0.8, label="ΔE*ab")
+    return _fig(run, fid, item, caption, fig)
+
+
+def _scatter(run, fid, item, caption, s):
+    fig, axes = subplots(3, width=8.5, height=2.9)
+    for k, (ax, name) in enumerate(zip(axes, ("L*", "a*", "b*"))):
+        m, r = s["measured"][:, k], s["reproduced"][:, k]
+        ax.scatter(m, r, s=8, c="tab:blue")
+        lo, hi = min(m.min(), r.min()), max(m.max(), r.max())
+        ax.plot([lo, hi], [lo, hi], "k--", lw=0.8)
+        ax.set_xlabel(f"measured {name}")
+        ax.set_ylabel(f"reproduced {name}")
+    return _fig(run, fid, item, caption, fig)
+
+
 def figures(run, a, formats):
     out = []
     space = a["space"]
@@ -236,42 +289,23 @@ def figures(run, a, formats):
         ax.set_ylabel("ΔE*ab")
         ax.legend(fontsize=7)
         out.append(_fig(run, "fig51", "51", "Fig. 51 — ΔE*ab per patch for the three test cases, camera's colour space.", fig))
-        fig, axes = subplots(len(space), width=8, height=2.6)
-        top = max(float(s["de"].max()) for s in space.values())
-        for ax, (fmt, s) in zip(axes, space.items()):
-            ax.hist(s["de"], bins=np.arange(0, top + 1, 1), color="tab:blue", edgecolor="k", lw=0.3)
-            ax.set_title(CASE_NAME[fmt])
-            ax.set_xlabel("ΔE*ab")
-        axes[0].set_ylabel("patches")
-        out.append(_fig(run, "fig52", "52", "Fig. 52 — histograms of ΔE*ab, camera's colour space.", fig))
-        fmt = next(iter(space))
-        s = space[fmt]
-        panels = [("camera's colour space", s["de"])]
-        best = min(a["poly"], key=lambda n: a["poly"][n]["de"].mean()) if a["poly"] else None
-        if best:
-            panels.append((f"polynomial {best}", a["poly"][best]["de"]))
-        fig, axes = subplots(len(panels), width=8, height=3)
-        for ax, (name, de) in zip(axes, panels):
-            g = chart_grid(s["ids"], de)
-            im = ax.imshow(g, cmap="gray", interpolation="nearest")
-            ax.set_xticks(range(g.shape[1]), [chr(65 + k) for k in range(g.shape[1])], fontsize=6)
-            ax.set_yticks(range(g.shape[0]), [str(k + 1) for k in range(g.shape[0])], fontsize=6)
-            ax.grid(False)
-            ax.set_title(f"{CASE_NAME[fmt]}, {name}", fontsize=8)
-            ax.figure.colorbar(im, ax=ax, shrink=0.8, label="ΔE*ab")
-        out.append(_fig(run, "fig53", "53", "Fig. 53 — ΔE*ab per patch on the chart's layout (bright = large error): "
-                        "(a) camera's colour space" + (f", (b) the best of §7.3's polynomials ({best})" if best else "")
-                        + ".", fig))
-        fig, axes = subplots(3, width=8.5, height=2.9)
-        for k, (ax, name) in enumerate(zip(axes, ("L*", "a*", "b*"))):
-            m, r = s["measured"][:, k], s["reproduced"][:, k]
-            ax.scatter(m, r, s=8, c="tab:blue")
-            lo, hi = min(m.min(), r.min()), max(m.max(), r.max())
-            ax.plot([lo, hi], [lo, hi], "k--", lw=0.8)
-            ax.set_xlabel(f"measured {name}")
-            ax.set_ylabel(f"reproduced {name}")
-        out.append(_fig(run, "fig54", "54", f"Fig. 54 — measured against reproduced L*, a*, b*, camera's colour space "
-                        f"({CASE_NAME[fmt]}).", fig))
+    best = min(a["poly"], key=lambda n: a["poly"][n]["de"].mean()) if a["poly"] else None
+    for key, name, (fh, fm, fs) in (("space", "camera's colour space", ("52", "53", "54")),
+                                    ("icc", "ICC profile", ("55", "56", "57"))):
+        cases = a[key]
+        if not cases:
+            continue
+        out.append(_histograms(run, f"fig{fh}", fh, f"Fig. {fh} — histograms of ΔE*ab, {name}.", cases))
+        fmt = next(iter(cases))
+        s = cases[fmt]
+        panels = [(f"{CASE_NAME[fmt]}, {name}", s["ids"], s["de"])]
+        if best and key == "space":
+            panels.append((f"{CASE_NAME[a['poly_format']]}, polynomial {best}", a["poly"][best]["ids"], a["poly"][best]["de"]))
+        out.append(_chart_maps(run, f"fig{fm}", fm, f"Fig. {fm} — ΔE*ab per patch on the chart's layout (bright = large "
+                               f"error), {name}" + (f"; beside it the best of §7.3's polynomials ({best})"
+                                                     if len(panels) > 1 else "") + ".", panels))
+        out.append(_scatter(run, f"fig{fs}", fs, f"Fig. {fs} — measured against reproduced L*, a*, b*, {name} "
+                            f"({CASE_NAME[fmt]}).", s))
     if a["poly"]:
         top = max(float(p["de"].max()) for p in a["poly"].values())
         for fid, ns in (("fig58", (1, 2, 3, 4)), ("fig59", (5, 6, 7, 8, 9, 10, 11))):

@@ -87,3 +87,12 @@ def fit_polynomial(rgb01: np.ndarray, lab: np.ndarray, polynomial: int) -> np.nd
     r = design(rgb01, polynomial)
     m, *_ = np.linalg.lstsq(r, np.asarray(lab, float), rcond=None)
     return r @ m
+
+
+def fit_matrix_shaper(rgb01: np.ndarray, xyz100: np.ndarray, gamma: float = 2.2) -> np.ndarray:
+    """§7.2's profile as the lab builds it (analysis/src/icc_profile.cpp): a pure-gamma shaper, then a 3 × 3
+    matrix to D50 XYZ by least squares; returns the training patches' L*a*b*. The run keeps neither the profile
+    nor its per-patch errors, only its statistics, which this reproduces."""
+    lin = np.clip(np.asarray(rgb01, float), 0, None) ** gamma
+    m, *_ = np.linalg.lstsq(lin, np.asarray(xyz100, float) / 100.0, rcond=None)
+    return xyz_to_lab(lin @ m)

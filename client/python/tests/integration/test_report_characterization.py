@@ -98,7 +98,9 @@ class CharacterizationReport(unittest.TestCase):
                                            prior_exclude=["Canon_20D"])["run_id"]
             cls.path = make_report(cls.daemon, [cls.cc], "characterize-camera")
             cls.tables, _ = parse(cls.path)
-            ref = {m["data"]["id"]: np.array(m["data"]["Lab"]) for m in cls.daemon.stored_measurements(cls.ref)}
+            stored_ref = cls.daemon.stored_measurements(cls.ref)
+            ref = {m["data"]["id"]: np.array(m["data"]["Lab"]) for m in stored_ref}
+            cls.xyz = {m["data"]["id"]: np.array(m["data"]["XYZ"]) for m in stored_ref}
             cls.patches = {}
             for m in cls.daemon.stored_measurements(cls.cc):
                 p = re.match(r"^patch/(\w+)/(\w+)$", m["step"])
@@ -159,16 +161,29 @@ class CharacterizationReport(unittest.TestCase):
                 self.assertLessEqual(means[3], means[1] + 1e-9)  # 4 ⊃ 2
                 self.assertLessEqual(means[3], means[2] + 1e-9)  # 4 ⊃ 3
 
-    def test_tables_10_and_13_from_the_stored_statistics(self):
+    def test_table10_the_labs_matrix_shaper_rebuilt(self):
         t = self.t("table10")
         published = thesis_stats(10)
         for k, fmt in enumerate(("tiff8", "jpeg", "tiff16")):
-            s = self.result["formats"][fmt]["approaches"]["icc_profile"]["training"]
-            self.assertEqual(t[("Max-stored", fmt, "stored")], s["max_de76"])
-            self.assertEqual(t[("Mean-stored", fmt, "stored")], s["mean_de76"])
-            self.assertAlmostEqual(t[("Max-diff", fmt, "difference")], s["max_de76"] - published["Max"][k], places=9)
-            self.assertEqual(t[("Stdev-published", fmt, "published")], published["Stdev"][k])
-            self.assertNotIn(("Min-stored", fmt, "stored"), t)  # not stored: a dash, not a number
+            rows = self.patches[fmt]
+            lin = np.clip(np.stack([r for _, r, _ in rows]) / SCALE[fmt], 0, None) ** 2.2
+            xyz = np.stack([self.xyz[i] for i, _, _ in rows]) / 100
+            q, r = np.linalg.qr(lin)
+            lab = lab_d50(lin @ np.linalg.solve(r, q.T @ xyz))
+            de = np.linalg.norm(lab - np.stack([l for _, _, l in rows]), axis=1)
+            s = self.result["formats"][fmt]["approaches"]["icc_profile"]
+            self.assertEqual((s["kind"], s["gamma"]), ("matrix/shaper", 2.2))
+            # The daemon's profile through lcms, to its precision: the rebuilt one is the lab's.
+            self.assertAlmostEqual(de.mean(), s["training"]["mean_de76"], delta=0.005)
+            self.assertAlmostEqual(de.max(), s["training"]["max_de76"], delta=0.03)
+            self.assertEqual(t[("Max-stored", fmt, "stored")], s["training"]["max_de76"])
+            self.assertEqual(t[("Mean-stored", fmt, "stored")], s["training"]["mean_de76"])
+            for stat, v in five(de).items():
+                self.assertAlmostEqual(t[(f"{stat}-measured", fmt, "measured")], v, delta=1e-9, msg=(fmt, stat))
+                self.assertEqual(t[(f"{stat}-published", fmt, "published")], published[stat][k])
+                self.assertAlmostEqual(t[(f"{stat}-diff", fmt, "difference")], v - published[stat][k], delta=1e-9)
+
+    def test_table13_from_the_stored_residuals(self):
         t = self.t("table13")
         published = thesis_stats(13)
         res = self.result["formats"]["raw"]["approaches"]["black_box"]["residuals"]["training"]
@@ -191,7 +206,7 @@ class CharacterizationReport(unittest.TestCase):
         self.assertEqual(n, 4 * 3)  # raw: icc, mapping, black box; each TIFF/JPEG: camera space, icc, mapping
 
     def test_opens_in_chromium_with_every_figure(self):
-        figs = [f"{short(self.cc)}-{f}" for f in ("fig51", "fig52", "fig53", "fig54", "fig58", "fig59", "fig60",
+        figs = [f"{short(self.cc)}-{f}" for f in ("fig51", "fig52", "fig53", "fig54", "fig55", "fig56", "fig57", "fig58", "fig59", "fig60",
                                                    "blackbox")]
         check_in_browser(self, self.path, figs, "characterize-camera")
 
