@@ -1,12 +1,12 @@
 """characterize-camera runs: chapter 7's Tables 9-13 and figs. 51-60, as far as the stored data allows.
 
-What the run stores: each format's 140 patch values (patch/<format>/<id>), the reference L*a*b* through its
-chart-read run, and its own fits' error statistics (ΔE00 and ΔE*ab mean/max, training and cross-validated;
-the black box's residual statistics and curves). Per-patch errors are not stored, so the report computes
-those the dissertation's way from the patch values and the reference (colour.py): the camera's colour space
-(§7.1, checked against the daemon's own ΔE*ab mean) and the eleven polynomials of §7.3. The ICC profile's and
-the black box's per-patch errors need the fitted models, which the run does not keep: their tables show the
-stored statistics only.
+What the run stores: each format's 140 patch values (patch/<format>/<id>), the reference L*a*b* and XYZ through
+its chart-read run, and its own fits' error statistics (ΔE00 and ΔE*ab mean/max, training and cross-validated;
+the black box's residual statistics and curves). Per-patch errors are not stored, so the report computes those
+the dissertation's way from the patch values and the reference (colour.py): the camera's colour space (§7.1),
+the lab's matrix/shaper profile rebuilt (§7.2) — both checked against the daemon's own ΔE*ab — and the eleven
+polynomials of §7.3. The black box's per-patch residuals need its fitted model, which the run does not keep:
+Table 13 shows the stored statistics.
 """
 from __future__ import annotations
 
