@@ -96,6 +96,8 @@ class ConsoleTest(unittest.TestCase):
         wait_for(self, "the event stream", lambda: self.by_css("#conn").text == "LIVE")
 
     def use_key(self, key, expect):
+        if not self.by_css("#key-box").get_attribute("open"):
+            self.click("#key-box summary")
         box = self.by_css("#key")
         box.clear()
         if key:

@@ -98,6 +98,9 @@ store.subscribe(what => {
 const keyInput = document.getElementById("key");
 const keyRemember = document.getElementById("key-remember");
 keyInput.value = getKey();
+// Open while there is no key yet (the first visit); folded away once one is set, which keeps a phone's
+// first screen for the lab.
+document.getElementById("key-box").open = !getKey();
 keyRemember.checked = remembered();
 document.getElementById("key-form").addEventListener("submit", ev => {
   ev.preventDefault();
