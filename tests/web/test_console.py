@@ -255,10 +255,20 @@ class ConsoleTest(unittest.TestCase):
             box.send_keys(value)
         self.click("#enqueue")
         wait_for(self, "queued", lambda: "Queued luminance-spot at position 1" in self.by_css("#start-form .result").text)
-        wait_for(self, "the item listed", lambda: "queued" in self.by_css("#queue ol").text)
+        box = self.by_css("#p-luminance-spot-readings")
+        box.clear()
+        box.send_keys("3")
+        self.click("#enqueue")
+        wait_for(self, "queued second", lambda: "at position 2" in self.by_css("#start-form .result").text)
+        rows = lambda: [li.text for li in self.all_css("#queue ol li")]  # noqa: E731
+        wait_for(self, "both listed", lambda: len(rows()) == 2)
+        self.click("#queue ol li:nth-child(2) button[data-focus^=up]")
+        wait_for(self, "the second moved first", lambda: '"readings":3' in rows()[0])
         self.click("#queue-start")
-        wait_for(self, "the item done", lambda: "done" in self.by_css("#queue details").get_attribute("textContent"),
+        wait_for(self, "both done", lambda: self.by_css("#queue details").get_attribute("textContent").count("done") == 2,
                  timeout=60)
+        history = self.daemon.client.conn.get("/v1/queue")["history"]
+        self.assertEqual([i["params"]["readings"] for i in history[:2]], [2, 3])  # most recent first
         self.click("#queue-stop")
         wait_for(self, "the queue stopped", lambda: "stopped" in self.by_css("#queue p").text)
         screenshot(self.d, "queue-done")

@@ -154,12 +154,26 @@ export function mount(section, ctx) {
       (q.items || []).length ? h("ol", { class: "rows" }, q.items.map(i => h("li", { class: "row" },
         h("span", { class: "name" }, i.campaign), badge(i.state),
         h("span", { class: "muted mono" }, JSON.stringify(i.params)),
-        i.state === "queued" ? h("button", { type: "button", class: "control", dataset: { focus: `rm-${i.id}` }, disabled: !can,
-          onclick: async () => { try { await del(`/v1/queue/${i.id}`); } catch (e) { ctx.toast(e.message, true); } refreshQueue(); } }, "Remove") : null)))
+        i.state === "queued" ? h("span", { class: "buttons" },
+          h("button", { type: "button", class: "control", dataset: { focus: `up-${i.id}` }, disabled: !can || i.position <= 1,
+                        "aria-label": `move ${i.campaign} up`, onclick: () => move(i, i.position - 1) }, "↑ Earlier"),
+          h("button", { type: "button", class: "control", dataset: { focus: `down-${i.id}` },
+                        disabled: !can || i.position >= queuedCount(q), "aria-label": `move ${i.campaign} down`,
+                        onclick: () => move(i, i.position + 1) }, "↓ Later"),
+          h("button", { type: "button", class: "control", dataset: { focus: `rm-${i.id}` }, disabled: !can,
+            onclick: async () => { try { await del(`/v1/queue/${i.id}`); } catch (e) { ctx.toast(e.message, true); } refreshQueue(); } }, "Remove"))
+          : null)))
         : h("p", { class: "muted" }, "The queue is empty."),
       (q.history || []).length ? h("details", {}, h("summary", {}, `history (${q.history.length})`),
         h("ul", { class: "rows" }, q.history.map(i => h("li", { class: "row" }, h("span", { class: "name" }, i.campaign), badge(i.state),
           i.reason ? h("span", { class: "reason" }, i.reason) : null)))) : null);
+  }
+
+  const queuedCount = q => (q.items || []).filter(i => i.state === "queued").length;
+
+  async function move(item, position) {
+    try { await post(`/v1/queue/${item.id}/move`, { position }); } catch (e) { ctx.toast(e.message, true); ctx.accessChanged(e); }
+    refreshQueue();
   }
 
   async function refreshQueue() {
