@@ -294,8 +294,11 @@ class ConsoleTest(unittest.TestCase):
     def test_4_open_the_run_with_measurements_and_exports(self):
         spot = self.spot
         self.open("runs")
-        link = wait_for(self, "the run listed", lambda: self.by_css(f'#runs-list a[href="#runs/{spot["run_id"]}"]'))
-        link.click()
+        wait_for(self, "the run listed", lambda: self.by_css(f'#runs-list a[href="#runs/{spot["run_id"]}"]'))
+        # A run with frames, started meanwhile: the first page of runs shows it without a reload.
+        frames = self.daemon.run_to_end("frame-average", frames=2)
+        wait_for(self, "the new run listed", lambda: self.all_css(f'#runs-list a[href="#runs/{frames["run_id"]}"]'))
+        self.click(f'#runs-list a[href="#runs/{spot["run_id"]}"]')
         wait_for(self, "measurement rows", lambda: len(self.all_css("#measurements tbody tr")) == READINGS)
         values = [r.find_elements("css selector", "td")[4].text for r in self.all_css("#measurements tbody tr")]
         stored = [m["value"] for m in self.daemon.stored_measurements(spot["run_id"])]
@@ -320,7 +323,6 @@ class ConsoleTest(unittest.TestCase):
             self.extra_allowed = [r"/report - Failed to load resource: the server responded with a status of 404"]
         screenshot(self.d, "run-detail")
         # A run with frames: previews through the key (fetched with the Authorization header), downloads.
-        frames = self.daemon.run_to_end("frame-average", frames=2)
         self.d.get(f"{self.daemon.url}/#runs/{frames['run_id']}")
         wait_for(self, "every preview drawn", lambda: (imgs := self.all_css("#blobs img")) and all(
             self.d.execute_script("return arguments[0].complete && arguments[0].naturalWidth > 0", i) for i in imgs))

@@ -59,8 +59,10 @@ export function mount(section, ctx) {
     async function refresh() {
       try { await fetchPage(); load(); } catch (e) { replace(table, errorBox(e)); }
     }
+    listRefresh = refresh;
     await refresh();
   }
+  let listRefresh = null;
 
   async function showRun(id) {
     listView.hidden = true;
@@ -134,7 +136,14 @@ export function mount(section, ctx) {
 
   return {
     show(arg) { if (arg) showRun(arg); else showList(); },
-    hide() { revokeAll(); },
-    update() {},
+    hide() { revokeAll(); listView.hidden = true; },
+    // The first page follows the lab: a run started or ended shows up without a reload (later pages stay put,
+    // so reading them is not disturbed). One re-read per burst of events.
+    update(what) {
+      const ev = what.event;
+      if (!ev || ev.topic !== "execution" || listView.hidden || page !== 0 || !listRefresh) return;
+      clearTimeout(this.timer);
+      this.timer = setTimeout(() => listRefresh(), 500);
+    },
   };
 }
