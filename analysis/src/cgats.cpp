@@ -1,9 +1,5 @@
 #include "colorlab/analysis/cgats.hpp"
 
-#include <memory>
-
-#include <lcms2.h>
-
 #include "colorlab/analysis/csv.hpp"
 #include "parse_util.hpp"
 
@@ -11,63 +7,30 @@ namespace colorlab::analysis {
 
 namespace {
 
-// lcms2 reports errors through its context's log handler; each parse gets its own context, so
-// concurrent readers (the daemon's reading threads) never see one another's message.
-struct LcmsLog {
-  std::string message;
-};
-
-void log_error(cmsContext ctx, cmsUInt32Number, const char* text) {
-  auto* log = static_cast<LcmsLog*>(cmsGetContextUserData(ctx));
-  if (!log || !log->message.empty()) return;
-  log->message = text;
-  // lcms2 prefixes the name of the file it was given; from memory that is empty (": Line 3, ...").
-  if (log->message.rfind(": ", 0) == 0) log->message.erase(0, 2);
-}
-
-struct ContextDeleter {
-  void operator()(void* c) const { cmsDeleteContext(static_cast<cmsContext>(c)); }
-};
-struct It8Deleter {
-  void operator()(void* h) const { cmsIT8Free(h); }
-};
-
-// lcms2 numbers its tables from 0 and keeps their keywords, fields and cells as text; this copies one
-// out so that the table outlives the handle and reads the same whatever wrote the file.
-CgatsTable copy_table(cmsHANDLE h, const std::string& source_name, int index) {
-  CgatsTable t;
-  t.source = source_name;
-  if (const char* type = cmsIT8GetSheetType(h)) t.file_type = type;
-  char** names = nullptr;
-  const auto n_props = cmsIT8EnumProperties(h, &names);
-  for (cmsUInt32Number i = 0; i < n_props; ++i) {
-    const char* value = cmsIT8GetProperty(h, names[i]);
-    t.keywords.emplace_back(names[i], value ? value : "");
-  }
-  char** fields = nullptr;
-  const int n_fields = cmsIT8EnumDataFormat(h, &fields);
-  const std::string where = source_name + " (table " + std::to_string(index + 1) + ")";
-  if (n_fields <= 0) detail::fail(where + ": no BEGIN_DATA_FORMAT fields");
-  for (int i = 0; i < n_fields; ++i) t.fields.emplace_back(fields[i] ? fields[i] : "");
-  const double sets = cmsIT8GetPropertyDbl(h, "NUMBER_OF_SETS");
-  // Compared as a double before the conversion: converting 1e300, -1 or NaN to a count is undefined.
-  if (!(sets >= 0 && sets <= 1e7)) detail::fail(where + ": NUMBER_OF_SETS is not a count");
-  const auto rows = static_cast<int>(sets);
-  t.rows.reserve(static_cast<std::size_t>(rows));
-  for (int r = 0; r < rows; ++r) {
-    std::vector<std::string> row;
-    row.reserve(static_cast<std::size_t>(n_fields));
-    for (int c = 0; c < n_fields; ++c) {
-      const char* cell = cmsIT8GetDataRowCol(h, r, c);
-      // lcms2 sizes the table by NUMBER_OF_SETS; a file with fewer rows than it says leaves holes.
-      if (!cell)
-        detail::fail(where + ": NUMBER_OF_SETS says " + std::to_string(rows) + " but data row " + std::to_string(r + 1) +
-                     " has no value for " + t.fields[static_cast<std::size_t>(c)]);
-      row.emplace_back(cell);
+// Splits a line into whitespace-separated tokens, keeping "quoted strings" whole.
+std::vector<std::string> tokenize(std::string_view line, const std::string& where) {
+  std::vector<std::string> out;
+  std::size_t i = 0;
+  while (i < line.size()) {
+    char c = line[i];
+    if (c == ' ' || c == '\t' || c == '\r') {
+      ++i;
+      continue;
     }
-    t.rows.push_back(std::move(row));
+    if (c == '#') break;
+    if (c == '"') {
+      std::size_t end = line.find('"', i + 1);
+      if (end == std::string_view::npos) detail::fail(where + ": unterminated quoted string");
+      out.emplace_back(line.substr(i + 1, end - i - 1));
+      i = end + 1;
+      continue;
+    }
+    std::size_t end = i;
+    while (end < line.size() && line[end] != ' ' && line[end] != '\t' && line[end] != '\r') ++end;
+    out.emplace_back(line.substr(i, end - i));
+    i = end;
   }
-  return t;
+  return out;
 }
 
 }  // namespace
@@ -100,28 +63,84 @@ double CgatsTable::number(std::size_t row, std::string_view field) const {
   return number(row, *idx);
 }
 
-// lcms2's IT8/CGATS.17 parser (the one its writer pairs with, fuzzed upstream by OSS-Fuzz) reads the
-// file; colorlab keeps only the copy of its tables. Its non-strict mode takes the keywords and fields
-// ArgyllCMS invents (SPECTRAL_NORM, SPEC_380 ...) without a KEYWORD declaration, as Argyll does.
 std::vector<CgatsTable> parse_cgats(std::string_view text, const std::string& source_name) {
-  if (text.find_first_not_of(" \t\r\n") == std::string_view::npos) detail::fail(source_name + ": no CGATS data table found");
-  LcmsLog log;
-  std::unique_ptr<void, ContextDeleter> ctx(cmsCreateContext(nullptr, &log));
-  if (!ctx) throw Error(ErrorClass::internal, "lcms2: cannot create a context");
-  cmsSetLogErrorHandlerTHR(static_cast<cmsContext>(ctx.get()), log_error);
-  // lcms2 takes a non-const buffer and a 32-bit length; it does not write to it.
-  if (text.size() > 0x7fffffffu) detail::fail(source_name + ": larger than 2 GiB");
-  std::string buffer(text);
-  std::unique_ptr<void, It8Deleter> it8(cmsIT8LoadFromMem(static_cast<cmsContext>(ctx.get()), buffer.data(),
-                                                           static_cast<cmsUInt32Number>(buffer.size())));
-  if (!it8) detail::fail(source_name + ": " + (log.message.empty() ? std::string("not a CGATS file") : log.message));
-  cmsHANDLE h = it8.get();
+  enum class State { header, format, data } state = State::header;
   std::vector<CgatsTable> tables;
-  const auto count = cmsIT8TableCount(h);
-  for (cmsUInt32Number i = 0; i < count; ++i) {
-    if (cmsIT8SetTable(h, i) < 0) detail::fail(source_name + ": cannot select table " + std::to_string(i + 1));
-    tables.push_back(copy_table(h, source_name, static_cast<int>(i)));
+  CgatsTable cur;
+  cur.source = source_name;
+  bool have_type = false;
+  std::size_t line_no = 0;
+  std::size_t pos = 0;
+  auto finish_table = [&]() {
+    tables.push_back(std::move(cur));
+    cur = CgatsTable{};
+    cur.source = source_name;
+    have_type = false;
+  };
+  while (pos <= text.size()) {
+    std::size_t nl = text.find('\n', pos);
+    std::string_view line = text.substr(pos, nl == std::string_view::npos ? std::string_view::npos : nl - pos);
+    pos = (nl == std::string_view::npos) ? text.size() + 1 : nl + 1;
+    ++line_no;
+    const std::string where = source_name + ":" + std::to_string(line_no);
+    auto tok = tokenize(line, where);
+    if (tok.empty()) continue;
+    switch (state) {
+      case State::header:
+        if (!have_type) {
+          cur.file_type = tok[0];
+          have_type = true;
+          if (tok.size() == 1) break;
+          tok.erase(tok.begin());  // tolerate "CTI3  extra"
+          break;
+        }
+        if (tok[0] == "BEGIN_DATA_FORMAT") {
+          state = State::format;
+          break;
+        }
+        if (tok[0] == "BEGIN_DATA") {
+          if (cur.fields.empty()) detail::fail(where + ": BEGIN_DATA before BEGIN_DATA_FORMAT");
+          state = State::data;
+          break;
+        }
+        if (tok[0] == "KEYWORD") break;  // declares a custom keyword; its value follows on its own line
+        {
+          std::string value;
+          for (std::size_t i = 1; i < tok.size(); ++i) value += (i > 1 ? " " : "") + tok[i];
+          cur.keywords.emplace_back(tok[0], value);
+        }
+        break;
+      case State::format:
+        for (auto& t : tok) {
+          if (t == "END_DATA_FORMAT") {
+            state = State::header;
+            break;
+          }
+          cur.fields.push_back(t);
+        }
+        break;
+      case State::data:
+        if (tok[0] == "END_DATA") {
+          if (auto n = cur.keyword("NUMBER_OF_SETS")) {
+            auto expected = detail::to_double(*n);
+            // Compared as a double: converting 1e300, -1 or NaN to a count is undefined.
+            if (expected && *expected != static_cast<double>(cur.rows.size()))
+              detail::fail(where + ": NUMBER_OF_SETS says " + *n + " but " + std::to_string(cur.rows.size()) +
+                           " data rows were read");
+          }
+          finish_table();
+          state = State::header;
+          break;
+        }
+        if (tok.size() != cur.fields.size())
+          detail::fail(where + ": data row has " + std::to_string(tok.size()) + " values, format declares " +
+                       std::to_string(cur.fields.size()) + " fields");
+        cur.rows.push_back(std::move(tok));
+        break;
+    }
   }
+  if (state == State::data) detail::fail(source_name + ": missing END_DATA");
+  if (state == State::format) detail::fail(source_name + ": missing END_DATA_FORMAT");
   if (tables.empty()) detail::fail(source_name + ": no CGATS data table found");
   return tables;
 }

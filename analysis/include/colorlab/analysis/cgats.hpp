@@ -23,8 +23,7 @@ struct CgatsTable {
   double number(std::size_t row, std::size_t field) const;
 };
 
-// All tables of a file (Argyll .ti3 may carry a second calibration table), read by lcms2's IT8 parser:
-// NUMBER_OF_FIELDS and NUMBER_OF_SETS must be declared and match the data, as CGATS.17 requires.
+// All tables of a file (Argyll .ti3 may carry a second calibration table).
 std::vector<CgatsTable> parse_cgats(std::string_view text, const std::string& source_name);
 std::vector<CgatsTable> read_cgats_all(const std::filesystem::path& path);
 // The first table; throws Error(io_error) if unreadable, Error(bad_data) if malformed.
