@@ -138,6 +138,15 @@ TEST(access_daemon, EachScopeGetsTheRightAnswerForEachRouteClassAndARevokedKeyIs
     }
   }
 
+  // GET /v1/control tells each caller its own scope (the web console shows itself read-only by it).
+  for (const auto& [scope, key] : keys) {
+    auto [control_status, control] = call(tcp(daemon, key.secret), "GET", "/v1/control");
+    ASSERT_EQ(control_status, 200) << control;
+    EXPECT_EQ(control["scope"], scope) << control;
+  }
+  EXPECT_EQ(call(tcp(daemon, ""), "GET", "/v1/control").second["scope"], "read");  // keyless loopback reads
+  EXPECT_EQ(call(local, "GET", "/v1/control").second["scope"], "admin");           // the Unix socket may do all
+
   // An admin key revokes the control key over TCP; from then on the control key gets 401 even for reads.
   auto [revoked_status, revoked] = call(tcp(daemon, keys["admin"].secret), "DELETE", "/v1/keys/" + keys["control"].id);
   ASSERT_EQ(revoked_status, 200) << revoked;
@@ -401,6 +410,11 @@ TEST(access_daemon, ARemotePeerNeedsAKeyForEveryRequest) {
   EXPECT_EQ(body["code"], "key-required");
   EXPECT_EQ(raw.headers["WWW-Authenticate"].rfind("Bearer", 0), 0u);
   EXPECT_EQ(call(ApiClient(remote), "GET", "/v1").first, 401);
+  // The web console's page itself holds no data, and a browser cannot attach a key to loading it:
+  // served to anyone; every datum it then asks for goes through the API with the key.
+  auto page = call(ApiClient(remote), "GET", "/", nullptr, &raw);
+  EXPECT_EQ(page.first, 200) << raw.body.substr(0, 300);
+  EXPECT_EQ(raw.content_type.rfind("text/html", 0), 0u) << raw.content_type;
 
   auto reader = create_key(ApiClient(local), "remote reader", "read");
   auto driver = create_key(ApiClient(local), "remote driver", "control");

@@ -39,6 +39,9 @@ json for_caller(json status, const Caller& caller) {
   json own_key = caller.key_id.empty() ? json(nullptr) : json(caller.key_id);
   status["yours"] = status.value("held", false) && status["key_id"] == own_key;
   status["you"] = caller.name();
+  // What this caller may do here (read, control, admin; null: nothing), so a client such as the web
+  // console can show itself read-only without probing a route that changes state.
+  status["scope"] = caller.scope ? json(std::string(to_string(*caller.scope))) : json(nullptr);
   return status;
 }
 
