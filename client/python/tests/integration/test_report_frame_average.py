@@ -130,6 +130,27 @@ class FrameAverageReport(unittest.TestCase):
         self.assertEqual(p.returncode, 3)
         self.assertIn("not reachable", p.stderr)
 
+    def test_the_colorlab_cli_makes_the_same_report(self):
+        """`colorlab report` (the C++ CLI) runs this package: same exit codes, the path as its last line."""
+        from daemon_fixture import BIN_DIR
+        out = Path(self.daemon.dir) / "via-colorlab.html"
+        env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}  # the binary finds the package itself
+        p = subprocess.run([str(BIN_DIR / "colorlab"), "--socket", self.daemon.endpoint["unix_socket"], "report",
+                            self.fa, self.ls, "-o", str(out)], capture_output=True, text=True, env=env, timeout=120)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertEqual(p.stdout.splitlines()[-1], str(out.resolve()))
+        html = out.read_text()
+        self.assertIn(f'data-run="{self.fa}"', html)
+        self.assertIn(f'data-run="{self.ls}"', html)
+        p = subprocess.run([str(BIN_DIR / "colorlab"), "--url", self.daemon.url, "report",
+                            "01900000-0000-7000-8000-00000000dead", "-o", os.devnull],
+                           capture_output=True, text=True, env=env, timeout=60)
+        self.assertEqual(p.returncode, 3, p.stderr)
+        p = subprocess.run([str(BIN_DIR / "colorlab"), "report", "not a run"], capture_output=True, text=True,
+                           env=env, timeout=60)
+        self.assertNotEqual(p.returncode, 0)
+        self.assertIn("not a run id", p.stderr)
+
 
 if __name__ == "__main__":
     unittest.main()
