@@ -4,7 +4,7 @@ from __future__ import annotations
 import datetime as dt
 import sys
 
-from . import cabinet_grid, characterization, common, fetch, frame_average, summaries
+from . import cabinet_grid, characterization, common, fetch, frame_average, pareto, stability, summaries
 from .html import document, esc
 
 TITLES = {
@@ -32,7 +32,26 @@ def section_for(run) -> str:
                 f'({esc(type(e).__name__)}: {esc(e)}); the run\'s summary instead:</p>' + summaries.section(run, "other"))
     return (f'<section id="{run.short}" class="run" data-run="{esc(run.id)}" data-kind="{esc(kind)}">'
             f'<h2>{esc(TITLES[kind])} — {esc(run.campaign)} {esc(run.id)}</h2>'
-            + common.header(run) + body + "</section>")
+            + common.header(run) + body + extras(run, kind) + "</section>")
+
+
+# Speed against accuracy and stability (issue 11): after the campaign's own section, each on its own.
+EXTRAS = {"frame-average": (pareto.frames_section,), "cabinet-grid": (pareto.luminance_section,),
+          "luminance-spot": (pareto.luminance_section,),
+          "characterize-camera": (pareto.characterization_section, stability.section)}
+
+
+def extras(run, kind) -> str:
+    out = []
+    for make in EXTRAS.get(kind, ()):
+        try:
+            out.append(make(run))
+        except Exception as e:  # noqa: BLE001 — an extra must not cost the run its section
+            print(f"colorlab report: run {run.id}: {make.__module__}.{make.__name__} failed: {type(e).__name__}: {e}",
+                  file=sys.stderr)
+            out.append(f'<p class="warn" data-error="true">{esc(make.__module__)} could not be made from the stored '
+                       f'data ({esc(type(e).__name__)}: {esc(e)}).</p>')
+    return "\n".join(out)
 
 
 def render(runs) -> str:
@@ -56,4 +75,10 @@ def load_runs(client, run_ids):
                 run.extra["reference"] = fetch.load(client, ref)
             except Exception:  # the reference only adds the L*a*b* comparisons; the section says when it lacks it
                 run.extra["reference"] = None
+    # The stability section's "another lamp": the report's other characterize-camera runs of the same reference.
+    cc = [r for r in runs if fetch.kind_of(r) == "characterize-camera"]
+    for run in cc:
+        p = run.doc.get("params") or {}
+        run.extra["other_lamps"] = [o for o in cc if o is not run and (o.doc.get("params") or {}).get("reference_run")
+                                    == p.get("reference_run") and (o.doc.get("params") or {}).get("lamp") != p.get("lamp")]
     return runs
