@@ -24,15 +24,17 @@ SECTIONS = {"frame-average": frame_average.section, "cabinet-grid": cabinet_grid
 def section_for(run) -> str:
     kind = fetch.kind_of(run)
     make = SECTIONS.get(kind)
+    ok = True
     try:
         body = make(run) if make else summaries.section(run, kind)
     except Exception as e:  # one odd run (aborted, hand-edited script) must not cost the other runs their sections
         print(f"colorlab report: run {run.id}: the {kind} section failed: {type(e).__name__}: {e}", file=sys.stderr)
+        ok = False
         body = (f'<p class="warn" data-error="true">This section could not be made from the stored data '
                 f'({esc(type(e).__name__)}: {esc(e)}); the run\'s summary instead:</p>' + summaries.section(run, "other"))
     return (f'<section id="{run.short}" class="run" data-run="{esc(run.id)}" data-kind="{esc(kind)}">'
             f'<h2>{esc(TITLES[kind])} — {esc(run.campaign)} {esc(run.id)}</h2>'
-            + common.header(run) + body + extras(run, kind) + "</section>")
+            + common.header(run) + body + (extras(run, kind) if ok else "") + "</section>")
 
 
 # Speed against accuracy and stability (issue 11): after the campaign's own section, each on its own.

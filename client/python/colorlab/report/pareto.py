@@ -31,6 +31,11 @@ def _seconds(ts) -> float:
     return pd.Timestamp(ts).timestamp()
 
 
+def _timed(run, rows) -> bool:
+    """Whether the run stored what the time axis is made of: its start and its measurements' measured_at."""
+    return bool(run.doc.get("started_at")) and "measured_at" in rows and rows.measured_at.notna().all()
+
+
 def _front_plot(ax, costs, errors, labels, front, chosen, *, xlabel, ylabel, limit=None, logx=False):
     ax.scatter(costs, errors, s=18, c="tab:gray", label="settings")
     fx = [costs[i] for i in front]
@@ -60,7 +65,7 @@ def _front_flags(n, front):
 def frames_data(run):
     """(frames, noise mean over channels, seconds per N, rule limit, chosen index) from the stored run."""
     rows = run.steps("noise/N")
-    if rows.empty:
+    if rows.empty or not _timed(run, rows):
         return None
     by_n: dict = {}
     for _, m in rows.iterrows():
@@ -235,6 +240,8 @@ def luminance_data(run):
         return None
     if "data.readings" in m:  # cabinet-grid with its readings per spot, lamp and level
         g = m[m.step.str.startswith("L/") & m["data.readings"].notna()]
+        if not _timed(run, g):
+            return None
         groups = [list(r) for r in g["data.readings"]]
         taken = sum(len(x) for x in groups)
         span = _seconds(g.measured_at.max()) - _seconds(run.doc["started_at"]) if taken else 0
@@ -244,7 +251,7 @@ def luminance_data(run):
                "(settling, warm-up and drift checks spread in)")
     else:
         r = run.steps("reading/")
-        if len(r) < 2:
+        if len(r) < 2 or not _timed(run, r):
             return None
         groups = [list(r.value.astype(float))]
         per = float(np.median(np.diff(sorted(_seconds(t) for t in r.measured_at))))
