@@ -23,7 +23,7 @@ from .plots import subplots, to_svg
 
 FRAME_RULE = 1.10          # σN ≤ 1.10 × the noise of the most frames the run averaged
 CHAR_TOLERANCE = 0.1       # CV mean ΔE00 within 0.1 of the best (the lab's own model-selection tolerance)
-REPEATABILITY_RULE = 0.5   # % of the mean luminance
+REPEATABILITY_RULE = 0.1   # % of the mean luminance
 READINGS = (1, 2, 3, 4, 5, 8, 10, 16, 25)
 
 

@@ -152,7 +152,7 @@ class TradeoffsReport(unittest.TestCase):
             self.assertAlmostEqual(t[("repeatability", str(n), "derived")], rel[k], places=9)
             self.assertAlmostEqual(t[("time", str(n), "measured")], times[k], delta=1e-6)
             self.assertEqual(t[("front", str(n), "derived")], 1.0 if k in brute_front(times, rel) else 0.0)
-        k = cheapest(times, rel, 0.5)
+        k = cheapest(times, rel, 0.1)
         self.assertEqual(self.chosen(run, name), "" if k is None else str(READINGS[k]))
 
     def test_cabinet_grid_readings_per_spot(self):
