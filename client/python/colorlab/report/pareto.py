@@ -42,8 +42,9 @@ def _front_plot(ax, costs, errors, labels, front, chosen, *, xlabel, ylabel, lim
     fy = [errors[i] for i in front]
     ax.step(fx, fy, where="post", color="tab:blue", lw=1.2, label="Pareto front")
     ax.scatter(fx, fy, s=24, c="tab:blue", zorder=3)
-    for i, lab in enumerate(labels):
-        ax.annotate(lab, (costs[i], errors[i]), fontsize=6, xytext=(2, 2), textcoords="offset points")
+    for k, i in enumerate(i for i, lab in enumerate(labels) if lab):  # alternate above and below: dense fronts
+        ax.annotate(labels[i], (costs[i], errors[i]), fontsize=6, xytext=(3, 3 if k % 2 == 0 else -9),
+                    textcoords="offset points")
     if chosen is not None:
         ax.scatter([costs[chosen]], [errors[chosen]], s=90, facecolors="none", edgecolors="tab:red", lw=1.5,
                    zorder=4, label=f"cheapest meeting the rule: {labels[chosen]}")
@@ -95,7 +96,10 @@ def frames_section(run) -> str:
     note = (f"Rule: σN ≤ {FRAME_RULE:.2f} × σ{d['frames'][-1]} = {d['limit']:.3f} {esc(d['unit'])} (within 10 % of the "
             f"noise floor this run reached). <b data-chosen=\"{d['frames'][k] if k is not None else ''}\">Cheapest N "
             f"meeting it: {d['frames'][k] if k is not None else 'none'}</b>. Noise: the run's stored σN (mean of its "
-            f"CFA channels). Time: not stored per frame — the run's capture time, {d['capture']:.3f} s from its start "
+            "CFA channels). The run stores no signal level (the region's mean), so a rule relative to the signal "
+            "(noise ≤ 1 % of it) cannot be applied, and the published 25-frame figure is in another camera's counts "
+            "(Table 2's note). "
+            f"Time: not stored per frame — the run's capture time, {d['capture']:.3f} s from its start "
             f"to its first stored noise row (measured_at) for {d['total']} frames, is shared equally "
             f"({d['per_frame'] * 1e3:.2f} ms a frame, processing included) and multiplied by N. On the simulated lab "
             "the time is the simulator's (time-scaled), not a real camera's.")
