@@ -25,6 +25,9 @@ FRAME_RULE = 1.10          # σN ≤ 1.10 × the noise of the most frames the ru
 CHAR_TOLERANCE = 0.1       # CV mean ΔE00 within 0.1 of the best (the lab's own model-selection tolerance)
 REPEATABILITY_RULE = 0.1   # % of the mean luminance
 READINGS = (1, 2, 3, 4, 5, 8, 10, 16, 25)
+PATCHES = (10, 15, 20, 30, 40, 60, 80, 100)  # training-set sizes tried (more than the model's terms)
+PATCH_RULE = 1.10          # mean ΔE00 ≤ 1.10 × the error trained on 9/10 of the chart
+LEARNING_DRAWS, LEARNING_SEED = 10, 11
 
 
 def _seconds(ts) -> float:
@@ -205,22 +208,46 @@ def characterization_section(run) -> str:
                                f"<b data-chosen=\"{ns[k] if k is not None else ''}\">Cheapest meeting it: polynomial "
                                f"{ns[k] if k is not None else 'none'}</b>.")))
         panels.append(("refit", cost, cv, [str(n) for n in ns], front, k, limit))
+        # Training-set size as the cost: the best-cross-validating polynomial's learning curve.
+        best = ns[int(np.argmin(cv))]
+        sizes = [s for s in PATCHES if r[best]["terms"] < s < len(ids)] + [len(ids) - len(ids) // 10]
+        curve = tr.learning_curve(rgb01, lab, best, sizes, draws=LEARNING_DRAWS, seed=LEARNING_SEED)
+        front = tr.pareto_front(sizes, curve)
+        limit = PATCH_RULE * curve[-1]
+        k = tr.cheapest_meeting(sizes, curve, limit)
+        out.append(table(f"{run.short}-pareto-patches", f"Training-set size: polynomial {best} (the best 10-fold CV "
+                         "above) trained on n patches, mean ΔE00 on the rest", [str(x) for x in sizes],
+                         [("mean ΔE00 on the rest", curve, "model", "error", None, 4),
+                          ("on the Pareto front (1 = yes)", [1.0 if i in front else 0.0 for i in range(len(sizes))],
+                           "derived", "front", None, 0)], corner="training patches",
+                         note=(f"Computed by the report (numpy): {LEARNING_DRAWS} random draws of n patches per size "
+                               f"(seeded {LEARNING_SEED}), fitted, evaluated on the patches not drawn. Rule: ≤ "
+                               f"{PATCH_RULE:.2f} × the error at {sizes[-1]} patches = {limit:.3f}. "
+                               f"<b data-chosen=\"{sizes[k] if k is not None else ''}\">Cheapest training set meeting "
+                               f"it: {sizes[k] if k is not None else 'none'} patches</b>.")))
+        panels.append(("patches", sizes, curve, [str(x) for x in sizes], front, k, limit))
     if not panels:
         return ""
-    fig, axes = subplots(len(panels), width=9, height=3.4)
+    fig, axes = subplots(len(panels), ncols=2, width=9, height=3.4)
     for ax, (what, x, y, labels, front, k, limit) in zip(axes, panels):
         if what == "stored":
             _front_plot(ax, x, y, [lb if i in front else "" for i, lb in enumerate(labels)], front, k,
                         xlabel="parameters", ylabel="stored CV mean ΔE00", limit=limit)
             ax.set_yscale("log")
             ax.set_title("(a) stored models", fontsize=8)
-        else:
+        elif what == "refit":
             _front_plot(ax, [v * 1e3 for v in x], y, labels, front, k, xlabel="fit + apply time (ms, numpy)",
                         ylabel="10-fold CV mean ΔE00", limit=limit)
             ax.set_title("(b) polynomials refitted by the report", fontsize=8)
+        else:
+            _front_plot(ax, x, y, labels, front, k, xlabel="training patches", ylabel="mean ΔE00 on the rest",
+                        limit=limit)
+            ax.set_yscale("log")
+            ax.set_title("(c) training-set size", fontsize=8)
     out.append(figure(f"{run.short}-fig-pareto-models", to_svg(fig, f"{run.short}-fig-pareto-models"),
                       "Characterization: cross-validated ΔE00 against cost, (a) the run's stored models against their "
-                      "parameter count, (b) §7.3's polynomials refitted and timed by the report; Pareto fronts (blue) "
+                      "parameter count, (b) §7.3's polynomials refitted and timed by the report, (c) the best of them "
+                      "against the number of training patches; Pareto fronts (blue) "
                       "and the cheapest model within the tolerance (red circle).", "pareto-models"))
     return "\n".join(out)
 

@@ -220,6 +220,20 @@ class TradeoffsReport(unittest.TestCase):
         for k in range(11):
             self.assertEqual(t[(f"poly{k + 1}", "Pareto front", "model")], 1.0 if k in front else 0.0)
         self.assertEqual(self.chosen(self.cc, "pareto-refits"), str(cheapest(costs, cvs, min(cvs) + 0.1) + 1))
+        # Training-set size: the best-cross-validating polynomial's learning curve (random draws: its values are the
+        # report's; the front and the choice are recomputed from them), up to 9/10 of the chart.
+        best = int(np.argmin(cvs)) + 1
+        self.assertIn(f"polynomial {best} (the best 10-fold CV", self.html)
+        t = self.t(self.cc, "pareto-patches")
+        curve = sorted((int(c), v) for (r, c, _), v in t.items() if r == "error")
+        sizes, errs = [c for c, _ in curve], [v for _, v in curve]
+        self.assertEqual(sizes[-1], 126)
+        self.assertTrue(all(s > len(terms(best, *rgb.T)) for s in sizes))
+        self.assertLess(errs[-1], errs[0])
+        front = brute_front(sizes, errs)
+        for k, s in enumerate(sizes):
+            self.assertEqual(t[("front", str(s), "derived")], 1.0 if k in front else 0.0)
+        self.assertEqual(self.chosen(self.cc, "pareto-patches"), str(sizes[cheapest(sizes, errs, 1.10 * errs[-1])]))
 
     # ---- stability ----
 
