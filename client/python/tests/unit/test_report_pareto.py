@@ -3,7 +3,6 @@ the cheapest setting meeting a rule, CIEDE2000 against Sharma, Wu & Dalal's publ
 learning curves on synthetic charts whose answers follow from the mathematics, and the sections on synthetic runs."""
 from __future__ import annotations
 
-import itertools
 import unittest
 
 import numpy as np
