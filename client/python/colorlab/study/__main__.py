@@ -1,0 +1,108 @@
+"""python3 -m colorlab.study dissertation [--url URL | --socket PATH] [--key KEY] [-o report.html] [--dry-run]
+                                        [--small] [--set STEP.KEY=VALUE …] [--state-file FILE] [--resume]
+
+Runs the study's campaigns through the daemon's night queue (so it survives a restart of colorlabd), follows
+them by the event stream printing progress lines, then writes the report of all the study's runs; the report's
+path is the last line of stdout. Exit codes: 0 ok, 2 usage, 3 daemon/run problem, 4 a campaign of the study
+failed (named, with its problem on stderr).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+
+import colorlab
+
+from . import definition
+from .runner import EXIT_DAEMON, EXIT_FAILED, EXIT_OK, EXIT_USAGE, Study, StudyFailed, StudyProblem
+
+
+def parse(argv):
+    p = argparse.ArgumentParser(prog="python3 -m colorlab.study",
+                                description="Run a built-in study (its campaigns through the night queue) and write its report.")
+    p.add_argument("study", choices=sorted(definition.STUDIES), help="the study")
+    where = p.add_mutually_exclusive_group()
+    where.add_argument("--url", help="the daemon's URL (default: COLORLAB_URL, then the local daemon's endpoint file)")
+    where.add_argument("--socket", help="the daemon's Unix socket (default: COLORLAB_SOCKET)")
+    p.add_argument("--key", help="API key (default: COLORLAB_API_KEY); needs the control scope (the queue)")
+    p.add_argument("-o", "--output", help="the report's HTML file (default: report-<first run id>.html here)")
+    p.add_argument("--dry-run", action="store_true",
+                   help="post each campaign's dry run and print the estimated total duration; nothing is queued")
+    p.add_argument("--small", action="store_true", help="a reduced study (tests, a first look): smaller grid, fewer frames")
+    p.add_argument("--set", action="append", default=[], metavar="STEP.KEY=VALUE",
+                   help="override one parameter of one step (VALUE as JSON, else a string), e.g. cabinet-grid.rows=4")
+    p.add_argument("--state-file", help="where the study keeps its queue items (default: ./colorlab-study-STUDY.json)")
+    p.add_argument("--resume", action="store_true",
+                   help="re-attach to the study in --state-file (after this command or the daemon was stopped)")
+    args = p.parse_args(argv)
+    overrides: dict = {}
+    names = {s["name"] for s in definition.STUDIES[args.study]}
+    for item in args.set:
+        key, eq, raw = item.partition("=")
+        step, dot, param = key.partition(".")
+        if not eq or not dot or not param or step not in names:
+            p.error(f"--set {item!r}: expected STEP.KEY=VALUE with STEP one of {', '.join(sorted(names))}")
+        try:
+            value = json.loads(raw)
+        except ValueError:
+            value = raw
+        overrides.setdefault(step, {})[param] = value
+    args.overrides = overrides
+    args.state_file = args.state_file or f"colorlab-study-{args.study}.json"
+    if args.resume and not os.path.exists(args.state_file):
+        p.error(f"--resume: no study state in {args.state_file}")
+    return args
+
+
+def connect(args) -> colorlab.Client:
+    if args.socket or (not args.url and os.environ.get("COLORLAB_SOCKET")):
+        return colorlab.Client(socket=args.socket or os.environ["COLORLAB_SOCKET"], key=args.key)
+    if args.url or os.environ.get("COLORLAB_URL"):
+        return colorlab.Client(args.url, key=args.key)
+    try:
+        return colorlab.Client.local(key=args.key)
+    except Exception:  # no endpoint file here: the documented default URL
+        return colorlab.Client(key=args.key)
+
+
+def main(argv=None) -> int:
+    try:
+        args = parse(sys.argv[1:] if argv is None else argv)
+    except SystemExit as e:  # argparse: 0 for --help, 2 for bad usage
+        return int(e.code or 0)
+    try:
+        client = connect(args)
+    except Exception as e:
+        print(f"colorlab study: cannot reach the daemon: {e}", file=sys.stderr)
+        return EXIT_DAEMON
+    steps = definition.steps(args.study, small=args.small, overrides=args.overrides)
+    study = Study(client, args.study, steps, state_file=args.state_file, resume=args.resume)
+    try:
+        if args.dry_run:
+            return study.dry_run()
+        run_ids = study.run()
+        return study.report(run_ids, args)
+    except StudyFailed as e:
+        print(f"colorlab study: {e}", file=sys.stderr)
+        return EXIT_FAILED
+    except StudyProblem as e:
+        print(f"colorlab study: {e}", file=sys.stderr)
+        return EXIT_DAEMON
+    except (colorlab.Unauthorized, colorlab.Forbidden) as e:
+        print(f"colorlab study: the daemon refused the key: {e}", file=sys.stderr)
+        return EXIT_DAEMON
+    except colorlab.ColorlabError as e:
+        print(f"colorlab study: {client.url}: {e}", file=sys.stderr)
+        return EXIT_DAEMON
+    except KeyboardInterrupt:
+        print(f"colorlab study: interrupted; the queue goes on — re-attach with --resume --state-file {args.state_file}",
+              file=sys.stderr)
+        return 130
+    finally:
+        client.close()
+
+
+if __name__ == "__main__":
+    sys.exit(main())

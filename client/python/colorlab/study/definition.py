@@ -1,0 +1,66 @@
+"""The dissertation study's definition: which campaigns, in which order, with which parameters.
+
+Data only. Each step is one queue item; ``reference`` names an earlier step whose run id goes into the
+given parameter when the item is queued (characterize-camera's ``reference_run`` is the study's own
+chart-read, so it is queued once that chart-read has finished). ``covers`` says what of the report the step
+is for (docs/reports.md, "What it contains").
+"""
+from __future__ import annotations
+
+DISSERTATION = [
+    {
+        "name": "chart-read",
+        "campaign": "chart-read",
+        # §6.1: the SG's 140 patches on the SpectroScan T; the reference for chapter 7.
+        "params": {"chart": "sg"},
+        "covers": "§6.1 chart reference (a*-b*, L* per patch); reference of characterize-camera",
+    },
+    {
+        "name": "frame-average",
+        "campaign": "frame-average",
+        "params": {"frames": 25},
+        "covers": "Table 2, fig. 34",
+    },
+    {
+        "name": "cabinet-grid",
+        "campaign": "cabinet-grid",
+        # The full 8 x 10 grid (Tables 3-6 are compared cell by cell only on it), three lamps x four levels:
+        # figs. 36-42 (D65 at 100/50/25/15 %), 43-46 (TL84, CWF at 100 and 50 %, and every other level),
+        # dimmer proportionality, lamps compared. Lamp-major: 3 lamp warm-ups instead of 161.
+        "params": {"rows": 8, "cols": 10, "lamps": ["D65", "TL84", "CWF"], "dimmer_levels": [100, 50, 25, 15],
+                   "order": "lamp-major"},
+        "covers": "Tables 3-6, figs. 36-46, dimmer proportionality, lamps compared",
+    },
+    {
+        "name": "characterize-camera",
+        "campaign": "characterize-camera",
+        # The three test cases of ch. 7 (8-bit TIFF, JPEG, 16-bit TIFF) and the raw for the black box.
+        # prior_exclude: the simulated camera is a 20D; its own curves must not be in the black box's prior.
+        "params": {"chart": "sg", "formats": ["raw", "tiff16", "tiff8", "jpeg"], "frames": 25, "lamp": "D65",
+                   "prior_exclude": ["Canon_20D"]},
+        "reference": {"param": "reference_run", "step": "chart-read"},
+        "covers": "Tables 9-13, figs. 51-60, black box",
+    },
+]
+
+# --small: the same four campaigns, reduced (tests, a first look): a 2 x 5 grid at two lamps and levels,
+# fewer frames. Tables 3-6 are then not compared cell by cell (the report says so).
+SMALL_OVERRIDES = {
+    "frame-average": {"frames": 4},
+    "cabinet-grid": {"rows": 2, "cols": 5, "lamps": ["D65", "TL84"], "dimmer_levels": [100, 50], "settle_s": 0},
+    "characterize-camera": {"frames": 2},
+}
+
+STUDIES = {"dissertation": DISSERTATION}
+
+
+def steps(study: str = "dissertation", *, small: bool = False, overrides: dict | None = None) -> list[dict]:
+    """The study's steps with ``--small`` and ``--set STEP.KEY=VALUE`` overrides applied (copies)."""
+    out = []
+    for step in STUDIES[study]:
+        s = {**step, "params": dict(step["params"])}
+        if small:
+            s["params"].update(SMALL_OVERRIDES.get(s["name"], {}))
+        s["params"].update((overrides or {}).get(s["name"], {}))
+        out.append(s)
+    return out

@@ -1,0 +1,153 @@
+"""python3 -m colorlab.study: the dissertation study (reduced with --small) through the night queue on a colorlabd
+with the embedded simulated lab, end to end to its report; re-attached with --resume after the study's process
+and the daemon were killed -9 mid-study; a campaign that fails ends the study with exit 4, naming it; bad usage 2."""
+from __future__ import annotations
+
+import json
+import os
+import re
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+import unittest
+from pathlib import Path
+
+import daemon_fixture
+from daemon_fixture import SOURCE_DIR
+
+# The chart must be located in the DSLR's photographs: the size characterize-camera's report test uses.
+LAB_TOML = "[genicam]\nenabled = false\n[dslr]\nsize = [1752, 1168]\n"
+ENV = dict(os.environ, PYTHONPATH=str(SOURCE_DIR / "client" / "python"), PYTHONUNBUFFERED="1")
+CAMPAIGNS = ["chart-read", "frame-average", "cabinet-grid", "characterize-camera"]
+
+
+def study_command(daemon, tmp: Path, *extra) -> list[str]:
+    return [sys.executable, "-m", "colorlab.study", "dissertation", "--small", "--socket",
+            daemon.endpoint["unix_socket"], "--state-file", str(tmp / "study.json"), "-o", str(tmp / "report.html"),
+            *extra]
+
+
+class Study(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        saved = daemon_fixture.LAB_TOML
+        daemon_fixture.LAB_TOML = LAB_TOML
+        try:
+            cls.daemon = daemon_fixture.Daemon(time_scale=500, seed=9)
+        finally:
+            daemon_fixture.LAB_TOML = saved
+        for instrument in ("spectrolino", "ls110", "dmx", "dslr"):
+            cls.daemon.wait_ready(instrument)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.daemon.cleanup()
+
+    def setUp(self):
+        self.tmp = Path(tempfile.mkdtemp(prefix="colorlab-study-", dir=self.daemon.dir))
+
+    def run_study(self, *extra, timeout=200) -> subprocess.CompletedProcess:
+        return subprocess.run(study_command(self.daemon, self.tmp, *extra), capture_output=True, text=True, env=ENV,
+                              timeout=timeout, cwd=self.tmp)
+
+    def check_study(self, p: subprocess.CompletedProcess) -> list[str]:
+        self.assertEqual(p.returncode, 0, f"{p.stdout}\n{p.stderr}\n{self.daemon.log_text()}")
+        lines = p.stdout.strip().splitlines()
+        report = self.tmp / "report.html"
+        self.assertEqual(lines[-1], str(report.resolve()), "the report's path is the last line")
+        self.assertTrue(any(re.search(r"\[\d/4\] \S+ +\d+\.\d % +ETA", line) for line in lines), p.stdout)
+        state = json.loads((self.tmp / "study.json").read_text())
+        runs = [state["runs"][c] for c in CAMPAIGNS]
+        html = report.read_text(encoding="utf-8")
+        self.assertNotIn('data-error="true"', html)
+        for campaign, run_id in zip(CAMPAIGNS, runs):
+            run = self.daemon.client.conn.get(f"/v1/runs/{run_id}")
+            self.assertEqual((run["campaign"], run["status"]), (campaign, "finished_ok"))
+            self.assertIn(f'data-run="{run_id}" data-kind="{campaign}"', html)
+        cc = self.daemon.client.conn.get(f"/v1/runs/{runs[3]}")
+        self.assertEqual(cc["params"]["reference_run"], runs[0], "characterized against the study's chart-read")
+        grid = self.daemon.client.conn.get(f"/v1/runs/{runs[2]}")["params"]
+        self.assertEqual((grid["rows"], grid["cols"], grid["lamps"]), (2, 5, ["D65", "TL84"]))
+        return runs
+
+    def queue_items(self, state) -> list[dict]:
+        return [self.daemon.client.conn.get(f"/v1/queue/{i}") for i in state["items"].values()]
+
+    def test_1_the_study_runs_end_to_end_to_its_report(self):
+        started = time.monotonic()
+        p = self.run_study()
+        self.check_study(p)
+        print(f"study --small: {time.monotonic() - started:.1f} s", file=sys.stderr)
+
+    def test_2_a_study_killed_with_its_daemon_resumes(self):
+        proc = subprocess.Popen(study_command(self.daemon, self.tmp), stdout=subprocess.PIPE,
+                                stderr=subprocess.STDOUT, text=True, env=ENV, cwd=self.tmp)
+        state_file = self.tmp / "study.json"
+        try:
+            deadline = time.monotonic() + 120
+            killed_in = None
+            while time.monotonic() < deadline and killed_in is None:
+                try:
+                    state = json.loads(state_file.read_text())
+                except (FileNotFoundError, ValueError):
+                    state = {}
+                item = state.get("items", {}).get("cabinet-grid")
+                if item and self.daemon.client.conn.get(f"/v1/queue/{item}")["state"] == "running":
+                    killed_in = "cabinet-grid"
+                    break
+                time.sleep(0.05)
+            self.assertEqual(killed_in, "cabinet-grid", "the study never reached its cabinet grid")
+            proc.send_signal(signal.SIGKILL)
+            self.daemon.kill9()
+        finally:
+            proc.kill()
+            first_out = proc.communicate()[0]
+        self.daemon.start()
+        p = self.run_study("--resume")
+        self.assertIn("re-attaching", p.stdout)
+        runs = self.check_study(p)
+        self.assertEqual(len(set(runs)), 4)
+        state = json.loads(state_file.read_text())
+        items = self.queue_items(state)
+        self.assertEqual([i["state"] for i in items], ["done"] * 4, f"{first_out}\n{p.stdout}")
+        self.assertEqual(len({i["execution_id"] for i in items}), 4, "each step ran once")
+
+    def test_3_a_failing_campaign_ends_the_study_with_exit_4(self):
+        # Validated (first_x_mm ≤ 310) but the SG's columns then run off the SpectroScan's 310 mm.
+        p = self.run_study("--set", "chart-read.first_x_mm=300")
+        self.assertEqual(p.returncode, 4, f"{p.stdout}\n{p.stderr}")
+        self.assertIn("campaign chart-read (chart-read) of study dissertation failed", p.stderr)
+        state = json.loads((self.tmp / "study.json").read_text())
+        states = {i["campaign"]: i["state"] for i in self.queue_items(state)}
+        self.assertEqual(states["chart-read"], "failed")
+        self.assertEqual({states["frame-average"], states["cabinet-grid"]}, {"removed"}, states)
+        self.assertNotIn("characterize-camera", states)
+        self.assertFalse((self.tmp / "report.html").exists())
+
+    def test_4_a_parameter_the_campaign_refuses_is_exit_4(self):
+        p = self.run_study("--set", "cabinet-grid.rows=0")
+        self.assertEqual(p.returncode, 4, f"{p.stdout}\n{p.stderr}")
+        self.assertIn("cabinet-grid", p.stderr)
+        self.assertIn("could not be queued", p.stderr)
+
+    def test_5_usage(self):
+        for extra in (["--set", "nosuchstep.x=1"], ["--set", "nodot"], ["--resume", "--state-file", "/nonexistent"]):
+            p = subprocess.run([sys.executable, "-m", "colorlab.study", "dissertation", *extra], capture_output=True,
+                               text=True, env=ENV, timeout=30, cwd=self.tmp)
+            self.assertEqual(p.returncode, 2, f"{extra}: {p.stdout}{p.stderr}")
+        p = subprocess.run([sys.executable, "-m", "colorlab.study", "nosuchstudy"], capture_output=True, text=True,
+                           env=ENV, timeout=30, cwd=self.tmp)
+        self.assertEqual(p.returncode, 2)
+
+    def test_6_dry_run_estimates_the_study(self):
+        p = self.run_study("--dry-run", timeout=120)
+        self.assertEqual(p.returncode, 0, f"{p.stdout}\n{p.stderr}")
+        self.assertRegex(p.stdout.splitlines()[-1], r"^study dissertation: estimated total .* \(\d+ s wall\)$")
+        for campaign in CAMPAIGNS[:3]:
+            self.assertRegex(p.stdout, rf"(?m)^{campaign} +\S+ wall")
+
+
+if __name__ == "__main__":
+    unittest.main()
