@@ -10,11 +10,8 @@
 
 #include <unistd.h>
 
+#include "colorlab/core/data_paths.hpp"
 #include "colorlab/core/error.hpp"
-
-#ifndef COLORLAB_PYTHON_SOURCE_DIR
-#define COLORLAB_PYTHON_SOURCE_DIR ""
-#endif
 
 namespace colorlab::cli {
 
@@ -26,22 +23,6 @@ struct ReportOptions {
   std::vector<std::string> runs;
   std::string output;
 };
-
-// Where `import colorlab` finds the report package: installed beside the binary
-// (<prefix>/lib/python3/dist-packages), else the source tree the binary was built from, else
-// Debian's module path as it stands.
-std::string python_path() {
-  if (const char* env = std::getenv("COLORLAB_PYTHONPATH"); env && *env) return env;
-  std::error_code ec;
-  const auto self = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) {
-    const auto installed = self.parent_path().parent_path() / "lib" / "python3" / "dist-packages";
-    if (fs::exists(installed / "colorlab" / "report" / "__main__.py", ec)) return installed.string();
-  }
-  const fs::path source = COLORLAB_PYTHON_SOURCE_DIR;
-  if (!source.empty() && fs::exists(source / "colorlab" / "report" / "__main__.py", ec)) return source.string();
-  return {};
-}
 
 // Replaces this process with the report module, so its output, progress and exit code (0 written,
 // 2 usage, 3 run or daemon not found) are the command's own.
@@ -59,7 +40,7 @@ std::string python_path() {
   // The key goes by environment, not argv, where any user's `ps` would see it.
   if (!g.key.empty()) ::setenv("COLORLAB_API_KEY", g.key.c_str(), 1);
   if (!g.cacert.empty()) ::setenv("REQUESTS_CA_BUNDLE", g.cacert.c_str(), 1);
-  if (auto path = python_path(); !path.empty()) {
+  if (auto path = paths::python_client_dir().string(); !path.empty()) {
     const char* existing = std::getenv("PYTHONPATH");
     const std::string joined = existing && *existing ? path + ":" + existing : path;
     ::setenv("PYTHONPATH", joined.c_str(), 1);

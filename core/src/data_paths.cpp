@@ -52,4 +52,20 @@ std::optional<fs::path> shared_data_file(std::string_view name) {
   return p;
 }
 
+fs::path python_client_dir() {
+  if (const char* env = std::getenv("COLORLAB_PYTHONPATH"); env && *env) return env;
+  std::error_code ec;
+  const auto marker = fs::path("colorlab") / "report" / "__main__.py";
+  const auto self = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const auto installed = self.parent_path().parent_path() / "lib" / "python3" / "dist-packages";
+    if (fs::exists(installed / marker, ec)) return installed;
+  }
+#ifdef COLORLAB_SOURCE_DIR
+  const fs::path source = fs::path(COLORLAB_SOURCE_DIR) / "client" / "python";
+  if (fs::exists(source / marker, ec)) return source;
+#endif
+  return {};
+}
+
 }  // namespace colorlab::paths

@@ -1,4 +1,5 @@
 #include "colorlab/daemon/console_files.hpp"
+#include "colorlab/daemon/report_service.hpp"
 #include "colorlab/daemon/daemon.hpp"
 
 #include <unistd.h>
@@ -52,6 +53,7 @@ struct Daemon::Impl {
   std::unique_ptr<NightQueue> queue;
   std::unique_ptr<ReadConnections> readers;
   std::unique_ptr<EventHub> events;
+  std::unique_ptr<ReportService> reports;  // runs' reports, made by the Python client (report_service.hpp)
   std::unique_ptr<ApiContext> api;
   std::unique_ptr<http::Server> server;
   std::unique_ptr<drivers::Discovery> discovery;
@@ -186,6 +188,14 @@ Daemon::Daemon(DaemonConfig config) : impl_(std::make_unique<Impl>()) {
   d.api->control = d.access.lock.get();
   d.api->blobs = d.blobs.get();
   d.api->console_dir = shipped_console_dir();
+  ReportService::Options report_options;
+  report_options.directory = d.config.state_dir / "reports";
+  report_options.unix_socket = d.config.socket_path();
+#ifdef COLORLAB_VERSION
+  report_options.version = COLORLAB_VERSION;
+#endif
+  d.reports = std::make_unique<ReportService>(report_options);
+  d.api->reports = d.reports.get();
 
   http::ServerOptions so;
   so.tcp_host = d.config.listen_host;

@@ -1,5 +1,10 @@
 #include "colorlab/drivers/instrument.hpp"
 
+#include <algorithm>
+#include <cmath>
+
+#include "colorlab/drivers/lab_capabilities.hpp"
+
 #include <nlohmann/json.hpp>
 
 namespace colorlab::drivers {
@@ -56,6 +61,30 @@ nlohmann::json describe(const Instrument& instrument) {
                    {"capabilities", std::move(caps)},
                    {"calibration", std::move(cals)}};
   if (auto p = instrument.last_problem(); !p.empty()) j["problem"] = p;
+  // The light cabinet as it is now: which lamps are lit and at what level (percent), so a client (the web
+  // console's Lab page) sees it without a campaign asking.
+  const auto* lamps = dynamic_cast<const LampController*>(&instrument);
+  const auto* dimmer = dynamic_cast<const Dimmer*>(&instrument);
+  if (lamps || dimmer) {
+    nlohmann::json lab = nlohmann::json::object();
+    std::vector<std::string> names, lit;
+    if (lamps) {
+      names = lamps->lamp_names();
+      lit = lamps->lamps_on();
+      nlohmann::json on = nlohmann::json::object();
+      for (const auto& n : names) on[n] = std::find(lit.begin(), lit.end(), n) != lit.end();
+      lab["lamps"] = on;
+    }
+    if (dimmer && !names.empty()) {
+      auto percent = [](double level) { return std::round(level * 1000.0) / 10.0; };
+      nlohmann::json levels = nlohmann::json::object();
+      for (const auto& n : names) levels[n] = percent(dimmer->level(n));
+      lab["levels"] = levels;
+      // The level of the lamp that is lit, when exactly one is (the cabinet's usual state).
+      if (lit.size() == 1) lab["dimmer"] = percent(dimmer->level(lit.front()));
+    }
+    j["lab"] = std::move(lab);
+  }
   return j;
 }
 

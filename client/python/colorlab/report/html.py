@@ -92,5 +92,6 @@ def figure(fig_id: str, svg: str, caption: str, item: str = "") -> str:
 
 
 def document(title: str, body: str) -> str:
-    return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+    # An empty icon: served by the daemon, the file would otherwise make the browser ask its origin for /favicon.ico.
+    return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><link rel=\"icon\" href=\"data:,\">"
             f"<title>{esc(title)}</title><style>{CSS}</style></head><body>\n{body}\n</body></html>\n")

@@ -151,6 +151,48 @@ class FrameAverageReport(unittest.TestCase):
         self.assertNotEqual(p.returncode, 0)
         self.assertIn("not a run id", p.stderr)
 
+    def test_the_daemon_serves_the_report_of_an_ended_run(self):
+        """GET /v1/runs/{id}/report: 202 with Retry-After while the daemon's child process makes it, then the HTML,
+        the same run's section as the CLI's; 404 for no such run; the run document links it."""
+        import json
+        import time
+        import urllib.error
+        import urllib.request
+
+        url = f"{self.daemon.url}/v1/runs/{self.ls}/report"
+        self.assertEqual(self.daemon.client.conn.get(f"/v1/runs/{self.ls}")["links"]["report"], f"/v1/runs/{self.ls}/report")
+        seen_202 = False
+        deadline = time.monotonic() + 180
+        while True:
+            with urllib.request.urlopen(url, timeout=30) as r:
+                body = r.read()
+                if r.status == 202:
+                    seen_202 = True
+                    self.assertEqual(r.headers["Retry-After"], "2")
+                    self.assertEqual(json.loads(body)["state"], "generating")
+                    self.assertLess(time.monotonic(), deadline, "the report was not made in 3 minutes")
+                    time.sleep(0.5)
+                    continue
+                self.assertEqual(r.status, 200)
+                self.assertTrue(r.headers["Content-Type"].startswith("text/html"), r.headers["Content-Type"])
+                html = body.decode()
+                etag = r.headers["ETag"]
+                break
+        self.assertTrue(seen_202, "the first request cannot find a report already made")
+        self.assertIn(f'data-run="{self.ls}"', html)
+        self.assertIn("SIMULATED", html)
+        # Made once: the next request is the same file, and its ETag answers 304.
+        req = urllib.request.Request(url, headers={"If-None-Match": etag})
+        with self.assertRaises(urllib.error.HTTPError) as cached:
+            urllib.request.urlopen(req, timeout=30)
+        self.assertEqual(cached.exception.code, 304)
+        with urllib.request.urlopen(urllib.request.Request(url, method="HEAD"), timeout=30) as r:
+            self.assertEqual(r.status, 200)
+            self.assertEqual(r.read(), b"")
+        with self.assertRaises(urllib.error.HTTPError) as missing:
+            urllib.request.urlopen(f"{self.daemon.url}/v1/runs/01900000-0000-7000-8000-00000000dead/report", timeout=30)
+        self.assertEqual(missing.exception.code, 404)
+
 
 if __name__ == "__main__":
     unittest.main()

@@ -34,12 +34,13 @@ function card(i) {
     i.problem ? h("p", { class: "error" }, typeof i.problem === "string" ? i.problem : (i.problem.detail || JSON.stringify(i.problem))) : null);
 }
 
-// The API reports no lamp or dimmer levels yet; show them when it does (fields named after the lab API).
+// GET /v1/instruments' `lab`: {lamps: {name: lit}, levels: {name: percent}, dimmer: percent of the lit lamp}.
 function lampState(i) {
   const lab = i.lab || i.status || {};
   if (!lab.lamps && lab.dimmer === undefined) return h("span", { class: "muted" }, "levels not reported by the daemon");
   return h("span", {},
-    lab.lamps ? Object.entries(lab.lamps).map(([k, v]) => `${k}: ${v ? "on" : "off"}`).join(", ") : "",
+    lab.lamps ? Object.entries(lab.lamps).map(([k, v]) =>
+      `${k}: ${v ? "on" : "off"}${lab.levels && lab.levels[k] !== undefined && v ? ` (${lab.levels[k]} %)` : ""}`).join(", ") : "",
     lab.dimmer !== undefined ? ` · dimmer ${lab.dimmer} %` : "");
 }
 

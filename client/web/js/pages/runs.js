@@ -1,6 +1,7 @@
 // Runs: the stored runs, newest first, cursor-paged as the API pages them; one run with its measurements
 // (paged too), its kept frames as previews, downloads, exports and — where the daemon has one — its report.
-import { get, exists } from "../api.js";
+import { get, authHeaders } from "../api.js";
+import { getKey } from "../key.js";
 import { h, replace, badge, errorBox, fmtTime, fmtNumber, fmtBytes, short } from "../dom.js";
 import { image, download, revokeAll } from "../files.js";
 
@@ -98,9 +99,8 @@ export function mount(section, ctx) {
       h("h4", {}, "Measurements"), meas,
       h("h4", {}, "Frames"), blobs);
 
-    exists(`${base}/report`).then(ok => {
-      if (ok) replace(report, h("a", { href: `${base}/report`, id: "report" }, "report"));
-    });
+    // An ended run has a report (the daemon makes it on first request: 202 until it is there).
+    if (run.links && run.links.report) replace(report, reportLink(run.links.report, id));
 
     const mCursors = [null];
     let mPage = 0;
@@ -146,4 +146,26 @@ export function mount(section, ctx) {
       this.timer = setTimeout(() => listRefresh(), 500);
     },
   };
+}
+
+// Without a key the link is followed as it is: the daemon's "making the report" page reloads itself until
+// the report is there. With a key (which a link cannot carry) the report is fetched, waiting out the 202s,
+// and opened from an object URL.
+function reportLink(path, id) {
+  const a = h("a", { href: path, id: "report", target: "_blank", rel: "noopener" }, "report");
+  a.addEventListener("click", async ev => {
+    if (!getKey()) return;
+    ev.preventDefault();
+    const tab = window.open("", "_blank");
+    for (let tries = 0; tries < 300; ++tries) {
+      const res = await fetch(path, { headers: authHeaders({ Accept: "text/html" }), cache: "no-store" });
+      if (res.status === 202) { await new Promise(r => setTimeout(r, 2000)); continue; }
+      if (!res.ok) { a.after(h("span", { class: "error" }, ` report: ${res.status}`)); if (tab) tab.close(); return; }
+      const url = URL.createObjectURL(await res.blob());
+      if (tab) tab.location = url; else window.location = url;
+      setTimeout(() => URL.revokeObjectURL(url), 60000);
+      return;
+    }
+  });
+  return a;
 }

@@ -19,4 +19,9 @@ std::optional<std::filesystem::path> shared_data_dir();
 // A file in the shared data set, or nullopt when the set or the file is absent.
 std::optional<std::filesystem::path> shared_data_file(std::string_view name);
 
+// The directory holding the Python client's package (`import colorlab`, its report and study modules):
+// $COLORLAB_PYTHONPATH, else installed beside the running binary (<prefix>/lib/python3/dist-packages),
+// else the source tree this was built from; empty when none has it (Debian's module path may still).
+std::filesystem::path python_client_dir();
+
 }  // namespace colorlab::paths

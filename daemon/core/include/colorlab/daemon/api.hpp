@@ -21,6 +21,8 @@ class EventHub;
 class Access;
 class ControlLock;
 
+class ReportService;
+
 struct ApiContext {
   store::Store& store;
   const campaigns::InstrumentSet& instruments;
@@ -40,7 +42,8 @@ struct ApiContext {
   store::Store& reads();
   Access* access = nullptr;       // checked first for every request (access.hpp)
   ControlLock* control = nullptr;  // /v1/control (control_api.cpp)
-  std::filesystem::path console_dir;  // the web console's static files, served at / (console_files.cpp)
+  std::filesystem::path console_dir;
+  ReportService* reports = nullptr;  // GET /v1/runs/{id}/report (report_service.hpp)  // the web console's static files, served at / (console_files.cpp)
 };
 
 http::HttpResponse handle_api(ApiContext& ctx, const http::HttpRequest& req);
