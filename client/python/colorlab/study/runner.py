@@ -203,6 +203,10 @@ class Study:
                         continue
                     if ev.topic in ("queue", "execution"):
                         break
+                else:  # the stream ended (the daemon said stop): look again in a moment on a fresh one
+                    events.close()
+                    time.sleep(1.0)
+                    events = self.client.events(give_up_after=300.0)
         except colorlab.ConnectionFailed as e:
             raise StudyProblem(f"lost the daemon ({self.client.url}): {e}; the queue goes on — re-attach with "
                                f"--resume --state-file {self.state_file}") from e
