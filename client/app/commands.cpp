@@ -10,6 +10,7 @@
 #include "colorlab/core/error.hpp"
 #include "colorlab/protocol/states.hpp"
 #include "client_support.hpp"
+#include "follow.hpp"
 #include "format.hpp"
 
 namespace colorlab::cli {
@@ -48,27 +49,8 @@ int run_campaign(const GlobalOptions& g, const RunOptions& o) {
     }
     return 0;
   }
-  std::string last_line;
-  std::set<std::string> requests_shown;
-  for (int poll = 0;; ++poll) {
-    execution = api.get("/v1/executions/" + id);
-    // An unattended campaign may still ask a person something: show it where the operator looks.
-    if (!o.id_only && poll % 10 == 0) {
-      for (const auto& r : api.get("/v1/requests").value("items", json::array())) {
-        if (r.value("execution_id", std::string()) == id && requests_shown.insert(r.value("id", std::string())).second) {
-          std::cerr << format_request(r);
-        }
-      }
-    }
-    auto status = protocol::execution_status_from_string(execution.value("status", std::string()));
-    if (!o.id_only && !g.json) {
-      std::string line = format_execution(execution);
-      if (line != last_line) std::cerr << line;
-      last_line = line;
-    }
-    if (status && protocol::is_terminal(*status)) break;
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  }
+  // Live by the event stream: progress and ETA, operator requests as they are posted, no polling.
+  execution = follow_execution(api, execution, o.id_only || g.json);
   json run = client::fetch_run(api, run_id);
   bool ok = execution["status"] == "finished_ok";
   if (o.id_only) {

@@ -10,6 +10,9 @@
 
 #include "colorlab/core/error.hpp"
 
+#include <algorithm>
+#include <functional>
+
 namespace colorlab::client {
 
 namespace asio = boost::asio;
@@ -111,35 +114,101 @@ void set_receive_timeout(int fd, std::chrono::milliseconds timeout) {
   ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
 }
 
-RawResponse exchange_tls(asio::io_context& io, const Endpoint& endpoint, std::chrono::milliseconds timeout,
-                         const std::string& method, const std::string& target, const std::string& body,
-                         const std::map<std::string, std::string>& headers) {
-  ssl::context context(ssl::context::tls_client);
-  context.set_options(ssl::context::default_workarounds | ssl::context::no_sslv2 | ssl::context::no_sslv3 |
-                      ssl::context::no_tlsv1 | ssl::context::no_tlsv1_1);
-  context.set_verify_mode(ssl::verify_peer);
-  if (endpoint.ca_file.empty()) {
-    context.set_default_verify_paths();
-  } else {
+// Opens the endpoint's kind of connection (Unix socket, TCP, TLS over TCP) and hands it to `use` with the
+// Host to name; translates a failure to talk into Error{no_comms} saying what to check.
+template <class Use>
+auto with_connection(const Endpoint& endpoint, std::chrono::milliseconds timeout, Use&& use) {
+  asio::io_context io;
+  try {
+    if (!endpoint.unix_socket.empty()) {
+      asio::local::stream_protocol::socket s(io);
+      s.connect(asio::local::stream_protocol::endpoint(endpoint.unix_socket));
+      return use(s, std::string("localhost"));
+    }
+    asio::ip::tcp::resolver resolver(io);
+    if (!endpoint.tls) {
+      asio::ip::tcp::socket s(io);
+      asio::connect(s, resolver.resolve(endpoint.host, std::to_string(endpoint.port)));
+      set_receive_timeout(s.native_handle(), timeout);
+      return use(s, endpoint.host);
+    }
+    ssl::context context(ssl::context::tls_client);
+    context.set_options(ssl::context::default_workarounds | ssl::context::no_sslv2 | ssl::context::no_sslv3 |
+                        ssl::context::no_tlsv1 | ssl::context::no_tlsv1_1);
+    context.set_verify_mode(ssl::verify_peer);
+    if (endpoint.ca_file.empty()) {
+      context.set_default_verify_paths();
+    } else {
+      boost::system::error_code ec;
+      context.load_verify_file(endpoint.ca_file, ec);
+      if (ec) {
+        throw Error(ErrorClass::bad_parameter, "cannot read the CA certificates in " + endpoint.ca_file + ": " + ec.message(),
+                    "--cacert (COLORLAB_CACERT) takes a PEM file");
+      }
+    }
+    ssl::stream<asio::ip::tcp::socket> stream(io, context);
+    // The certificate must name the host we asked for (DNS name, or IP address in subjectAltName).
+    stream.set_verify_callback(ssl::host_name_verification(endpoint.host));
     boost::system::error_code ec;
-    context.load_verify_file(endpoint.ca_file, ec);
-    if (ec) {
-      throw Error(ErrorClass::bad_parameter, "cannot read the CA certificates in " + endpoint.ca_file + ": " + ec.message(),
-                  "--cacert (COLORLAB_CACERT) takes a PEM file");
+    asio::ip::make_address(endpoint.host, ec);
+    if (ec) SSL_set_tlsext_host_name(stream.native_handle(), endpoint.host.c_str());  // SNI: names only
+    asio::connect(stream.next_layer(), resolver.resolve(endpoint.host, std::to_string(endpoint.port)));
+    set_receive_timeout(stream.next_layer().native_handle(), timeout);
+    stream.handshake(ssl::stream_base::client);
+    auto out = use(stream, endpoint.host);
+    stream.shutdown(ec);  // the answer is complete; a peer that closes without close_notify changes nothing
+    return out;
+  } catch (const boost::system::system_error& e) {
+    if (e.code().category() == asio::error::get_ssl_category()) {
+      throw Error(ErrorClass::no_comms,
+                  "TLS with colorlabd at " + endpoint.describe() + " failed: " + e.code().message(),
+                  "is its certificate issued for this host and by a CA you trust? pass the CA's certificate with "
+                  "--cacert FILE (or COLORLAB_CACERT)");
+    }
+    throw Error(ErrorClass::no_comms, "cannot talk to colorlabd at " + endpoint.describe() + ": " + e.code().message(),
+                "is colorlabd running? start it with: build/bin/colorlabd");
+  }
+}
+
+// A GET whose body is read as it arrives (an event stream): each piece goes to `on_data` until it returns
+// false or the body ends. A refusal (not 2xx) is read whole and returned for the caller to raise.
+template <class Stream>
+RawResponse stream_body(Stream& stream, const std::string& host, const std::string& target,
+                        const std::map<std::string, std::string>& headers,
+                        const std::function<bool(std::string_view)>& on_data) {
+  bhttp::request<bhttp::empty_body> req{bhttp::verb::get, target, 11};
+  req.set(bhttp::field::host, host);
+  req.set(bhttp::field::user_agent, "colorlab-client");
+  req.set(bhttp::field::accept, "text/event-stream, application/problem+json");
+  for (const auto& [k, v] : headers) req.set(k, v);
+  req.keep_alive(false);
+  bhttp::write(stream, req);
+  boost::beast::flat_buffer buffer;
+  bhttp::response_parser<bhttp::buffer_body> parser;
+  parser.body_limit(boost::none);
+  bhttp::read_header(stream, buffer, parser);
+  RawResponse out;
+  out.status = static_cast<int>(parser.get().result_int());
+  out.content_type = std::string(parser.get()[bhttp::field::content_type]);
+  for (const auto& f : parser.get()) out.headers[std::string(f.name_string())] = std::string(f.value());
+  const bool ok = out.status >= 200 && out.status < 300;
+  char piece[16384];
+  while (!parser.is_done()) {
+    parser.get().body().data = piece;
+    parser.get().body().size = sizeof piece;
+    boost::system::error_code ec;
+    // read_some: whatever has arrived (an event is small), not a full buffer's worth.
+    bhttp::read_some(stream, buffer, parser, ec);
+    if (ec == bhttp::error::need_buffer) ec = {};
+    if (ec == bhttp::error::end_of_stream || ec == asio::error::eof) break;
+    if (ec) throw boost::system::system_error(ec);
+    const std::string_view got(piece, sizeof piece - parser.get().body().size);
+    if (!ok) {
+      if (out.body.size() < (1u << 20)) out.body.append(got);
+    } else if (!got.empty() && !on_data(got)) {
+      break;
     }
   }
-  ssl::stream<asio::ip::tcp::socket> stream(io, context);
-  // The certificate must name the host we asked for (DNS name, or IP address in subjectAltName).
-  stream.set_verify_callback(ssl::host_name_verification(endpoint.host));
-  boost::system::error_code ec;
-  asio::ip::make_address(endpoint.host, ec);
-  if (ec) SSL_set_tlsext_host_name(stream.native_handle(), endpoint.host.c_str());  // SNI: names only
-  asio::ip::tcp::resolver resolver(io);
-  asio::connect(stream.next_layer(), resolver.resolve(endpoint.host, std::to_string(endpoint.port)));
-  set_receive_timeout(stream.next_layer().native_handle(), timeout);
-  stream.handshake(ssl::stream_base::client);
-  auto out = exchange(stream, endpoint.host, method, target, body, headers);
-  stream.shutdown(ec);  // the answer is complete; a peer that closes without close_notify changes nothing
   return out;
 }
 
@@ -149,29 +218,21 @@ RawResponse ApiClient::request(const std::string& method, const std::string& tar
                                const std::map<std::string, std::string>& headers) const {
   auto all = headers;
   if (!api_key_.empty() && all.find("Authorization") == all.end()) all["Authorization"] = "Bearer " + api_key_;
-  asio::io_context io;
-  try {
-    if (!endpoint_.unix_socket.empty()) {
-      asio::local::stream_protocol::socket s(io);
-      s.connect(asio::local::stream_protocol::endpoint(endpoint_.unix_socket));
-      return exchange(s, "localhost", method, target, body, all);
-    }
-    if (endpoint_.tls) return exchange_tls(io, endpoint_, timeout_, method, target, body, all);
-    asio::ip::tcp::resolver resolver(io);
-    asio::ip::tcp::socket s(io);
-    asio::connect(s, resolver.resolve(endpoint_.host, std::to_string(endpoint_.port)));
-    set_receive_timeout(s.native_handle(), timeout_);
-    return exchange(s, endpoint_.host, method, target, body, all);
-  } catch (const boost::system::system_error& e) {
-    if (e.code().category() == asio::error::get_ssl_category()) {
-      throw Error(ErrorClass::no_comms,
-                  "TLS with colorlabd at " + endpoint_.describe() + " failed: " + e.code().message(),
-                  "is its certificate issued for this host and by a CA you trust? pass the CA's certificate with "
-                  "--cacert FILE (or COLORLAB_CACERT)");
-    }
-    throw Error(ErrorClass::no_comms, "cannot talk to colorlabd at " + endpoint_.describe() + ": " + e.code().message(),
-                "is colorlabd running? start it with: build/bin/colorlabd");
-  }
+  return with_connection(endpoint_, timeout_, [&](auto& stream, const std::string& host) {
+    return exchange(stream, host, method, target, body, all);
+  });
+}
+
+void ApiClient::stream(const std::string& target, const std::function<bool(std::string_view)>& on_data,
+                       const std::map<std::string, std::string>& headers) const {
+  auto all = headers;
+  if (!api_key_.empty() && all.find("Authorization") == all.end()) all["Authorization"] = "Bearer " + api_key_;
+  // Keep-alive comments come every 15 s: a minute without a byte is a dead link.
+  const auto timeout = std::max(timeout_, std::chrono::milliseconds(60000));
+  RawResponse refused = with_connection(endpoint_, timeout, [&](auto& s, const std::string& host) {
+    return stream_body(s, host, target, all, on_data);
+  });
+  if (refused.status < 200 || refused.status >= 300) (void)expect_json(refused);  // throws ApiError
 }
 
 nlohmann::json ApiClient::expect_json(const RawResponse& r) const {

@@ -1,4 +1,6 @@
 #pragma once
+#include <functional>
+#include <string_view>
 // Talks to colorlabd over a Unix socket, HTTP or HTTPS (the server's certificate verified against
 // a CA file or the system's store, and its name or address checked). A non-2xx answer becomes
 // ApiError carrying the server's problem+json, so callers (the CLI, tests) see the server's own
@@ -60,6 +62,10 @@ class ApiClient {
   nlohmann::json post(const std::string& target, const nlohmann::json& body,
                       const std::map<std::string, std::string>& headers = {}) const;
   nlohmann::json del(const std::string& target) const;  // DELETE
+  // GET with a body read as it arrives (GET /v1/events/stream): `on_data` gets each piece until it returns
+  // false or the daemon ends the body. Throws ApiError for a refusal, Error{no_comms} for a lost link.
+  void stream(const std::string& target, const std::function<bool(std::string_view)>& on_data,
+              const std::map<std::string, std::string>& headers = {}) const;
 
   const Endpoint& endpoint() const { return endpoint_; }
 
