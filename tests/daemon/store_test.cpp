@@ -217,6 +217,47 @@ TEST(Store, CursorPagingVisitsEveryRunOnceNewestFirst) {
   EXPECT_EQ(seen, created);
 }
 
+TEST(Store, RunsFilteredByCampaignAndStatusPageOnlyTheMatching) {
+  TempDir dir;
+  Store store(dir / "colorlab.db");
+  std::vector<std::string> spots_finished;
+  for (int i = 0; i < 9; ++i) {
+    auto run = luminance_run();
+    if (i % 3 == 0) run.campaign = "frame-average";
+    auto id = store.create_execution(run).execution.run_id;
+    if (i % 3 != 0 && i % 2 == 0) {
+      store.finish_run(id, colorlab::protocol::ExecutionStatus::finished_ok, nlohmann::json::object(), nullptr);
+      spots_finished.push_back(id);
+    }
+  }
+  auto collect = [&](const colorlab::store::RunFilter& f) {
+    std::vector<std::string> ids;
+    std::optional<std::string> cursor;
+    do {
+      auto page = store.runs(2, cursor, f);
+      EXPECT_LE(page.runs.size(), 2u);
+      for (const auto& r : page.runs) {
+        if (!f.campaign.empty()) {
+          EXPECT_EQ(r.campaign, f.campaign);
+        }
+        if (!f.status.empty()) {
+          EXPECT_EQ(r.status, f.status);
+        }
+        ids.push_back(r.id);
+      }
+      cursor = page.next_cursor;
+    } while (cursor);
+    return ids;
+  };
+  EXPECT_EQ(collect({"frame-average", ""}).size(), 3u);
+  EXPECT_EQ(collect({"luminance-spot", ""}).size(), 6u);
+  auto finished = collect({"luminance-spot", "finished_ok"});
+  std::reverse(spots_finished.begin(), spots_finished.end());
+  EXPECT_EQ(finished, spots_finished);
+  EXPECT_TRUE(collect({"no-such-campaign", ""}).empty());
+  EXPECT_EQ(collect({}).size(), 9u);
+}
+
 TEST(Store, ForeignCursorIsABadParameter) {
   TempDir dir;
   Store store(dir / "colorlab.db");

@@ -204,13 +204,21 @@ HttpResponse get_runs(ApiContext& ctx, const HttpRequest& req) {
   unsigned limit = page_limit(req);
   std::optional<std::string> cursor;
   if (auto it = req.query.find("cursor"); it != req.query.end()) cursor = it->second;
-  auto page = ctx.reads().runs(limit, cursor);
+  store::RunFilter filter;
+  if (auto it = req.query.find("campaign"); it != req.query.end()) filter.campaign = it->second;
+  if (auto it = req.query.find("status"); it != req.query.end()) filter.status = it->second;
+  auto page = ctx.reads().runs(limit, cursor, filter);
   json items = json::array();
   for (const auto& r : page.runs) items.push_back(r.to_json());
   json links = json::object();
-  links["next"] = page.next_cursor ? json(std::string(protocol::kPrefix) + "/runs?limit=" + std::to_string(limit) +
-                                          "&cursor=" + *page.next_cursor)
-                                   : json(nullptr);
+  if (page.next_cursor) {
+    std::string next = std::string(protocol::kPrefix) + "/runs?limit=" + std::to_string(limit) + "&cursor=" + *page.next_cursor;
+    if (!filter.campaign.empty()) next += "&campaign=" + http::percent_encode(filter.campaign);
+    if (!filter.status.empty()) next += "&status=" + http::percent_encode(filter.status);
+    links["next"] = next;
+  } else {
+    links["next"] = nullptr;
+  }
   return HttpResponse::json(200, {{"items", items}, {"links", links}, {"next_cursor", page.next_cursor ? json(*page.next_cursor) : json(nullptr)}});
 }
 

@@ -587,7 +587,7 @@ std::int64_t Store::last_event_seq() {
   return st.step() ? st.int64(0) : 0;
 }
 
-RunPage Store::runs(unsigned limit, const std::optional<std::string>& cursor) {
+RunPage Store::runs(unsigned limit, const std::optional<std::string>& cursor, const RunFilter& filter) {
   std::int64_t before = INT64_MAX;
   if (cursor) {
     try {
@@ -600,8 +600,13 @@ RunPage Store::runs(unsigned limit, const std::optional<std::string>& cursor) {
     }
   }
   // Keyset paging: the cost of a page does not grow with how far back it is.
-  auto st = db_.prepare(std::string("SELECT ") + kRunColumns + " FROM runs WHERE seq < ?1 ORDER BY seq DESC LIMIT ?2");
-  st.bind(1, before).bind(2, static_cast<std::int64_t>(limit) + 1);
+  auto st = db_.prepare(std::string("SELECT ") + kRunColumns +
+                        " FROM runs WHERE seq < ?1 AND (?3 = '' OR campaign = ?3) AND (?4 = '' OR status = ?4)"
+                        " ORDER BY seq DESC LIMIT ?2");
+  st.bind(1, before)
+      .bind(2, static_cast<std::int64_t>(limit) + 1)
+      .bind(3, std::string_view(filter.campaign))
+      .bind(4, std::string_view(filter.status));
   RunPage page;
   while (st.step()) page.runs.push_back(read_run(st));
   if (page.runs.size() > limit) {

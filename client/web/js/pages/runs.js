@@ -19,31 +19,42 @@ export function mount(section, ctx) {
     detailView.hidden = true;
     listView.hidden = false;
     revokeAll();
-    const fCampaign = h("input", { id: "filter-campaign", type: "search", value: filter.campaign, placeholder: "e.g. luminance-spot" });
+    const fCampaign = h("input", { id: "filter-campaign", type: "search", value: filter.campaign, placeholder: "e.g. luminance-spot",
+      list: "campaign-names" });
+    const names = h("datalist", { id: "campaign-names" });
+    get("/v1/campaigns").then(c => replace(names, (c.items || []).map(i => h("option", { value: i.name })))).catch(() => {});
     const fStatus = h("select", { id: "filter-status" }, ["", "running", "finished_ok", "finished_error", "aborted", "interrupted"]
       .map(s => h("option", { value: s, selected: s === filter.status }, s || "any")));
     const table = h("div", { class: "table-wrap" }, h("p", { class: "muted" }, "…"));
     const pager = h("div", { class: "buttons pager" });
-    const apply = () => { filter = { campaign: fCampaign.value.trim(), status: fStatus.value }; load(); };
-    fCampaign.addEventListener("input", apply);
+    // The daemon filters (GET /v1/runs?campaign=&status=), so every page is of matching runs.
+    const apply = async () => {
+      filter = { campaign: fCampaign.value.trim(), status: fStatus.value };
+      cursors = [null];
+      page = 0;
+      await refresh();
+    };
+    fCampaign.addEventListener("change", apply);
     fStatus.addEventListener("change", apply);
     replace(listView,
       h("div", { class: "filters" },
-        h("div", { class: "field" }, h("label", { for: "filter-campaign" }, "campaign contains"), fCampaign),
-        h("div", { class: "field" }, h("label", { for: "filter-status" }, "status"), fStatus),
-        h("small", { class: "help" }, "Filters apply to the page shown (the API pages runs newest first, unfiltered).")),
+        h("div", { class: "field" }, h("label", { for: "filter-campaign" }, "campaign"), fCampaign, names),
+        h("div", { class: "field" }, h("label", { for: "filter-status" }, "status"), fStatus)),
       table, pager);
 
     let runs = [], next = null;
     async function fetchPage() {
       const cursor = cursors[page];
-      const r = await get(`/v1/runs?limit=${RUNS_PAGE}${cursor ? `&cursor=${encodeURIComponent(cursor)}` : ""}`);
+      const q = new URLSearchParams({ limit: String(RUNS_PAGE) });
+      if (cursor) q.set("cursor", cursor);
+      if (filter.campaign) q.set("campaign", filter.campaign);
+      if (filter.status) q.set("status", filter.status);
+      const r = await get(`/v1/runs?${q}`);
       runs = r.items;
       next = r.next_cursor;
     }
     function load() {
-      const shown = runs.filter(r => (!filter.campaign || (r.campaign || "").includes(filter.campaign))
-        && (!filter.status || r.status === filter.status));
+      const shown = runs;
       replace(table, shown.length ? h("table", { class: "runs" },
         h("thead", {}, h("tr", {}, ["run", "campaign", "status", "data", "started", "finished"].map(c => h("th", { scope: "col" }, c)))),
         h("tbody", {}, shown.map(r => h("tr", {},
@@ -51,7 +62,7 @@ export function mount(section, ctx) {
           h("td", {}, r.campaign), h("td", {}, badge(r.status)),
           h("td", {}, r.simulated ? h("span", { class: "tag sim" }, "SIMULATED") : h("span", { class: "tag real" }, "real")),
           h("td", {}, fmtTime(r.started_at || r.created_at)), h("td", {}, fmtTime(r.finished_at))))))
-        : h("p", { class: "muted" }, runs.length ? "No run on this page matches." : "No runs stored yet."));
+        : h("p", { class: "muted" }, filter.campaign || filter.status ? "No run matches." : "No runs stored yet."));
       replace(pager,
         h("button", { type: "button", id: "runs-newer", disabled: page === 0, onclick: async () => { page--; await refresh(); } }, "← Newer"),
         h("span", { class: "muted" }, `page ${page + 1}`),

@@ -130,6 +130,12 @@ struct EventRecord {
   nlohmann::json payload;
 };
 
+// Which runs a page of GET /v1/runs holds; empty fields match everything.
+struct RunFilter {
+  std::string campaign;  // exact name
+  std::string status;    // exact status
+};
+
 struct RunPage {
   std::vector<RunRecord> runs;
   std::optional<std::string> next_cursor;
@@ -211,7 +217,7 @@ class Store {
   std::int64_t measurement_count(const std::string& run_id);
   std::int64_t last_event_seq();
   // Newest first; `cursor` is the opaque next_cursor of the previous page.
-  RunPage runs(unsigned limit, const std::optional<std::string>& cursor);
+  RunPage runs(unsigned limit, const std::optional<std::string>& cursor, const RunFilter& filter = {});
 
   std::int64_t append_event(const std::string& topic, const nlohmann::json& payload);
   // Events with seq > after, oldest first (a client resumes from the last seq it saw).
