@@ -13,7 +13,6 @@ listen="${COLORLAB_LISTEN:-127.0.0.1:8765}"
 # (5 lab s = 0.1 s apart) and the settling keep their physics (docs/reports.md, "The dissertation study").
 time_scale="${COLORLAB_TIME_SCALE:-50}"
 bin=build/bin
-python=/usr/bin/python3   # Debian's: numpy, pandas, matplotlib (a pyenv python3 does not see them)
 
 mkdir -p "$state"
 # The embedded simulated lab, time-scaled: the daemon's configuration, kept in the state directory.
@@ -39,7 +38,7 @@ done
 # The study: chart-read, frame-average, cabinet-grid, characterize-camera through the night queue, followed by the
 # event stream, then the report. Over the Unix socket (control needs no key there); its last line is the report.
 report="$state/dissertation-report.html"
-PYTHONPATH=client/python "$python" -m colorlab.study dissertation --socket "$state/colorlabd.sock" \
+"$bin/colorlab" --socket "$state/colorlabd.sock" study dissertation \
   --state-file "$state/dissertation-study.json" -o "$report" | tee "$state/dissertation-study.log"
 report=$(tail -n 1 "$state/dissertation-study.log")
 cat <<MSG
@@ -52,6 +51,6 @@ Query it again while a daemon runs:
   $bin/colorlabd --state $state --listen $listen &
   $bin/colorlab --url $url runs
   $bin/colorlab --url $url show RUN_ID --json
-  PYTHONPATH=client/python $python -m colorlab.report RUN_ID… -o report.html
+  $bin/colorlab --url $url report RUN_ID… -o report.html
 $report
 MSG

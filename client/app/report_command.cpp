@@ -24,14 +24,21 @@ struct ReportOptions {
   std::string output;
 };
 
-// Replaces this process with the report module, so its output, progress and exit code (0 written,
-// 2 usage, 3 run or daemon not found) are the command's own.
-[[noreturn]] void exec_report(const GlobalOptions& g, const ReportOptions& o) {
+struct StudyOptions {
+  std::string study;
+  std::string output;
+  std::vector<std::string> overrides;
+  std::string state_file;
+  bool dry_run = false, small = false, resume = false;
+};
+
+// Replaces this process with a module of the Python client (the report, a study), so its output, progress
+// and exit code are the command's own.
+[[noreturn]] void exec_module(const GlobalOptions& g, const std::string& module, const std::vector<std::string>& module_args) {
   const char* python = std::getenv("COLORLAB_PYTHON");
   const std::string interpreter = python && *python ? python : "/usr/bin/python3";
-  std::vector<std::string> args{interpreter, "-m", "colorlab.report"};
-  args.insert(args.end(), o.runs.begin(), o.runs.end());
-  if (!o.output.empty()) args.insert(args.end(), {"-o", o.output});
+  std::vector<std::string> args{interpreter, "-m", module};
+  args.insert(args.end(), module_args.begin(), module_args.end());
   if (!g.socket.empty()) {
     args.insert(args.end(), {"--socket", g.socket});
   } else {
@@ -50,7 +57,7 @@ struct ReportOptions {
   argv.push_back(nullptr);
   ::execv(interpreter.c_str(), argv.data());
   throw Error(ErrorClass::not_found, "cannot run " + interpreter + ": " + std::strerror(errno),
-              "reports need Python 3 with matplotlib, numpy, pandas and requests: scripts/setup.sh installs them");
+              "reports and studies need Python 3 with matplotlib, numpy, pandas and requests: scripts/setup.sh installs them");
 }
 
 }  // namespace
@@ -69,7 +76,34 @@ void add_report_command(CLI::App& app, GlobalOptions& global) {
       if (run.empty() || run.find_first_not_of("0123456789abcdefABCDEF-") != std::string::npos)
         throw Error(ErrorClass::bad_parameter, "'" + run + "' is not a run id", "colorlab runs lists them");
     }
-    exec_report(global, *o);
+    std::vector<std::string> args = o->runs;
+    if (!o->output.empty()) args.insert(args.end(), {"-o", o->output});
+    // 0 written, 2 usage, 3 a run not found or the daemon unreachable.
+    exec_module(global, "colorlab.report", args);
+  });
+
+  auto s = std::make_shared<StudyOptions>();
+  auto* study = app.add_subcommand(
+      "study",
+      "Run a built-in study — dissertation: the SG chart read, 25-frame averaging, the cabinet grid over lamps and "
+      "dimmer levels, camera characterization — through the night queue, live, then write its report; prints its path");
+  study->add_option("study", s->study, "the study")->required()->check(CLI::IsMember({"dissertation"}));
+  study->add_option("-o,--output", s->output, "the report's HTML file (default: ./report-<first run>.html)");
+  study->add_option("--set", s->overrides, "override one step's parameter, STEP.KEY=VALUE (repeatable), e.g. cabinet-grid.rows=4");
+  study->add_flag("--dry-run", s->dry_run, "each campaign's dry run and the estimated total; nothing is queued");
+  study->add_flag("--small", s->small, "a reduced study (a first look): smaller grid, fewer frames");
+  study->add_option("--state-file", s->state_file, "where the study keeps its queue items (for --resume)");
+  study->add_flag("--resume", s->resume, "carry on a study whose queue items are already in the daemon (after a restart)");
+  study->callback([&global, s] {
+    std::vector<std::string> args{s->study};
+    if (!s->output.empty()) args.insert(args.end(), {"-o", s->output});
+    for (const auto& o : s->overrides) args.insert(args.end(), {"--set", o});
+    if (!s->state_file.empty()) args.insert(args.end(), {"--state-file", s->state_file});
+    if (s->dry_run) args.push_back("--dry-run");
+    if (s->small) args.push_back("--small");
+    if (s->resume) args.push_back("--resume");
+    // 0 done, 2 usage, 3 the daemon, 4 a campaign of the study failed (named).
+    exec_module(global, "colorlab.study", args);
   });
 }
 

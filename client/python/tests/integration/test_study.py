@@ -148,6 +148,17 @@ class Study(unittest.TestCase):
         for campaign in CAMPAIGNS[:3]:
             self.assertRegex(p.stdout, rf"(?m)^{campaign} +\S+ wall")
 
+    def test_7_the_colorlab_cli_runs_the_study(self):
+        """`colorlab study` (the C++ CLI, as scripts/quickstart.sh runs it) is this package: same options, same exits."""
+        from daemon_fixture import BIN_DIR
+        env = {k: v for k, v in ENV.items() if k != "PYTHONPATH"}  # the binary finds the package itself
+        cli = [str(BIN_DIR / "colorlab"), "--socket", self.daemon.endpoint["unix_socket"], "study", "dissertation"]
+        p = subprocess.run(cli + ["--dry-run"], capture_output=True, text=True, env=env, timeout=120, cwd=self.tmp)
+        self.assertEqual(p.returncode, 0, f"{p.stdout}\n{p.stderr}")
+        self.assertRegex(p.stdout.splitlines()[-1], r"^study dissertation: estimated total .* \(\d+ s wall\)$")
+        p = subprocess.run(cli + ["--set", "no-dot"], capture_output=True, text=True, env=env, timeout=60, cwd=self.tmp)
+        self.assertEqual(p.returncode, 2, f"{p.stdout}\n{p.stderr}")
+
 
 if __name__ == "__main__":
     unittest.main()
