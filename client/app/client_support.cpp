@@ -1,5 +1,7 @@
 #include "client_support.hpp"
 
+#include <fstream>
+
 #include <iostream>
 
 #include "colorlab/core/error.hpp"
@@ -48,6 +50,33 @@ json parse_params(const std::vector<std::string>& entries) {
     params[p.substr(0, eq)] = parse_param_value(p.substr(eq + 1));
   }
   return params;
+}
+
+client::RawResponse fetch_bytes(const GlobalOptions& g, const std::string& target) {
+  client::RawResponse r = make_client(g).request("GET", target);
+  if (r.status >= 200 && r.status < 300) return r;
+  protocol::Problem p;
+  auto j = json::parse(r.body, nullptr, false);
+  if (j.is_object()) {
+    p = protocol::Problem::from_json(j);
+  } else {
+    p.detail = r.body;
+  }
+  p.status = r.status;
+  throw client::ApiError(p);
+}
+
+void write_bytes(const std::filesystem::path& path, const std::string& bytes) {
+  std::ofstream f(path, std::ios::binary | std::ios::trunc);
+  if (!f) throw Error(ErrorClass::io_error, "cannot write " + path.string(), "check the directory exists and is writable");
+  f << bytes;
+  f.close();
+  if (!f) throw Error(ErrorClass::io_error, "write failed for " + path.string());
+}
+
+void check_id(const std::string& id, const std::string& what, const std::string& hint) {
+  if (id.empty() || id.find_first_not_of("0123456789abcdefABCDEF-") != std::string::npos)
+    throw Error(ErrorClass::bad_parameter, "'" + id + "' is not " + what, hint);
 }
 
 }  // namespace colorlab::cli

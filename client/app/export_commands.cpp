@@ -25,21 +25,11 @@ struct ExportOptions {
   std::string output;
 };
 
-// The bytes as sent; a refusal becomes ApiError with the server's problem (exit code 2).
 client::RawResponse fetch(const GlobalOptions& g, const ExportOptions& o) {
-  // Checked rather than escaped: a run id is a UUID, and anything else would name another route.
-  if (o.run.empty() || o.run.find_first_not_of("0123456789abcdefABCDEF-") != std::string::npos)
-    throw Error(ErrorClass::bad_parameter, "'" + o.run + "' is not a run id", "colorlab runs lists them");
+  check_id(o.run, "a run id", "colorlab runs lists them");
   std::string target = "/v1/runs/" + o.run + "/export?format=" + o.format;
   if (!o.camera_format.empty()) target += "&camera_format=" + o.camera_format;
-  client::RawResponse r = make_client(g).request("GET", target);
-  if (r.status >= 200 && r.status < 300) return r;
-  protocol::Problem p;
-  auto j = json::parse(r.body, nullptr, false);
-  if (j.is_object()) p = protocol::Problem::from_json(j);
-  else p.detail = r.body;
-  p.status = r.status;
-  throw client::ApiError(p);
+  return fetch_bytes(g, target);
 }
 
 // A directory takes the daemon's file name (Content-Disposition), never a path the header names.
@@ -54,14 +44,6 @@ fs::path target_path(const ExportOptions& o, const client::RawResponse& r) {
       name = fs::path(m[1].str()).filename().string();
   }
   return out / (name.empty() || name == "." || name == ".." ? o.run + "." + o.format : name);
-}
-
-void write_file(const fs::path& path, const std::string& bytes) {
-  std::ofstream f(path, std::ios::binary | std::ios::trunc);
-  if (!f) throw Error(ErrorClass::io_error, "cannot write " + path.string(), "check the directory exists and is writable");
-  f << bytes;
-  f.close();
-  if (!f) throw Error(ErrorClass::io_error, "write failed for " + path.string());
 }
 
 }  // namespace
@@ -85,7 +67,7 @@ void add_export_command(CLI::App& app, GlobalOptions& global) {
       return;
     }
     const fs::path path = target_path(*o, r);
-    write_file(path, r.body);
+    write_bytes(path, r.body);
     json done{{"path", path.string()}, {"bytes", r.body.size()}, {"format", o->format}, {"run", o->run}};
     print(global, done, [](const json& j) {
       return "wrote " + j["path"].get<std::string>() + " (" + std::to_string(j["bytes"].get<std::size_t>()) + " bytes)\n";

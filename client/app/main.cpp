@@ -10,6 +10,7 @@
 #include "queue_commands.hpp"
 #include "export_commands.hpp"
 #include "report_command.hpp"
+#include "blob_commands.hpp"
 #include "access_commands.hpp"
 #ifdef COLORLAB_HAVE_ANALYZE
 #include "colorlab/cli/analyze_command.hpp"
@@ -31,6 +32,7 @@ int main(int argc, char** argv) {
   colorlab::cli::add_queue_commands(app, global);
   colorlab::cli::add_export_command(app, global);
   colorlab::cli::add_report_command(app, global);
+  colorlab::cli::add_blob_commands(app, global);
   colorlab::cli::add_access_commands(app, global);
 #ifdef COLORLAB_HAVE_ANALYZE
   colorlab::cli::add_analyze_command(app);

@@ -10,6 +10,7 @@
 
 #include <unistd.h>
 
+#include "client_support.hpp"
 #include "colorlab/core/data_paths.hpp"
 #include "colorlab/core/error.hpp"
 
@@ -72,10 +73,7 @@ void add_report_command(CLI::App& app, GlobalOptions& global) {
   cmd->add_option("runs", o->runs, "run ids (colorlab runs lists them)")->required();
   cmd->add_option("-o,--output", o->output, "HTML file to write (default: ./report-<first run>.html)");
   cmd->callback([&global, o] {
-    for (const auto& run : o->runs) {
-      if (run.empty() || run.find_first_not_of("0123456789abcdefABCDEF-") != std::string::npos)
-        throw Error(ErrorClass::bad_parameter, "'" + run + "' is not a run id", "colorlab runs lists them");
-    }
+    for (const auto& run : o->runs) check_id(run, "a run id", "colorlab runs lists them");
     std::vector<std::string> args = o->runs;
     if (!o->output.empty()) args.insert(args.end(), {"-o", o->output});
     // 0 written, 2 usage, 3 a run not found or the daemon unreachable.

@@ -221,6 +221,18 @@ TEST(BlobApi, FrameAverageKeepsItsFramesAndServesThemByteExact) {
   EXPECT_EQ(raw_png.status, 200);
   EXPECT_EQ(raw_png.body.substr(1, 3), "PNG");
 
+  // The CLI lists the run's frames as the API does and downloads one byte for byte (and exits 2 on a refusal).
+  auto listed_cli = run_command({bin_path("colorlab"), "--url", daemon.url(), "--json", "blobs", run_id});
+  ASSERT_EQ(listed_cli.exit_code, 0) << listed_cli.err;
+  EXPECT_EQ(json::parse(listed_cli.out)["items"], listed["items"]);
+  const auto downloaded = dir / "downloaded.dng";
+  auto got = run_command({bin_path("colorlab"), "--url", daemon.url(), "download", raw["sha256"].get<std::string>(), "-o",
+                          downloaded.string()});
+  ASSERT_EQ(got.exit_code, 0) << got.err;
+  EXPECT_TRUE(read_all(downloaded) == raw_bytes);
+  auto missing = run_command({bin_path("colorlab"), "--url", daemon.url(), "download", std::string(64, '0')});
+  EXPECT_EQ(missing.exit_code, 2) << missing.err;
+
   // Unknown blobs and runs: problem+json 404.
   Fetched unknown = curl(daemon.url() + "/v1/blobs/" + std::string(64, '0'), {}, dir.path());
   EXPECT_EQ(unknown.status, 404);

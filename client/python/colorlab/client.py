@@ -37,6 +37,20 @@ class Client(RunsMixin, BlobsMixin, ExportsMixin, ExecutionsMixin, LabMixin, Acc
             return cls(key=key, cacert=cacert, socket=path, timeout=timeout)
         return cls(endpoint["url"], key, cacert, timeout=timeout)
 
+    @classmethod
+    def from_options(cls, url: str | None = None, socket: str | None = None, key: str | None = None) -> "Client":
+        """What a command line names, in the order the colorlab commands document: ``socket`` (or
+        ``COLORLAB_SOCKET`` when no ``url``), else ``url`` (or ``COLORLAB_URL``), else the local daemon's endpoint
+        file (``Client.local()``), else http://127.0.0.1:8765."""
+        if socket or (not url and os.environ.get("COLORLAB_SOCKET")):
+            return cls(socket=socket or os.environ["COLORLAB_SOCKET"], key=key)
+        if url or os.environ.get("COLORLAB_URL"):
+            return cls(url, key=key)
+        try:
+            return cls.local(key=key)
+        except Exception:  # no endpoint file here: the documented default URL
+            return cls(key=key)
+
     def close(self) -> None:
         """Closes the pooled connections (also at the end of ``with Client(...) as lab:``)."""
         self.conn.session.close()

@@ -57,14 +57,7 @@ def parse(argv):
 
 
 def connect(args) -> colorlab.Client:
-    if args.socket or (not args.url and os.environ.get("COLORLAB_SOCKET")):
-        return colorlab.Client(socket=args.socket or os.environ["COLORLAB_SOCKET"], key=args.key)
-    if args.url or os.environ.get("COLORLAB_URL"):
-        return colorlab.Client(args.url, key=args.key)
-    try:
-        return colorlab.Client.local(key=args.key)
-    except Exception:  # no endpoint file here: the documented default URL
-        return colorlab.Client(key=args.key)
+    return colorlab.Client.from_options(args.url, args.socket, args.key)
 
 
 def main(argv=None) -> int:
