@@ -36,8 +36,3 @@ export async function request(method, path, body, { headers = {}, signal } = {})
 export const get = (path, opts) => request("GET", path, undefined, opts);
 export const post = (path, body, opts) => request("POST", path, body === undefined ? {} : body, opts);
 export const del = (path, opts) => request("DELETE", path, undefined, opts);
-
-// HEAD answers with a status only; a network failure counts as "not there".
-export async function exists(path) {
-  try { return (await request("HEAD", path)).ok; } catch { return false; }
-}

@@ -273,7 +273,7 @@ HttpResponse get_run_report(ApiContext& ctx, const HttpRequest& req, const std::
   ok.headers["ETag"] = etag;
   ok.headers["Cache-Control"] = "no-cache";
   ok.headers["Content-Disposition"] = "inline; filename=\"report-" + id + ".html\"";
-  if (req.header("if-none-match").value_or("").find(etag) != std::string::npos) {
+  if (auto inm = req.header("if-none-match"); inm && none_match_hits(*inm, etag)) {
     ok.status = 304;
     ok.content_type.clear();
     return ok;

@@ -5,6 +5,7 @@
 #include <string>
 #include <system_error>
 
+#include "colorlab/daemon/blob_api.hpp"
 #include "colorlab/protocol/api.hpp"
 
 namespace colorlab::daemon {
@@ -80,7 +81,7 @@ std::optional<http::HttpResponse> serve_console(const http::HttpRequest& req, co
   // Revalidate every time: after an upgrade the browser must not mix old scripts with a new API.
   r.headers["Cache-Control"] = "no-cache";
   r.headers["X-Content-Type-Options"] = "nosniff";
-  if (req.header("if-none-match").value_or("").find(etag) != std::string::npos) {
+  if (auto inm = req.header("if-none-match"); inm && none_match_hits(*inm, etag)) {
     r.status = 304;
     r.content_type.clear();
     return r;

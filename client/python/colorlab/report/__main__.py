@@ -27,10 +27,6 @@ def parse(argv):
     return p.parse_args(argv)
 
 
-def connect(args):
-    return colorlab.Client.from_options(args.url, args.socket, args.key)
-
-
 def main(argv=None) -> int:
     try:
         args = parse(sys.argv[1:] if argv is None else argv)
@@ -38,7 +34,7 @@ def main(argv=None) -> int:
         return int(e.code or 0)
     from . import build
     try:
-        client = connect(args)
+        client = colorlab.Client.from_options(args.url, args.socket, args.key)
     except Exception as e:
         print(f"colorlab report: cannot reach the daemon: {e}", file=sys.stderr)
         return EXIT_NOT_FOUND

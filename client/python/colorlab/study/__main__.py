@@ -56,17 +56,13 @@ def parse(argv):
     return args
 
 
-def connect(args) -> colorlab.Client:
-    return colorlab.Client.from_options(args.url, args.socket, args.key)
-
-
 def main(argv=None) -> int:
     try:
         args = parse(sys.argv[1:] if argv is None else argv)
     except SystemExit as e:  # argparse: 0 for --help, 2 for bad usage
         return int(e.code or 0)
     try:
-        client = connect(args)
+        client = colorlab.Client.from_options(args.url, args.socket, args.key)
     except Exception as e:
         print(f"colorlab study: cannot reach the daemon: {e}", file=sys.stderr)
         return EXIT_DAEMON
