@@ -1,15 +1,19 @@
-// Stability suite: drives each characterization method into its failure regions and records the ΔE growth —
+// Stability: drives each characterization method into its failure regions and records the ΔE growth —
 // extrapolation, RAW noise, exposure changes, few training patches, ill-conditioning. Prints one line per case.
+// The cases that are the library's stability suite (analysis/stability.hpp) run through run_stability.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <numeric>
 #include <random>
+#include <stdexcept>
+#include <string>
 
 #include "colorlab/analysis/characterization.hpp"
 #include "colorlab/analysis/chart_io.hpp"
 #include "colorlab/analysis/regression.hpp"
+#include "colorlab/analysis/stability.hpp"
 #include "colorlab/core/error.hpp"
 #include "argyll_reference.hpp"
 #include "test_support.hpp"
@@ -47,6 +51,24 @@ ca::ErrorStats selected_on(const ca::ChartData& train, const ca::ChartData& test
   return ca::evaluate(ca::fit_method(ch.method, train, o).apply(test.rgb), test.lab);
 }
 
+// The suite with only the cases a test asks for.
+ca::StabilityOptions suite_options() {
+  ca::StabilityOptions o;
+  o.methods.assign(std::begin(kMethods), std::end(kMethods));
+  o.fit = unit_scale();
+  o.noise.clear();
+  o.exposures.clear();
+  o.training_sizes.clear();
+  return o;
+}
+
+const ca::StabilityCase& find_case(const ca::StabilityResult& r, const std::string& method, const std::string& kind,
+                                   double level) {
+  for (const auto& c : r.cases)
+    if (c.method == method && c.kind == kind && c.level == level) return c;
+  throw std::runtime_error("no case " + method + " " + kind + " " + std::to_string(level));
+}
+
 bool have_argyll() { return ca::testing::have_tool("colprof") && ca::testing::have_tool("profcheck"); }
 
 class AnalysisStability : public ::testing::Test {
@@ -68,9 +90,12 @@ TEST_F(AnalysisStability, ExtrapolationToTheMostSaturatedPatches) {
   std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return chroma(a) > chroma(b); });
   std::vector<std::size_t> held(order.begin(), order.begin() + 20), kept(order.begin() + 20, order.end());
   const auto train = sg_.subset(kept), test = sg_.subset(held);
+  // The suite's out-of-gamut case holds out the same 20 (1/7 of 140 by reference C*ab).
+  const auto suite = ca::run_stability(sg_, suite_options());
+  ASSERT_EQ(suite.gamut_ids, test.ids);
   for (const char* m : kMethods) {
     double inside = ca::evaluate(ca::fit(m, train, unit_scale()).apply(train.rgb), train.lab).s00.mean;
-    double outside = test_error(m, train, test);
+    double outside = find_case(suite, m, "out_of_gamut", 20).de00.mean;
     std::cout << "extrapolation " << m << ": training " << inside << ", 20 most saturated (held out) " << outside << "\n";
     // Outside the training gamut every method does worse than on its own patches.
     EXPECT_GT(outside, inside) << m;
@@ -161,19 +186,24 @@ TEST_F(AnalysisStability, RawNoiseFromPointOneToTwoPercent) {
 }
 
 TEST_F(AnalysisStability, ExposurePlusMinusOneStop) {
-  const auto o = unit_scale();
+  // Fitted on the SG, applied to the CC24 at half, the same and twice the exposure. The chart's colours do not change
+  // with exposure; the camera signal does: the suite undoes the scale in XYZ before L*a*b*.
+  auto o = suite_options();
+  o.exposures = {0.5, 1.0, 2.0};
+  const auto suite = ca::run_stability(sg_, o, &cc24_);
   for (const char* m : kMethods) {
-    auto model = ca::fit(m, sg_, o);
     std::cout << "exposure " << m << ":";
     std::vector<double> errs;
     for (double k : {0.5, 1.0, 2.0}) {
-      // The chart's colours do not change with exposure; the camera signal does. Undo the scale in XYZ before L*a*b*.
-      Eigen::MatrixXd xyz = model.predict_target(k * cc24_.rgb) / k;
-      double e = ca::evaluate(ca::xyz_rows_to_lab(xyz, cc24_.white), cc24_.lab).s00.mean;
-      errs.push_back(e);
-      std::cout << " x" << k << " " << e;
+      const auto& c = find_case(suite, m, "exposure", k);
+      ASSERT_TRUE(c.fitted) << m << " " << c.why;
+      ASSERT_EQ(c.evaluated, cc24_.size());
+      errs.push_back(c.de00.mean);
+      std::cout << " x" << k << " " << errs.back();
     }
     std::cout << "\n";
+    // At the exposure trained at, the suite's case is the plain test error.
+    EXPECT_NEAR(errs[1], test_error(m, sg_, cc24_), 1e-9) << m;
     if (std::string(m).rfind("rootpoly", 0) == 0 || std::string(m) == "poly:1") {
       EXPECT_NEAR(errs[0], errs[1], 1e-9) << m;  // degree-1 homogeneous terms: exposure invariant
       EXPECT_NEAR(errs[2], errs[1], 1e-9) << m;
@@ -183,6 +213,51 @@ TEST_F(AnalysisStability, ExposurePlusMinusOneStop) {
       EXPECT_GT(errs[2], errs[1]) << m;
     }
   }
+}
+
+TEST_F(AnalysisStability, SuiteJudgesEveryCaseAgainstTheTolerance) {
+  auto o = suite_options();
+  o.methods = {"poly:1", "poly:10"};
+  o.noise = {0.01};
+  o.exposures = {2.0};
+  o.training_sizes = {24};
+  o.draws = 2;
+  // The training chart itself as "another lamp": the model meets exactly the patches it was fitted on.
+  const auto r = ca::run_stability(sg_, o, nullptr, {{"same", sg_}});
+  for (const char* m : {"poly:1", "poly:10"}) {
+    const auto& training = find_case(r, m, "training", 140);
+    const auto& lamp = find_case(r, m, "other_lamp", 140);
+    EXPECT_EQ(lamp.label, "same");
+    EXPECT_NEAR(lamp.de00.mean, training.de00.mean, 1e-9) << m;
+    EXPECT_NEAR(training.de00.mean, ca::evaluate(ca::fit(m, sg_, unit_scale()).apply(sg_.rgb), sg_.lab).s00.mean, 1e-9) << m;
+    // Leave-one-out never flatters: each patch is predicted by a model that did not see it.
+    EXPECT_GE(find_case(r, m, "cross_validated", 140).de00.mean, training.de00.mean) << m;
+    // Noise: the model fitted on 2 × 140 noisy copies, evaluated on the clean chart.
+    EXPECT_EQ(find_case(r, m, "noise", 0.01).evaluated, 2 * sg_.size()) << m;
+  }
+  // Few patches: evaluated on the 116 left out of each draw.
+  EXPECT_EQ(find_case(r, "poly:1", "training_patches", 24).evaluated, 2 * (sg_.size() - 24));
+  // poly:10 has 29 terms: 24 patches cannot determine it. Not fitted is a failure, not a crash.
+  const auto& few = find_case(r, "poly:10", "training_patches", 24);
+  EXPECT_FALSE(few.fitted);
+  EXPECT_TRUE(few.fails);
+  EXPECT_NE(few.why.find("rank"), std::string::npos) << few.why;
+  // Every verdict names the first case (in the suite's order) above either tolerance.
+  for (const auto& v : r.verdicts) {
+    const ca::StabilityCase* first = nullptr;
+    for (const auto& c : r.cases) {
+      const bool over = !c.fitted || c.de00.mean > o.tolerance_mean || c.de00.max > o.tolerance_max;
+      EXPECT_EQ(c.fails, over) << c.method << " " << c.kind;
+      if (c.method == v.method && over && !first) first = &c;
+    }
+    ASSERT_EQ(v.fails, first != nullptr) << v.method;
+    if (first) {
+      EXPECT_EQ(v.first_kind, first->kind);
+      EXPECT_EQ(v.first_level, first->level);
+    }
+  }
+  EXPECT_TRUE(r.verdicts[1].fails);  // poly:10 at least at 24 patches
+  EXPECT_THROW(ca::run_stability(sg_, [&] { auto b = o; b.methods = {"poly:99"}; return b; }()), colorlab::Error);
 }
 
 TEST_F(AnalysisStability, FromOneHundredFortyToTwentyFourTrainingPatches) {

@@ -19,6 +19,7 @@
 #include "colorlab/core/error.hpp"
 #include "locate_chart_command.hpp"
 #include "pgm_reader.hpp"
+#include "stability_command.hpp"
 
 namespace colorlab::cli {
 
@@ -314,7 +315,7 @@ void run_averaging(const AveragingOptions& o) {
 
 void add_analyze_command(CLI::App& app) {
   auto* analyze = app.add_subcommand("analyze", "Colour science over files: spectra to XYZ/L*a*b*, colour differences, "
-                                                "camera characterization, cabinet uniformity, frame averaging");
+                                                "camera characterization and its stability, cabinet uniformity, frame averaging");
   analyze->require_subcommand(1);
 
   for (bool lab : {false, true}) {
@@ -381,6 +382,7 @@ void add_analyze_command(CLI::App& app) {
     c->callback([o] { run_averaging(*o); });
   }
   detail::add_locate_chart_command(*analyze);
+  detail::add_stability_command(*analyze);
 }
 
 }  // namespace colorlab::cli

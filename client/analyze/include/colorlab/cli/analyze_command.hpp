@@ -4,7 +4,7 @@
 
 namespace colorlab::cli {
 
-// Adds the `analyze` subcommand tree (xyz, lab, de2000, fit, uniformity, averaging, locate-chart) to the application.
+// Adds the `analyze` subcommand tree (xyz, lab, de2000, fit, uniformity, averaging, locate-chart, stability) to the application.
 // Results go to stdout; errors are thrown as colorlab::Error from the callbacks.
 void add_analyze_command(CLI::App& app);
 
