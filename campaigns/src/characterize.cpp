@@ -328,15 +328,29 @@ BlackBoxSetup black_box_setup(const ca::ChartData& d, const json& camera, const 
   return s;
 }
 
-// Table 13: |predicted − measured| per channel, in counts and in % of the raw's full scale.
+// Table 13: |predicted − measured| per channel (min, median, mean, max, stdev), in counts and in % of the raw's full
+// scale.
 json residual_table(const Eigen::MatrixXd& residuals, double full_scale) {
   json out = json::object();
   for (int c = 0; c < 3; ++c) {
     std::vector<double> a;
     for (Eigen::Index i = 0; i < residuals.rows(); ++i) a.push_back(std::abs(residuals(i, c)));
     const ca::Summary sum = ca::summarize(a);
-    out[std::string(1, "RGB"[c])] = {{"mean", sum.mean}, {"median", sum.median}, {"max", sum.max}, {"stdev", sum.stdev},
+    out[std::string(1, "RGB"[c])] = {{"min", sum.min}, {"mean", sum.mean}, {"median", sum.median}, {"max", sum.max},
+                                     {"stdev", sum.stdev}, {"min_pct", 100 * sum.min / full_scale},
                                      {"mean_pct", 100 * sum.mean / full_scale}, {"max_pct", 100 * sum.max / full_scale}};
+  }
+  return out;
+}
+
+// Each patch's signed residual (predicted − measured, counts) per channel, in the chart's patch order: Table 13's
+// statistics can be recomputed from them and a patch's misfit found (140 × 3 numbers per set).
+json residual_patches(const std::vector<std::string>& ids, const Eigen::MatrixXd& residuals) {
+  json out{{"ids", ids}};
+  for (int c = 0; c < 3; ++c) {
+    std::vector<double> v(static_cast<std::size_t>(residuals.rows()));
+    for (Eigen::Index i = 0; i < residuals.rows(); ++i) v[static_cast<std::size_t>(i)] = residuals(i, c);
+    out[std::string(1, "RGB"[c])] = std::move(v);
   }
   return out;
 }
@@ -419,7 +433,9 @@ json black_box(const ca::ChartData& d, const BlackBoxSetup& s, const std::string
               {"mapping", {{"method", method}, {"target", ca::to_string(target)}}},
               {"full_scale", full_scale},
               {"residuals", {{"unit", "counts"}, {"training", residual_table(predicted - d.rgb, full_scale)},
-                             {"cv", residual_table(held_counts - d.rgb, full_scale)}}},
+                             {"cv", residual_table(held_counts - d.rgb, full_scale)},
+                             {"patches", {{"training", residual_patches(d.ids, predicted - d.rgb)},
+                                          {"cv", residual_patches(d.ids, held_counts - d.rgb)}}}}},
               {"regularisation", regularisation},
               {"sensitivities", curves}};
 }

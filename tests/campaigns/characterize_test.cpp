@@ -120,6 +120,23 @@ TEST(CharacterizeBlackBox, PredictsHeldOutPatchesWithinTheInjectedNoise) {
               << r["max"] << "; two photographs differ by " << two_photos << " on average\n";
     EXPECT_LE(r["mean"].get<double>(), two_photos) << ch;
     EXPECT_LE(r["mean_pct"].get<double>(), dissertation_mean_pct[c3]) << ch;
+    // The stored per-patch residuals are the table's: |r| over the patches gives its min, mean and max.
+    for (const char* set : {"training", "cv"}) {
+      const json& patches = b["residuals"]["patches"][set];
+      const json& stats = b["residuals"][set][ch];
+      ASSERT_EQ(patches["ids"].size(), patches[ch].size());
+      ASSERT_EQ(patches["ids"].size(), static_cast<std::size_t>(s.truth.rows()));
+      double lo = INFINITY, hi = 0, sum = 0;
+      for (const auto& v : patches[ch]) {
+        lo = std::min(lo, std::abs(v.get<double>()));
+        hi = std::max(hi, std::abs(v.get<double>()));
+        sum += std::abs(v.get<double>());
+      }
+      EXPECT_DOUBLE_EQ(stats["min"].get<double>(), lo) << set << " " << ch;
+      EXPECT_DOUBLE_EQ(stats["max"].get<double>(), hi) << set << " " << ch;
+      EXPECT_NEAR(stats["mean"].get<double>(), sum / static_cast<double>(patches[ch].size()), 1e-9 * hi) << set << " " << ch;
+      EXPECT_LE(stats["min"].get<double>(), stats["mean"].get<double>());
+    }
   }
 
   // ΔE00: the black box's held-out L*a*b* against what the same mapping, refitted without the
