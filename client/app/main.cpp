@@ -12,6 +12,7 @@
 #include "report_command.hpp"
 #include "blob_commands.hpp"
 #include "access_commands.hpp"
+#include "locate_commands.hpp"
 #ifdef COLORLAB_HAVE_ANALYZE
 #include "colorlab/cli/analyze_command.hpp"
 #endif
@@ -34,6 +35,7 @@ int main(int argc, char** argv) {
   colorlab::cli::add_report_command(app, global);
   colorlab::cli::add_blob_commands(app, global);
   colorlab::cli::add_access_commands(app, global);
+  colorlab::cli::add_locate_commands(app, global);
 #ifdef COLORLAB_HAVE_ANALYZE
   colorlab::cli::add_analyze_command(app);
 #endif

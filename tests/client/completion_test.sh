@@ -35,6 +35,10 @@ run_options="$(complete_words run --)"
 for o in --param --detach --id-only --dry-run --idempotency-key --help; do
   grep -qx -- "$o" <<<"$run_options" || { echo "FAIL: run -- lacks $o"; fail=1; }
 done
+locate_options="$(complete_words locate-chart --)"
+for o in --blob --chart --corners --reference-run --fraction --min-confidence --json --help; do
+  grep -qx -- "$o" <<<"$locate_options" || { echo "FAIL: locate-chart -- lacks $o"; fail=1; }
+done
 # No daemon at this socket: campaign names are simply not offered, and nothing is printed.
 out="$(complete_words --socket /nonexistent/colorlab.sock run "" 2>&1)"
 check "run without a daemon" "" "$out"

@@ -10,6 +10,7 @@
 #include "colorlab/core/ids.hpp"
 #include "colorlab/core/log.hpp"
 #include "colorlab/daemon/control_lock.hpp"
+#include "locate_api.hpp"
 #include "problem_response.hpp"
 
 namespace colorlab::daemon {
@@ -39,6 +40,8 @@ Scope required_scope(const HttpRequest& req) {
   if (req.path == keys || req.path.rfind(keys + "/", 0) == 0) return Scope::admin;
   // Retention deletes kept frames' files: not something a campaign operator's key should do.
   if (req.method == "POST" && req.path == std::string(protocol::kPrefix) + "/blobs/retention") return Scope::admin;
+  // Locating a chart in a stored photograph is a POST that stores nothing.
+  if (req.method == "POST" && is_locate_chart_path(req.path)) return Scope::read;
   // Unknown methods need control too: nothing reaches a route that changes state with only read.
   if (req.method == "GET" || req.method == "HEAD" || req.method == "OPTIONS") return Scope::read;
   return Scope::control;

@@ -13,6 +13,7 @@
 #include "colorlab/daemon/report_service.hpp"
 #include "colorlab/protocol/api.hpp"
 #include "colorlab/protocol/problem.hpp"
+#include "locate_api.hpp"
 
 #ifndef COLORLAB_VERSION
 #define COLORLAB_VERSION "dev"
@@ -63,7 +64,7 @@ HttpResponse get_root(ApiContext& ctx) {
   json features = json::array({"instruments", "ports", "events", "campaigns", "lua-campaigns", "executions",
                                "execution-control", "resume-after-restart", "runs", "run-script", "problem+json",
                                "cursor-paging", "idempotency-key", "operator-requests", "queue", "measurement-pages",
-                               "event-stream", "blobs", "exports", "api-keys", "control-lock", "tls"});
+                               "event-stream", "blobs", "locate-chart", "exports", "api-keys", "control-lock", "tls"});
   return HttpResponse::json(200, {{"server", "colorlabd"},
                                   {"server_version", COLORLAB_VERSION},
                                   {"api_version", protocol::kApiVersion},
@@ -325,6 +326,7 @@ HttpResponse get_run_measurements(ApiContext& ctx, const HttpRequest& req, const
 }  // namespace
 
 bool serves_stored_data(const HttpRequest& req) {
+  if (is_locate_chart_path(req.path)) return true;  // reads a stored photograph; the locating is the pool's work
   if (req.method != "GET" && req.method != "HEAD") return false;
   if (wants_event_stream(req)) return false;  // its snapshot is the main thread's state
   const std::string prefix(protocol::kPrefix);
@@ -394,6 +396,7 @@ HttpResponse handle_api(ApiContext& ctx, const HttpRequest& req) {
       }
     }
     if (auto queue = handle_queue_api(ctx, req)) return *queue;
+    if (auto located = handle_locate_api(ctx, req)) return *located;
     if (auto blob = handle_blob_api(ctx, req)) return *blob;
     if (auto exported = handle_export_api(ctx, req)) return *exported;
     if (p == prefix + "/runs") {
