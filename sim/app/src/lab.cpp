@@ -54,7 +54,8 @@ struct Lab::Impl {
   std::shared_ptr<Ls110Sim> ls110;
   std::shared_ptr<SpectrolinoSim> spectrolino;
   std::shared_ptr<DmxSim> dmx;
-  std::shared_ptr<const camera::CameraModel> camera_model;
+  std::shared_ptr<camera::CameraModel> camera_model;       // the GenICam camera's
+  std::shared_ptr<camera::CameraModel> dslr_model;
   std::unique_ptr<aravis::GvFakeCamera> genicam;
   std::unique_ptr<dslr::DslrServer> dslr;
   std::filesystem::path dslr_temp_dir;  // created here, removed with the lab
@@ -141,6 +142,57 @@ struct Lab::Impl {
     t["surface_spectrum"] = std::vector<float>(surface.begin(), surface.end());
     if (auto last = m.last_spectrum()) t["last_spectrum"] = std::vector<float>(last->begin(), last->end());
     return t;
+  }
+
+  // The camera models by instrument id ("" = every camera): what camera_view aims and floor_truth describes.
+  std::vector<std::pair<std::string, std::shared_ptr<camera::CameraModel>>> cameras(const std::string& id) const {
+    std::vector<std::pair<std::string, std::shared_ptr<camera::CameraModel>>> out;
+    if (genicam && camera_model && (id.empty() || id == config.genicam.id)) out.emplace_back(config.genicam.id, camera_model);
+    if (dslr && dslr_model && (id.empty() || id == config.dslr.id)) out.emplace_back(config.dslr.id, dslr_model);
+    if (out.empty()) throw Error(ErrorClass::not_found, "no simulated camera '" + id + "'", "use a camera id from the announcement");
+    return out;
+  }
+
+  // The lens's f-number a camera photographs at now: the DSLR's setting; the GenICam camera's fixed lens.
+  double f_number_of(const std::string& id) const {
+    if (dslr && id == config.dslr.id) return dslr->body().settings().value("aperture", 4.0);
+    return 4.0;  // scene_camera_options' default: a machine-vision lens at f/4
+  }
+
+  static json corners_json(const camera::CameraModel& m) {
+    json c = json::array();
+    for (const auto& p : m.floor_corners_px()) c.push_back({p[0], p[1]});
+    return c;
+  }
+
+  // Ground truth of the floor as one camera sees it now: every spot of the 8 × 20 grid with its true luminance (the
+  // LS-110's physics, no noise), the LS-110's σ there, its pixel and the floor view's relative illumination there; the
+  // floor's corners in the image; the camera's noise model (docs/simulator.md, "floor_truth").
+  json floor_truth(const std::string& id) const {
+    auto [name, m] = cameras(id).front();
+    const double f_number = f_number_of(name);
+    json spots = json::array();
+    for (int r = 0; r < floor_rows; ++r)
+      for (int c = 0; c < floor_cols; ++c) {
+        const auto [x, y] = Scene::floor_spot_position_mm(r, c);
+        const double l = scene->floor_luminance(r, c);
+        const auto px = m->floor_point_px(x, y);
+        spots.push_back({{"row", r}, {"col", c}, {"x_mm", x}, {"y_mm", y}, {"luminance", l},
+                         {"ls110_sigma", scene->luminance_noise_sigma(l)}, {"px", {px[0], px[1]}},
+                         {"relative_illumination", m->relative_illumination(px[0], px[1], f_number, camera::CameraModel::View::floor)}});
+      }
+    const auto& cc = m->config();
+    json lamps = json::array();
+    for (auto l : scene->lamps_on()) lamps.push_back(to_string(l));
+    return {{"ok", true}, {"instrument", name},
+            {"view", m->view() == camera::CameraModel::View::floor ? "floor" : "chart"},
+            {"width", m->width()}, {"height", m->height()}, {"f_number", f_number},
+            {"floor_corners_px", corners_json(*m)}, {"lamps_on", lamps}, {"dimmer", scene->dimmer()},
+            {"noise", {{"gain_dn_per_e_iso100", cc.gain_dn_per_e_iso100}, {"read_noise_e", cc.read_noise_e},
+                       {"adc_noise_dn", cc.adc_noise_dn}, {"dark_current_e_per_s", cc.dark_current_e_per_s},
+                       {"prnu_sigma", cc.prnu_sigma}, {"dsnu_sigma_dn", cc.dsnu_sigma_dn},
+                       {"column_offset_sigma_dn", cc.column_offset_sigma_dn}, {"black_level", 256}}},
+            {"spots", spots}};
   }
 
   Ls110Truth ls110_truth() const {
@@ -234,7 +286,8 @@ void Lab::start_dslr() {
     d.dslr_temp_dir = std::filesystem::temp_directory_path() / ("colorlab-sim-" + std::to_string(::getpid()) + "-dslr");
     bc.capture_dir = d.dslr_temp_dir;
   }
-  auto body = std::make_shared<dslr::DslrBody>(std::make_shared<camera::CameraModel>(scene, cc), bc);
+  d.dslr_model = std::make_shared<camera::CameraModel>(scene, cc);
+  auto body = std::make_shared<dslr::DslrBody>(d.dslr_model, bc);
   d.dslr = std::make_unique<dslr::DslrServer>(d.io->get_executor(), body, dc.socket.value_or(runtime_path("dslr.sock")), d.clock);
   d.dslr->start();
   if (!dc.faults.empty()) d.dslr->set_faults(dc.faults);
@@ -471,6 +524,18 @@ json Lab::control(const json& command) {
       d.aim_col = col;
       return {{"ok", true}};
     }
+    if (cmd == "camera_view") {
+      // The operator's "aim_camera": the chart out of the cabinet and the camera at the whole floor, or back.
+      const std::string view = command.value("view", std::string());
+      if (view != "floor" && view != "chart") throw Error(ErrorClass::bad_parameter, "camera_view: view must be \"floor\" or \"chart\"");
+      json cams = json::object();
+      for (auto& [name, m] : d.cameras(command.value("instrument", std::string()))) {
+        m->set_view(view == "floor" ? camera::CameraModel::View::floor : camera::CameraModel::View::chart);
+        cams[name] = {{"view", view}, {"width", m->width()}, {"height", m->height()}, {"floor_corners_px", Impl::corners_json(*m)}};
+      }
+      return {{"ok", true}, {"view", view}, {"cameras", cams}};
+    }
+    if (cmd == "floor_truth") return d.floor_truth(command.value("instrument", std::string()));
     if (cmd == "lamp") {
       d.scene->set_lamp(lamp_from_string(command.value("lamp", std::string())), command.value("on", true));
       return {{"ok", true}};
@@ -480,7 +545,7 @@ json Lab::control(const json& command) {
       return {{"ok", true}};
     }
     throw Error(ErrorClass::bad_parameter, "unknown control command '" + cmd + "'",
-                "commands: announce, truth, camera_truth, fault, place, aim, lamp, dimmer");
+                "commands: announce, truth, camera_truth, floor_truth, camera_view, fault, place, aim, lamp, dimmer");
   } catch (const Error& e) {
     return {{"ok", false}, {"error", to_string(e.cls())}, {"message", e.info().message}, {"hint", e.hint()}};
   } catch (const json::exception& e) {

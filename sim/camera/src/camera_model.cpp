@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <mutex>
 #include <random>
@@ -11,6 +12,7 @@
 #include "colorlab/analysis/colorimetry.hpp"
 #include "colorlab/core/error.hpp"
 #include "chart_pose.hpp"
+#include "floor_view.hpp"
 #include "fast_random.hpp"
 #include "sensitivities.hpp"
 
@@ -63,6 +65,8 @@ struct CameraModel::Impl {
   detail::Sensitivities sens;
   double px_per_mm = 0, origin_x = 0, origin_y = 0;  // chart top-left in pixels
   std::optional<detail::PoseGeometry> pose;            // set: the chart at a pose instead
+  std::optional<detail::FloorGeometry> floor;          // the floor view's geometry
+  std::atomic<View> view{View::chart};
   std::vector<Spectrum> material_reflectance;          // material_count
   // response[lamp][material][channel]: green-normalised exposure per cd/m² of floor luminance.
   std::array<std::vector<std::array<double, 3>>, 5> response;
@@ -73,6 +77,7 @@ struct CameraModel::Impl {
 
   struct Precomputed {
     CameraSettings settings;
+    View view = View::chart;
     std::uint64_t version = 0;
     double gain = 0;  // DN per electron
     std::vector<Lamp> lamps;
@@ -108,23 +113,34 @@ struct CameraModel::Impl {
     return {origin_x + X * px_per_mm, origin_y + Y * px_per_mm};
   }
 
-  int material_at(int x, int y) const {
+  int material_at(int x, int y, View v) const {
+    if (v == View::floor) return floor_material;  // the chart is out of the cabinet
     const auto [cx, cy] = chart_mm(x + 0.5, y + 0.5);
     if (cx < 0 || cy < 0 || cx >= chart_width_mm || cy >= chart_height_mm) return floor_material;
     const auto p = scene->chart().patch_at(cx, cy);
     return p ? *p : surround_material;
   }
 
-  std::pair<double, double> floor_mm(double x, double y) const {
+  // The floor point a continuous image position sees. Beyond the floor's edges the floor view shows the walls, lit
+  // as the floor where they meet it: the field stays continuous, so its interpolation between nodes never blends a
+  // wall's step into the floor's edge spots.
+  std::pair<double, double> floor_mm(double x, double y, View v) const {
+    if (v == View::floor) {
+      const auto [fx, fy] = floor->floor_of(x, y);
+      return {std::clamp(fx, 0.0, cabinet_width_mm), std::clamp(fy, 0.0, cabinet_depth_mm)};
+    }
     const auto [cx, cy] = chart_mm(x, y);
     return scene->chart_to_floor_mm(cx, cy);
   }
 
-  double vignetting(int x, int y, double f_number) const {
-    const double dx = x + 0.5 - config.width / 2.0, dy = y + 0.5 - config.height / 2.0;
+  // Continuous image position (pixel x covers [x, x+1)).
+  double optics(double u, double v, double f_number, View view_now) const {
+    const double dx = u - config.width / 2.0, dy = v - config.height / 2.0;
     const double r2 = (dx * dx + dy * dy) / (config.width * config.width / 4.0 + config.height * config.height / 4.0);
-    return 1.0 - (0.35 / f_number) * r2;  // natural vignetting eases as the lens is stopped down
+    const double vig = 1.0 - (0.35 / f_number) * r2;  // natural vignetting eases as the lens is stopped down
+    return view_now == View::floor ? vig * floor->cos4(u, v) : vig;
   }
+  double vignetting(int x, int y, double f_number, View v) const { return optics(x + 0.5, y + 0.5, f_number, v); }
 
   double gain_dn_per_e(const CameraSettings& s) const { return config.gain_dn_per_e_iso100 * s.iso / 100.0; }
 
@@ -137,7 +153,8 @@ std::shared_ptr<const CameraModel::Impl::Precomputed> CameraModel::Impl::precomp
   check_settings(s);
   const std::uint64_t version = scene->state_version();
   std::lock_guard lock(cache_mutex);
-  if (!cache || cache->version != version || !same_settings(cache->settings, s)) cache = build(s, version);
+  if (!cache || cache->version != version || !same_settings(cache->settings, s) || cache->view != view.load())
+    cache = build(s, version);
   return cache;
 }
 
@@ -146,6 +163,8 @@ std::shared_ptr<const CameraModel::Impl::Precomputed> CameraModel::Impl::build(c
   auto pre = std::make_shared<Precomputed>();
   pre->settings = s;
   pre->version = version;
+  pre->view = view.load();
+  const View v = pre->view;
   pre->gain = gain_dn_per_e(s);
   pre->lamps = scene->lamps_on();
   const double dimmer = scene->dimmer();
@@ -164,7 +183,7 @@ std::shared_ptr<const CameraModel::Impl::Precomputed> CameraModel::Impl::build(c
   for (std::size_t li = 0; li < pre->lamps.size(); ++li)
     for (int j = 0; j < ny; ++j)
       for (int i = 0; i < nx; ++i) {
-        const auto [fx, fy] = floor_mm(i * field_node_step, j * field_node_step);
+        const auto [fx, fy] = floor_mm(i * field_node_step, j * field_node_step, v);
         nodes[li][static_cast<std::size_t>(j * nx + i)] = scene->lamp_floor_luminance(pre->lamps[li], dimmer, fx, fy);
       }
 
@@ -187,9 +206,9 @@ std::shared_ptr<const CameraModel::Impl::Precomputed> CameraModel::Impl::build(c
       const double ty = double(y - jy * field_node_step) / field_node_step;
       for (int x = 0; x < W; ++x) {
         const std::size_t p = static_cast<std::size_t>(y) * W + x;
-        const int m = material_at(x, y);
+        const int m = material_at(x, y, v);
         const int c = rggb_channel(x, y);
-        const double vig = vignetting(x, y, s.f_number);
+        const double vig = vignetting(x, y, s.f_number, v);
         double pixel_gain = 1.0 + config.prnu_sigma * detail::hashed_normal(prnu_key + p);
         for (const auto& d : dust) {
           const double r2 = ((x + 0.5 - d.x) * (x + 0.5 - d.x) + (y + 0.5 - d.y) * (y + 0.5 - d.y)) / (d.radius * d.radius);
@@ -342,6 +361,7 @@ CameraModel::CameraModel(std::shared_ptr<const Scene> scene, CameraConfig config
     }
   }
   if (m.config.pose) m.pose.emplace(*m.config.pose, m.config.width, m.config.height, m.config.chart_height_fraction);
+  m.floor.emplace(m.config.width, m.config.height);
   for (const auto& p : m.scene->chart().patches) {
     if (m.pose) {
       // The largest axis-aligned rectangle centred on the patch inside its image (pixel centres at +0.5).
@@ -477,6 +497,23 @@ std::vector<std::array<double, 3>> CameraModel::ground_truth(const CameraSetting
       out[static_cast<std::size_t>(m)][c] = std::min(256.0 + pre->gain * e, 4095.0);
     }
   return out;
+}
+
+void CameraModel::set_view(View view) { impl_->view.store(view); }
+CameraModel::View CameraModel::view() const { return impl_->view.load(); }
+
+std::array<double, 2> CameraModel::floor_point_px(double x_mm, double y_mm) const {
+  const auto [u, v] = impl_->floor->image_of(x_mm, y_mm);
+  return {u - 0.5, v - 0.5};
+}
+
+std::array<std::array<double, 2>, 4> CameraModel::floor_corners_px() const {
+  return {floor_point_px(0, 0), floor_point_px(cabinet_width_mm, 0), floor_point_px(cabinet_width_mm, cabinet_depth_mm),
+          floor_point_px(0, cabinet_depth_mm)};
+}
+
+double CameraModel::relative_illumination(double x_px, double y_px, double f_number, View view) const {
+  return impl_->optics(x_px + 0.5, y_px + 0.5, f_number, view);
 }
 
 const std::vector<PixelDefect>& CameraModel::defects() const { return impl_->defects; }

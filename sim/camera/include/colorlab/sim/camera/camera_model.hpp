@@ -80,6 +80,12 @@ struct DustSpeck {
 
 class CameraModel {
  public:
+  // What the camera photographs: the chart in the cabinet (the default), or the empty cabinet floor — the chart
+  // taken out and the camera aimed at the whole floor from the cabinet's open front, as an imaging luminance meter
+  // sees it (docs/simulator.md, "camera_view"). The floor is the scene's one luminance field, the one the LS-110
+  // reads, seen through this view's perspective, its lens's cos⁴ fall-off and the camera's own vignetting and noise.
+  enum class View { chart, floor };
+
   CameraModel(std::shared_ptr<const Scene> scene, CameraConfig config = {});
   ~CameraModel();
   CameraModel(const CameraModel&) = delete;
@@ -113,6 +119,18 @@ class CameraModel {
   // Fixed per camera seed.
   const std::vector<PixelDefect>& defects() const;
   const std::vector<DustSpeck>& dust() const;
+
+  // Aims the camera (thread-safe; frames rendered from now on show the new view).
+  void set_view(View view);
+  View view() const;
+  // The floor view's geometry (whatever the current view), pixel centres at integers: the image position of a
+  // floor point (mm, the scene's coordinates), and of the floor's corners — front-left, front-right, back-right,
+  // back-left — which is what a bench measures on its own photograph to map the floor.
+  std::array<double, 2> floor_point_px(double x_mm, double y_mm) const;
+  std::array<std::array<double, 2>, 4> floor_corners_px() const;
+  // The relative illumination the optics give a pixel in a view (1 = none lost): the lens's vignetting at this
+  // f-number, times the cos⁴ fall-off in the floor view. Pixel centres at integers.
+  double relative_illumination(double x_px, double y_px, double f_number, View view) const;
 
   // Relative spectral sensitivities (R, G, B) on 380–730 nm / 5 nm, and their source ("file path" or "parametric").
   const std::array<Spectrum, 3>& sensitivities() const;
