@@ -36,6 +36,7 @@ std::string TimingKeys::key(const std::string& call, const json& args) const {
   }
   if (call == "camera.photograph_chart") return "camera.photograph_chart per frame and format";
   if (call == "camera.capture") return "camera.capture per frame";
+  if (call == "camera.photograph_floor") return "camera.photograph_floor per frame";
   return call;
 }
 
@@ -51,6 +52,7 @@ double TimingKeys::units(const std::string& call, const json& args) {
     return number("frames", 25.0) * formats;
   }
   if (call == "camera.capture") return number("frames", 1.0);
+  if (call == "camera.photograph_floor") return number("frames", 8.0);  // photograph_floor's default
   return 1.0;
 }
 

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "colorlab/campaigns/floor_photograph.hpp"
 #include "colorlab/campaigns/operator_desk.hpp"
 #include "colorlab/core/error.hpp"
 #include "colorlab/core/ids.hpp"
@@ -196,6 +197,8 @@ json DryLab::answer(const std::string& call, const json& args, double lab_now_s,
                                     {"detected", std::vector<bool>(ids.size(), true)}};
     }
     result = out;
+  } else if (call == "camera.photograph_floor") {
+    result = dry_floor_photograph(args[0], instrument_id);
   } else if (call == "runs.chart_reference") {
     if (!runs_) throw Error(ErrorClass::unsupported, "lab.runs.chart_reference: this lab keeps no runs to read");
     result = chart_reference(*runs_, args[0].get<std::string>());

@@ -10,6 +10,7 @@
 
 #include "colorlab/analysis/colorimetry.hpp"
 #include "colorlab/campaigns/chart_photograph.hpp"
+#include "colorlab/campaigns/floor_photograph.hpp"
 #include "colorlab/campaigns/frame_statistics.hpp"
 #include "colorlab/core/error.hpp"
 #include "colorlab/core/ids.hpp"
@@ -418,6 +419,12 @@ asio::awaitable<json> Lab::perform(const std::string& call, const json& args, co
     }
     json photographs = co_await photograph_chart(*camera, options, keeper_);
     co_return photographs;
+  }
+  if (call == "camera.photograph_floor") {
+    auto camera = co_await acquire<cam::CameraInstrument>("camera");
+    json options = args[0];
+    json photograph = co_await photograph_floor(*camera, options, keeper_);
+    co_return photograph;
   }
   if (call == "runs.chart_reference") {
     if (!runs_) throw Error(ErrorClass::unsupported, "lab.runs.chart_reference: this lab keeps no runs to read");

@@ -11,6 +11,7 @@
 #include "colorlab/analysis/uniformity.hpp"
 #include "colorlab/campaigns/characterize.hpp"
 #include "colorlab/campaigns/chart_plan.hpp"
+#include "colorlab/campaigns/floor_photograph.hpp"
 #include "colorlab/campaigns/lua_value.hpp"
 #include "colorlab/core/error.hpp"
 
@@ -47,6 +48,7 @@ const std::map<std::string, CallSpec>& call_specs() {
       {"camera.configure", {CallKind::effect, {"table"}}},
       {"camera.capture", {CallKind::reading, {"table?"}}},
       {"camera.photograph_chart", {CallKind::reading, {"table?"}}},
+      {"camera.photograph_floor", {CallKind::reading, {"table"}}},
       {"runs.chart_reference", {CallKind::reading, {"string"}}},
       {"wait", {CallKind::effect, {"number"}}},
       {"wait_stable", {CallKind::reading, {"table?"}}},
@@ -320,6 +322,19 @@ int analysis_characterize(lua_State* L) {
   return 1;
 }
 
+// lab.analysis.floor_luminance(photograph, calibration, {degree =, subset =}) → the floor's luminance (floor_photograph.hpp).
+int analysis_floor_luminance(lua_State* L) {
+  guarded(L, [&] {
+    json photo = to_json(L, 1, "lab.analysis.floor_luminance's photograph");
+    json calibration = to_json(L, 2, "lab.analysis.floor_luminance's calibration");
+    json options = lua_gettop(L) >= 3 && !lua_isnil(L, 3) ? to_json(L, 3, "lab.analysis.floor_luminance's options") : json::object();
+    json result = floor_luminance(photo, calibration, options);
+    lua_settop(L, 0);
+    push_json(L, result);
+  });
+  return 1;
+}
+
 // lab.chart.plan{chart=, first_x_mm=, first_y_mm=, pitch_mm=} → the chart's patches on the table in visiting order.
 int chart_plan_fn(lua_State* L) {
   guarded(L, [&] {
@@ -387,6 +402,8 @@ void install_lab_api(lua_State* L, LabCallSink* sink) {
   lua_setfield(L, -2, "compare_lamps");
   lua_pushcfunction(L, analysis_characterize);
   lua_setfield(L, -2, "characterize");
+  lua_pushcfunction(L, analysis_floor_luminance);
+  lua_setfield(L, -2, "floor_luminance");
   lua_setfield(L, -2, "analysis");
   lua_newtable(L);
   lua_pushcfunction(L, chart_plan_fn);

@@ -67,6 +67,16 @@ asio::awaitable<std::optional<json>> SimulatorHands::perform(const std::string& 
     co_await command(cmd);
     co_return json{{"chart", "in place"}};
   }
+  if (action == "aim_camera") {
+    // floor-luminance: the chart out of the cabinet and the cameras at the whole floor ("floor"), or back ("chart").
+    const std::string view = details.is_object() ? details.value("view", std::string()) : std::string();
+    if (view != "floor" && view != "chart") {
+      throw Error(ErrorClass::script_error, "aim_camera needs details = {view = \"floor\" | \"chart\"} on the simulated lab");
+    }
+    json cmd{{"cmd", "camera_view"}, {"view", view}};
+    co_await command(cmd);
+    co_return json{{"camera_view", view}};
+  }
   if (action == "white_tile") {
     json cmd{{"cmd", "place"}, {"target", "white_tile"}};
     co_await command(cmd);
