@@ -24,6 +24,14 @@ return {
                       description = "camspec cameras the black box's prior leaves out (the camera under test, to judge its curves against its published ones)" },
     load_timeout_s = { type = "number", default = 600, min = 0, max = 86400, unit = "s",
                        description = "how long to wait for the operator to confirm the chart before photographing anyway" },
+    corners_raw = { type = "array", items = "number", default = {}, max_items = 8, min = 0, unit = "px",
+                    description = "the raw photograph's chart corners x1, y1, …, x4, y4 (outer corners of the patch grid, the first patch's first, clockwise), when the locator refused it; empty = found automatically" },
+    corners_tiff16 = { type = "array", items = "number", default = {}, max_items = 8, min = 0, unit = "px",
+                       description = "the same for the 16-bit TIFF" },
+    corners_tiff8 = { type = "array", items = "number", default = {}, max_items = 8, min = 0, unit = "px",
+                      description = "the same for the 8-bit TIFF" },
+    corners_jpeg = { type = "array", items = "number", default = {}, max_items = 8, min = 0, unit = "px",
+                     description = "the same for the JPEG" },
     keep = { type = "array", items = "string", values = { "average", "raw", "tiff16", "tiff8", "jpeg", "preview" },
              default = { "average", "raw", "preview" }, max_items = 6,
              description = "frames kept in the image store: the averaged raw (float array), the first raw as captured, the first frame's TIFF/JPEG, a PNG preview" },
@@ -31,6 +39,16 @@ return {
   run = function(p)
     if p.reference_run == nil or p.reference_run == "" then
       error("reference_run is required: the id of a finished chart-read run of the chart in the cabinet (run chart-read first)")
+    end
+    -- The operator's corners, per format, from a run the locator refused (see refusal_error below).
+    local corners = {}
+    for _, format in ipairs(p.formats) do
+      local c = p["corners_" .. format]
+      if #c ~= 0 and #c ~= 8 then
+        error({ class = "bad_parameter", message = string.format("corners_%s has %d numbers", format, #c),
+                hint = "give 8 numbers x1,y1,x2,y2,x3,y3,x4,y4 (the outer corners of the patch grid, the first patch's first, clockwise), or none" })
+      end
+      if #c == 8 then corners[format] = c end
     end
     local ref = lab.runs.chart_reference(p.reference_run)
     if ref.chart ~= p.chart then
@@ -60,8 +78,47 @@ return {
     -- The reference's luminances let the locator tell patches as dark as the chart's surround (no edge of their
     -- own) from a covered chart. (Only ids and XYZ: the spectra would swell the call's journal entry.)
     local shots = lab.camera.photograph_chart { frames = p.frames, chart = p.chart, formats = p.formats, camera = p.camera,
-                                                reference = { ids = ref.ids, XYZ = ref.XYZ }, keep = p.keep }
+                                                reference = { ids = ref.ids, XYZ = ref.XYZ }, keep = p.keep,
+                                                corners = corners, on_refusal = "return" }
     lab.log(string.format("photographed %d frames as %s", p.frames, table.concat(p.formats, ", ")))
+    -- A photograph the locator refused (no chart, partly covered, unsure) fails the run — never fitted to wrong
+    -- patches —, but only after recording it with the kept frame, so the operator can find the corners in exactly
+    -- that photograph and give them to the next run.
+    local refusals, commands, params = {}, {}, {}
+    for _, format in ipairs(p.formats) do
+      local f = shots.formats[format]
+      if f.refused then
+        local kind = format == "raw" and "average" or format
+        local sha
+        for _, b in ipairs(shots.blobs or {}) do
+          if b.kind == kind then sha = b.sha256 end
+        end
+        lab.record("chart/" .. format, {
+          quantity = "chart_location", value = 0, unit = "confidence", instrument = shots.instrument,
+          data = { format = format, refused = f.refused, blob = sha, from_corners = f.from_corners, frames = f.frames,
+                   files = f.files, width = f.width, height = f.height },
+        })
+        refusals[#refusals + 1] = string.format("the %s photograph%s: %s", format,
+                                                f.from_corners and " (with corners_" .. format .. ")" or "", f.refused.message)
+        if sha then
+          commands[#commands + 1] = string.format("colorlab locate-chart --blob %s --chart %s --reference-run %s --corners x1,y1,x2,y2,x3,y3,x4,y4",
+                                                  sha, p.chart, p.reference_run)
+        else
+          commands[#commands + 1] = string.format("colorlab analyze locate-chart %s --chart %s --corners x1,y1,x2,y2,x3,y3,x4,y4", f.files[1], p.chart)
+        end
+        params[#params + 1] = string.format("-p corners_%s=[x1,y1,x2,y2,x3,y3,x4,y4]", format)
+      end
+    end
+    if #refusals > 0 then
+      error({
+        class = "needs_operator",
+        message = "the chart was not located in " .. table.concat(refusals, "; "),
+        hint = "check that the whole chart is in the frame, lit and in focus; or find its four corners (the outer corners of the "
+               .. "patch grid, the first patch's first, clockwise; `colorlab download SHA256 --preview -o chart.png` shows the photograph) "
+               .. "until `" .. table.concat(commands, "` and `") .. "` locates it, then start characterize-camera again with "
+               .. "the same parameters and " .. table.concat(params, " "),
+      })
+    end
     local out = { reference_run = p.reference_run, chart = p.chart, frames = p.frames, lamp = p.lamp,
                   instrument = shots.instrument, formats = {} }
     local best_format, best_cv
@@ -69,7 +126,7 @@ return {
       local f = shots.formats[format]
       lab.record("chart/" .. format, {
         quantity = "chart_location", value = f.confidence, unit = "confidence", instrument = shots.instrument,
-        data = { format = format, corners = f.corners, rotation_deg = f.rotation_deg, patches_detected = f.patches_detected,
+        data = { format = format, corners = f.corners, from_corners = f.from_corners, rotation_deg = f.rotation_deg, patches_detected = f.patches_detected,
                  reprojection_rms_px = f.reprojection_rms_px, check = f.check, frames = f.frames, files = f.files,
                  width = f.width, height = f.height, notes = f.notes },
       })

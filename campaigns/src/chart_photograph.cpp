@@ -63,6 +63,26 @@ PhotographOptions parse(const json& o) {
     if (!o[key].is_number() || !(o[key].get<double>() > 0 && o[key].get<double>() <= 1)) throw bad(std::string(key) + " must be a number in (0, 1]");
     out = o[key].get<double>();
   };
+  if (o.contains("corners")) {
+    // {raw = {x1, y1, …, x4, y4}, jpeg = {…}}: the operator's corners per format; an empty list = locate it alone.
+    const json& c = o["corners"];
+    if (!c.is_object() && !(c.is_array() && c.empty())) throw bad("corners must be a table {<format> = {x1, y1, x2, y2, x3, y3, x4, y4}}");
+    if (c.is_object()) {
+      for (const auto& [format, v] : c.items()) {
+        if (std::find(kFormats.begin(), kFormats.end(), format) == kFormats.end()) throw bad("corners names no format '" + format + "'");
+        if (v.is_array() && v.empty()) continue;
+        if (!v.is_array() || v.size() != 8 || !std::all_of(v.begin(), v.end(), [](const json& x) { return x.is_number(); }))
+          throw bad("corners." + format + " must be 8 numbers x1, y1, …, x4, y4 (or empty)");
+        std::array<ca::Point2, 4> corners{};
+        for (std::size_t i = 0; i < 4; ++i) corners[i] = {v[2 * i].get<double>(), v[2 * i + 1].get<double>()};
+        p.sampling.corners[format] = corners;
+      }
+    }
+  }
+  if (o.contains("on_refusal")) {
+    if (o["on_refusal"] != "error" && o["on_refusal"] != "return") throw bad("on_refusal must be \"error\" or \"return\"");
+    p.sampling.return_refusals = o["on_refusal"] == "return";
+  }
   fraction("sample_fraction", p.sampling.sample_fraction);
   fraction("min_confidence", p.sampling.min_confidence);
   if (o.contains("reference")) {
@@ -150,7 +170,7 @@ asio::awaitable<json> sample_all(std::shared_ptr<RawSum> raw, std::vector<std::f
                                  std::vector<std::filesystem::path> raw_files, PhotographOptions p, std::string camera_name,
                                  FrameKeeper* keeper) {
   json formats = json::object();
-  const bool keeping = keeper && p.keep.any();
+  bool keeping = keeper && p.keep.any();
   if (wants(p, "raw")) {
     detail::AveragedPhoto a;
     a.format = "raw";
@@ -167,8 +187,8 @@ asio::awaitable<json> sample_all(std::shared_ptr<RawSum> raw, std::vector<std::f
     auto* dst = reinterpret_cast<std::uint16_t*>(a.photo.bytes.data());
     const double k = a.scale / raw->frames;
     for (std::size_t i = 0; i < raw->sum.size(); ++i) dst[i] = static_cast<std::uint16_t>(std::min(65535.0, std::round(raw->sum[i] * k)));
-    if (!keeping) raw->sum = {};
     formats["raw"] = detail::locate_and_sample(a, p.sampling);
+    if (!keeping && !formats["raw"].contains("refused")) raw->sum = {};
   }
   auto processed = average_sidecars(sidecars, p);
   for (const auto& format : p.formats) {
@@ -180,6 +200,14 @@ asio::awaitable<json> sample_all(std::shared_ptr<RawSum> raw, std::vector<std::f
     }
     formats[format] = detail::locate_and_sample(it->second, p.sampling);
   }
+  // A refused photograph is kept whatever `keep` says — the raw as the average the locator saw, a processed format
+  // as its first file —, so the operator can find its corners in it (POST /v1/blobs/{sha256}/locate-chart).
+  for (const auto& [format, f] : formats.items()) {
+    if (!f.contains("refused")) continue;
+    const std::string kind = format == "raw" ? "average" : format;
+    if (!p.keep.wants(kind)) p.keep.kinds.push_back(kind);
+  }
+  keeping = keeper && p.keep.any();
   json blobs = json::array();
   if (keeping) {
     detail::SeriesFrames series;

@@ -89,10 +89,24 @@ json locate_and_sample(const AveragedPhoto& a, const SamplingOptions& options) {
   lo.sample_fraction = options.sample_fraction;
   lo.min_confidence = options.min_confidence;
   lo.reference = options.reference;
+  if (auto it = options.corners.find(a.format); it != options.corners.end()) lo.corners = it->second;
   ca::ChartLocation loc;
   try {
     loc = ca::locate_chart(view, options.chart, lo);
   } catch (const Error& e) {
+    const bool refusal = e.cls() == ErrorClass::not_found || e.cls() == ErrorClass::needs_operator ||
+                         (e.cls() == ErrorClass::bad_parameter && lo.corners);
+    if (options.return_refusals && refusal) {
+      return json{{"format", a.format},
+                  {"frames", a.frames},
+                  {"files", a.files},
+                  {"width", a.photo.width},
+                  {"height", a.photo.height},
+                  {"bits", a.bits},
+                  {"chart", std::string(ca::to_string(options.chart))},
+                  {"from_corners", lo.corners.has_value()},
+                  {"refused", {{"error", std::string(to_string(e.cls()))}, {"message", e.info().message}, {"hint", e.hint()}}}};
+    }
     // Which of the four photographs the locator refused matters to the operator.
     ErrorInfo info = e.info();
     info.message = "the " + a.format + " photograph of the chart: " + info.message;
@@ -123,6 +137,7 @@ json locate_and_sample(const AveragedPhoto& a, const SamplingOptions& options) {
               {"chart", std::string(ca::to_string(loc.type))},
               {"confidence", loc.confidence},
               {"rotation_deg", loc.rotation_deg},
+              {"from_corners", loc.from_corners},
               {"corners", corners},
               {"patches_detected", loc.patches_detected},
               {"reprojection_rms_px", loc.reprojection_rms_px},

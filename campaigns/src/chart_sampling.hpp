@@ -1,6 +1,7 @@
 #pragma once
 // The chart photograph's pixels, averaged over the frames of one series per image format, and their
 // chart location and patch values. Internal to chart_photograph.cpp; runs off the daemon's io thread.
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <map>
@@ -37,6 +38,12 @@ struct SamplingOptions {
   // The chart's patch luminances from a reference read (chart-read's XYZ): lets the locator tell patches that
   // merely lack a luminance edge against the surround from a covered chart (chart_locate.hpp).
   std::optional<analysis::ChartReference> reference;
+  // The operator's corners per format ("raw", "jpeg", …): the outer corners of the patch grid in that format's
+  // pixels, the first patch's first, clockwise (chart_locate.hpp). Given after the locator refused a photograph.
+  std::map<std::string, std::array<analysis::Point2, 4>> corners;
+  // The locator's refusal (not_found, needs_operator, corners it cannot use) comes back as {format, refused = {…}}
+  // instead of failing the call, so the frames are kept and the script can tell the operator which to look at.
+  bool return_refusals = false;
 };
 
 // Sums of the camera's own processed files (JPEG, TIFF) of one format; throws Error(bad_data) when
@@ -48,7 +55,9 @@ std::map<std::string, AveragedPhoto> average_tiffs(const std::vector<std::filesy
 // Locates the chart (colorlab_chart_locate, as `colorlab analyze locate-chart`) and samples every
 // patch: {format, frames, files, width, height, bits, black_subtracted, confidence, rotation_deg,
 // corners, patches_detected, reprojection_rms_px, check, ids, values = [[r, g, b], …]}.
-// Throws the locator's typed Error, with the format named.
+// With corners for the format, the locator starts from them (from_corners). Throws the locator's typed Error, with
+// the format named — or, with return_refusals, returns {format, frames, files, width, height, bits, chart,
+// from_corners, refused = {error, message, hint}} for a refusal.
 nlohmann::json locate_and_sample(const AveragedPhoto& averaged, const SamplingOptions& options);
 
 }  // namespace colorlab::campaigns::detail

@@ -267,13 +267,28 @@ asio::awaitable<RunOutcome> run_campaign_script(ScriptRunSetup setup, Lab& lab, 
       }
       // A runtime error in the script (or a limit it hit).
       std::string message = lua_tostring(thread, -1) ? lua_tostring(thread, -1) : "error object is not a string";
+      // A script that knows what a person must do says so: error{message = ..., hint = ..., class = "needs_operator"}.
+      ErrorInfo raised{ErrorClass::script_error, "", "fix the script and start a new run"};
+      if (lua_istable(thread, -1) && !sandbox.killed()) {
+        if (lua_getfield(thread, -1, "message") == LUA_TSTRING) message = lua_tostring(thread, -1);
+        if (lua_getfield(thread, -2, "hint") == LUA_TSTRING) raised.hint = lua_tostring(thread, -1);
+        if (lua_getfield(thread, -3, "class") == LUA_TSTRING) {
+          const std::string cls = lua_tostring(thread, -1);
+          // Only classes that describe the run's inputs or the lab's state: not ones the engine itself acts on
+          // (io_error suspends, aborted ends quietly).
+          for (auto c : {ErrorClass::needs_operator, ErrorClass::bad_parameter, ErrorClass::bad_data, ErrorClass::not_found}) {
+            if (to_string(c) == cls) raised.cls = c;
+          }
+        }
+        lua_pop(thread, 3);
+      }
       if (sandbox.killed()) message = sandbox.kill_reason();
       luaL_traceback(L, thread, nullptr, 0);
       std::string traceback = lua_tostring(L, -1) ? lua_tostring(L, -1) : "";
       lua_pop(L, 1);
       outcome.kind = RunOutcome::Kind::failed;
-      outcome.error = Error(ErrorClass::script_error, message + " (step " + (engine.label_.empty() ? "start" : engine.label_) + ")",
-                            "fix the script and start a new run");
+      raised.message = message + " (step " + (engine.label_.empty() ? "start" : engine.label_) + ")";
+      outcome.error = Error(std::move(raised));
       outcome.script_location = location(line_of(message, file));
       outcome.script_location["traceback"] = traceback;
       flush();

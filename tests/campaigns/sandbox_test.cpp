@@ -178,3 +178,20 @@ TEST(LabAnalysis, UniformityAndDimmerProportionalityFromAScript) {
   EXPECT_NEAR(o.result["dimmer_error"].get<double>(), 0.0, 1e-9);  // exactly proportional by construction
   EXPECT_NE(o.result["ragged"].get<std::string>().find("every row needs 2 values"), std::string::npos);
 }
+
+// A script that knows what a person must do raises error{message, hint, class}: the run fails with that hint and a
+// class for people (characterize-camera's refused photograph), never one the engine acts on (io_error suspends).
+TEST(Sandbox, AnErrorTableCarriesItsHintAndAClassForPeople) {
+  auto o = run_body("error({ message = 'the chart was not located', hint = 'give corners_raw', class = 'needs_operator' })");
+  ASSERT_EQ(o.kind, RunOutcome::Kind::failed);
+  ASSERT_TRUE(o.error);
+  EXPECT_EQ(o.error->cls(), ErrorClass::needs_operator);
+  EXPECT_NE(std::string(o.error->what()).find("the chart was not located"), std::string::npos) << o.error->what();
+  EXPECT_EQ(o.error->hint(), "give corners_raw");
+  auto suspending = run_body("error({ message = 'disk', class = 'io_error' })");
+  ASSERT_EQ(suspending.kind, RunOutcome::Kind::failed);
+  EXPECT_EQ(suspending.error->cls(), ErrorClass::script_error);
+  EXPECT_EQ(suspending.error->hint(), "fix the script and start a new run");
+  auto plain = run_body("error('plain')");
+  EXPECT_EQ(plain.error->hint(), "fix the script and start a new run");
+}
