@@ -51,6 +51,8 @@ return {
                  description = "settling after each dimmer change (lab seconds)" },
     aim_timeout_s = { type = "number", default = 1800, min = 0, max = 86400, unit = "s",
                       description = "how long to wait for the operator to aim the meter or the camera" },
+    grid_run = { type = "string",
+                 description = "the cabinet-grid run the report compares with (the campaign itself does not read it)" },
     keep = { type = "array", items = "string", default = { "preview" }, max_items = 3,
              description = "frames kept per photograph: average, raw, preview (an 8-megapixel average is 33 MB)" },
   },

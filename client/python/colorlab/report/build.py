@@ -4,7 +4,7 @@ from __future__ import annotations
 import datetime as dt
 import sys
 
-from . import cabinet_grid, characterization, common, fetch, frame_average, pareto, stability, summaries
+from . import cabinet_grid, characterization, common, fetch, frame_average, imaging_meter, pareto, stability, summaries
 from .html import document, esc
 
 TITLES = {
@@ -13,12 +13,13 @@ TITLES = {
     "characterize-camera": "Camera characterization (chapter 7)",
     "chart-read": "Chart reference values (§6.3)",
     "luminance-spot": "Spot luminance",
+    "floor-luminance": "The camera as an imaging luminance meter (§6.2's floor)",
     "other": "Run summary",
 }
 
 
 SECTIONS = {"frame-average": frame_average.section, "cabinet-grid": cabinet_grid.section,
-            "characterize-camera": characterization.section}
+            "characterize-camera": characterization.section, "floor-luminance": imaging_meter.section}
 
 
 def section_for(run) -> str:
@@ -77,6 +78,7 @@ def load_runs(client, run_ids):
                 run.extra["reference"] = fetch.load(client, ref)
             except Exception:  # the reference only adds the L*a*b* comparisons; the section says when it lacks it
                 run.extra["reference"] = None
+    imaging_meter.link(client, runs)  # each floor-luminance run's cabinet-grid
     # The stability section's "another lamp": the report's other characterize-camera runs of the same reference.
     cc = [r for r in runs if fetch.kind_of(r) == "characterize-camera"]
     for run in cc:

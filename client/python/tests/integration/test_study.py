@@ -20,7 +20,7 @@ from daemon_fixture import SOURCE_DIR
 # The chart must be located in the DSLR's photographs: the size characterize-camera's report test uses.
 LAB_TOML = "[genicam]\nenabled = false\n[dslr]\nsize = [1752, 1168]\n"
 ENV = dict(os.environ, PYTHONPATH=str(SOURCE_DIR / "client" / "python"), PYTHONUNBUFFERED="1")
-CAMPAIGNS = ["chart-read", "frame-average", "cabinet-grid", "characterize-camera"]
+CAMPAIGNS = ["chart-read", "frame-average", "cabinet-grid", "floor-luminance", "characterize-camera"]
 
 
 def study_command(daemon, tmp: Path, *extra) -> list[str]:
