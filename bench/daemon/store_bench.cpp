@@ -1,11 +1,18 @@
 // What durability costs and what keyset paging saves, measured side by side:
+// - one campaign step committed by the store against the same rows through raw SQLite with the store's own
+//   schema and settings (WAL, synchronous=FULL, foreign_keys, busy_timeout, temp_store), statements prepared once;
 // - one committed measurement with synchronous=FULL (colorlab's choice) vs NORMAL vs a batched
 //   transaction (QCoDeS's fix for slow inserts, PR #1187);
 // - a page of runs deep in a 20 000-run catalogue: keyset (colorlab) vs OFFSET (QCoDeS #1915).
+// Runs interleaved by default (5 repetitions, random interleaving), so every comparison is made in one run
+// under the same load; flags given on the command line override these defaults.
 #include <benchmark/benchmark.h>
 #include <fcntl.h>
 #include <sqlite3.h>
 #include <unistd.h>
+
+#include <string>
+#include <vector>
 
 #include "colorlab/store/store.hpp"
 #include "colorlab/testing/temp_dir.hpp"
@@ -66,13 +73,98 @@ void BM_Fdatasync4k(benchmark::State& state) {
 }
 BENCHMARK(BM_Fdatasync4k)->Unit(benchmark::kMicrosecond);
 
-// The same rows through raw SQLite: NORMAL (no fsync per commit) and one transaction for all.
+// The store's connection settings (daemon/store/src/store.cpp), with the given synchronous level.
+void store_settings(sqlite3* db, const char* sync) {
+  for (std::string pragma : {"PRAGMA busy_timeout = 5000", "PRAGMA journal_mode = WAL", "PRAGMA foreign_keys = ON",
+                             "PRAGMA journal_size_limit = 67108864", "PRAGMA temp_store = MEMORY"}) {
+    sqlite3_exec(db, pragma.c_str(), nullptr, nullptr, nullptr);
+  }
+  sqlite3_exec(db, (std::string("PRAGMA synchronous = ") + sync).c_str(), nullptr, nullptr, nullptr);
+}
+
+// The reference for BM_CommitCampaignStep_Full: the same step's rows and statements (journal entry, measurement
+// with its sequence number, the execution's progress, the event) in one transaction through raw SQLite, on the
+// store's own schema with the store's settings, every statement prepared once and the JSON texts made once.
+void BM_RawStep_Full(benchmark::State& state) {
+  colorlab::testing::TempDir dir;
+  colorlab::store::ExecutionRecord e;
+  {
+    colorlab::store::Store store(dir / "colorlab.db");  // schema and one execution, then closed
+    colorlab::store::NewRun run{"luminance-spot", nlohmann::json::object(), true, nlohmann::json::array(), std::nullopt};
+    run.script_sha256 = "bench";
+    run.script_source = "return {}";
+    e = store.create_execution(run).execution;
+  }
+  sqlite3* db = nullptr;
+  sqlite3_open((dir / "colorlab.db").c_str(), &db);
+  store_settings(db, "FULL");
+  auto prepare = [&](const char* sql) {
+    sqlite3_stmt* st = nullptr;
+    if (sqlite3_prepare_v2(db, sql, -1, &st, nullptr) != SQLITE_OK) state.SkipWithError(sqlite3_errmsg(db));
+    return st;
+  };
+  sqlite3_stmt* begin = prepare("BEGIN");
+  sqlite3_stmt* commit = prepare("COMMIT");
+  sqlite3_stmt* journal = prepare("INSERT INTO journal (execution_id, seq, call, args, result, at) VALUES (?1, ?2, 'meter.measure', '[]', ?3, ?4)");
+  sqlite3_stmt* max_seq = prepare("SELECT COALESCE(MAX(seq), 0) FROM measurements WHERE run_id = ?1");
+  sqlite3_stmt* measurement = prepare(
+      "INSERT INTO measurements (run_id, seq, step, instrument_id, simulated, quantity, value, unit, data, measured_at) "
+      "VALUES (?1, ?2, ?3, 'ls110', 1, 'luminance', 245.3, 'cd/m2', ?4, ?5)");
+  sqlite3_stmt* progress = prepare(
+      "UPDATE executions SET progress = 0.5, step = ?2, updated_at = ?3, steps_committed = steps_committed + 1, "
+      "resume_attempts = 0 WHERE id = ?1");
+  sqlite3_stmt* event = prepare("INSERT INTO event_log (time, topic, payload) VALUES (?1, 'progress', ?2)");
+  const std::string result = R"({"instrument":"ls110","luminance":245.3,"raw":"OK00,   245.30","unit":"cd/m2"})";
+  const std::string data = R"({"raw":"OK00,   245.30"})";
+  const std::string now = "2026-11-24T00:00:00.000Z";
+  auto run = [](sqlite3_stmt* st) {
+    while (sqlite3_step(st) == SQLITE_ROW) {
+    }
+    sqlite3_reset(st);
+  };
+  std::int64_t i = 0;
+  for (auto _ : state) {
+    const std::string step = "reading/" + std::to_string(i);
+    const std::string payload = R"({"execution_id":")" + e.id + R"(","measurements":1,"progress":0.5,"run_id":")" + e.run_id +
+                                R"(","step":")" + step + R"("})";
+    run(begin);
+    sqlite3_bind_text(journal, 1, e.id.c_str(), -1, SQLITE_STATIC);
+    sqlite3_bind_int64(journal, 2, i);
+    sqlite3_bind_text(journal, 3, result.c_str(), -1, SQLITE_STATIC);
+    sqlite3_bind_text(journal, 4, now.c_str(), -1, SQLITE_STATIC);
+    run(journal);
+    sqlite3_bind_text(max_seq, 1, e.run_id.c_str(), -1, SQLITE_STATIC);
+    std::int64_t seq = sqlite3_step(max_seq) == SQLITE_ROW ? sqlite3_column_int64(max_seq, 0) : 0;
+    sqlite3_reset(max_seq);
+    sqlite3_bind_text(measurement, 1, e.run_id.c_str(), -1, SQLITE_STATIC);
+    sqlite3_bind_int64(measurement, 2, seq + 1);
+    sqlite3_bind_text(measurement, 3, step.c_str(), -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(measurement, 4, data.c_str(), -1, SQLITE_STATIC);
+    sqlite3_bind_text(measurement, 5, now.c_str(), -1, SQLITE_STATIC);
+    run(measurement);
+    sqlite3_bind_text(progress, 1, e.id.c_str(), -1, SQLITE_STATIC);
+    sqlite3_bind_text(progress, 2, step.c_str(), -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(progress, 3, now.c_str(), -1, SQLITE_STATIC);
+    run(progress);
+    sqlite3_bind_text(event, 1, now.c_str(), -1, SQLITE_STATIC);
+    sqlite3_bind_text(event, 2, payload.c_str(), -1, SQLITE_TRANSIENT);
+    run(event);
+    run(commit);
+    ++i;
+  }
+  for (auto* st : {begin, commit, journal, max_seq, measurement, progress, event}) sqlite3_finalize(st);
+  sqlite3_close(db);
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_RawStep_Full)->Unit(benchmark::kMicrosecond);
+
+// One row per commit through raw SQLite with the store's settings: FULL (durable), NORMAL (no fsync per
+// commit) and one transaction for all.
 void raw_inserts(benchmark::State& state, const char* sync, bool batched) {
   colorlab::testing::TempDir dir;
   sqlite3* db = nullptr;
   sqlite3_open((dir / "raw.db").c_str(), &db);
-  sqlite3_exec(db, "PRAGMA journal_mode=WAL", nullptr, nullptr, nullptr);
-  sqlite3_exec(db, (std::string("PRAGMA synchronous=") + sync).c_str(), nullptr, nullptr, nullptr);
+  store_settings(db, sync);
   sqlite3_exec(db, "CREATE TABLE m(run TEXT, seq INT, step TEXT, value REAL, data TEXT, PRIMARY KEY(run, step)) WITHOUT ROWID",
                nullptr, nullptr, nullptr);
   sqlite3_stmt* st = nullptr;
@@ -146,4 +238,17 @@ BENCHMARK(BM_RunsPage_Offset_Deep)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+  // Interleaved repetitions unless the command line says otherwise (later flags win).
+  std::vector<char*> args{argv[0]};
+  std::string reps = "--benchmark_repetitions=5", interleave = "--benchmark_enable_random_interleaving=true";
+  args.push_back(reps.data());
+  args.push_back(interleave.data());
+  for (int i = 1; i < argc; ++i) args.push_back(argv[i]);
+  int n = static_cast<int>(args.size());
+  benchmark::Initialize(&n, args.data());
+  if (benchmark::ReportUnrecognizedArguments(n, args.data())) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
