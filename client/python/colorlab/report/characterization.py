@@ -5,8 +5,8 @@ its chart-read run, and its own fits' error statistics (ΔE00 and ΔE*ab mean/ma
 the black box's residual statistics and curves). Per-patch errors are not stored, so the report computes those
 the dissertation's way from the patch values and the reference (colour.py): the camera's colour space (§7.1),
 the lab's matrix/shaper profile rebuilt (§7.2) — both checked against the daemon's own ΔE*ab — and the eleven
-polynomials of §7.3. The black box's per-patch residuals need its fitted model, which the run does not keep:
-Table 13 shows the stored statistics.
+polynomials of §7.3. Table 13 shows the black box's stored residual statistics (min, median, mean, max, stdev per
+channel; runs since issue 11 also store each patch's residual).
 """
 from __future__ import annotations
 
@@ -40,6 +40,24 @@ def reference(run):
     xyz = m["data.XYZ"] if "data.XYZ" in m else [None] * len(m)
     return {i: (np.asarray(v, float), None if x is None else np.asarray(x, float))
             for i, v, x in zip(m["data.id"], m["data.Lab"], xyz)}
+
+
+def reference_patches(run, minimum: int) -> dict | None:
+    """The first test case (8-bit TIFF, JPEG, 16-bit TIFF) with at least `minimum` patches in the reference run:
+    {"fmt", "ids", "rgb" (0-1 of full scale), "lab", "xyz" (None when the reference lacks XYZ)}; None without one."""
+    ref = reference(run)
+    if not ref:
+        return None
+    for fmt in TEST_CASES:
+        ids, rgb = patches(run, fmt)
+        keep = [k for k, i in enumerate(ids) if i in ref]
+        if len(keep) >= minimum:
+            ids = [ids[k] for k in keep]
+            xyz = [ref[i][1] for i in ids]
+            return {"fmt": fmt, "ids": ids, "rgb": rgb[keep] / FULL_SCALE[fmt],
+                    "lab": np.stack([ref[i][0] for i in ids]),
+                    "xyz": np.stack(xyz) if all(x is not None for x in xyz) else None}
+    return None
 
 
 def analyse(run) -> dict:
@@ -194,13 +212,17 @@ def table13(run, formats) -> str:
         return ""
     t = bb["residuals"].get("training") or {}
     cols = ["R", "G", "B"]
-    measured = {c: {"Max": t.get(c, {}).get("max"), "Median": t.get(c, {}).get("median"),
-                    "Mean": t.get(c, {}).get("mean"), "Stdev": t.get(c, {}).get("stdev")} for c in cols}
+    measured = {c: {"Min": t.get(c, {}).get("min"), "Max": t.get(c, {}).get("max"),
+                    "Median": t.get(c, {}).get("median"), "Mean": t.get(c, {}).get("mean"),
+                    "Stdev": t.get(c, {}).get("stdev")} for c in cols}
+    missing_min = any(t.get(c, {}).get("min") is None for c in cols)
     return table(f"{run.short}-table13", f"Table 13 — black-box residuals of R, G, B against the RAW "
                  f"({esc(bb['residuals'].get('unit', 'counts'))}, full scale {bb.get('full_scale', 4095):g})",
                  cols, _stats_rows(measured, pub.TABLE13, cols, kind="stored"), corner="statistic",
                  note=f"Published: {esc(pub.TABLE13.ref())}. Stored: the lab's black box ({esc(bb.get('kind', ''))}; "
-                      f"{esc(bb.get('spd_note', ''))}), training residuals; the minimum is not stored.")
+                      f"{esc(bb.get('spd_note', ''))}), |predicted − measured| counts over the training patches"
+                      + ("; this run predates the stored minimum." if missing_min else
+                         ", with each patch's signed residual stored beside them."))
 
 
 def stored_polynomials(run, formats) -> str:
@@ -343,11 +365,11 @@ def figures(run, a, formats):
         ax.set_title("(a) recovered spectral sensitivities")
         t = (bb.get("residuals") or {}).get("training") or {}
         x = np.arange(3)
-        for k, stat in enumerate(("max", "median", "mean", "stdev")):
-            bx.bar(x + k * 0.2, [t.get(c, {}).get(stat, np.nan) for c in "RGB"], 0.2, label=stat)
+        for k, stat in enumerate(("min", "max", "median", "mean", "stdev")):
+            bx.bar(x + k * 0.16, [t.get(c, {}).get(stat, np.nan) for c in "RGB"], 0.16, label=stat)
         pubmax = pub.TABLE13.row("Max").values()
-        bx.plot(x + 0.3, pubmax, "k_", ms=18, mew=2, label="published max")
-        bx.set_xticks(x + 0.3, list("RGB"))
+        bx.plot(x + 0.16, pubmax, "k_", ms=18, mew=2, label="published max")
+        bx.set_xticks(x + 0.32, list("RGB"))
         bx.set_ylabel("residual (counts)")
         bx.legend(fontsize=6)
         bx.set_title("(b) residuals against the RAW")

@@ -137,15 +137,8 @@ def stored_models(run, fmt):
 
 def poly_inputs(run):
     """(format, ids, rgb 0-1, reference L*a*b*) of the first test case with a reference, else None."""
-    ref = ch.reference(run)
-    if not ref:
-        return None
-    for fmt in ch.TEST_CASES:
-        ids, rgb = ch.patches(run, fmt)
-        keep = [k for k, i in enumerate(ids) if i in ref]
-        if len(keep) >= 30:
-            return fmt, [ids[k] for k in keep], rgb[keep] / ch.FULL_SCALE[fmt], np.stack([ref[ids[k]][0] for k in keep])
-    return None
+    d = ch.reference_patches(run, 30)
+    return (d["fmt"], d["ids"], d["rgb"], d["lab"]) if d else None
 
 
 def refits(rgb01, lab, k: int = 10):

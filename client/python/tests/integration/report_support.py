@@ -1,5 +1,6 @@
-"""Helpers for the report's integration tests: make a report through the CLI exactly as colorlab's own CLI will
-(``python3 -m colorlab.report``), read its tables back from the markup, and open it in headless Chromium."""
+"""Helpers for the report's integration tests: a daemon on the simulated lab with the campaigns a test needs
+(``ReportCase``), a report made through the CLI exactly as colorlab's own CLI will (``python3 -m colorlab.report``),
+its tables read back from the markup, and the file opened in headless Chromium."""
 from __future__ import annotations
 
 import os
@@ -10,11 +11,48 @@ import unittest
 from html.parser import HTMLParser
 from pathlib import Path
 
+import daemon_fixture
 from daemon_fixture import BIN_DIR, SOURCE_DIR
 
 ARTIFACTS = Path(os.environ.get("COLORLAB_BIN_DIR") or BIN_DIR).resolve().parent / "test-artifacts" / "report"
 CHROMIUM = Path("/usr/bin/chromium")
 CHROMEDRIVER = Path("/usr/bin/chromedriver")
+
+
+def start_daemon(*, seed: int, lab_toml: str | None = None, time_scale: float = 500) -> daemon_fixture.Daemon:
+    """A daemon on the simulated lab; `lab_toml` replaces the fixture's simulated-lab configuration for it."""
+    saved = daemon_fixture.LAB_TOML
+    if lab_toml is not None:
+        daemon_fixture.LAB_TOML = lab_toml
+    try:
+        return daemon_fixture.Daemon(time_scale=time_scale, seed=seed)
+    finally:
+        daemon_fixture.LAB_TOML = saved
+
+
+class ReportCase(unittest.TestCase):
+    """One daemon per test class: started in setUpClass with SEED and LAB_TOML, then ``campaigns(daemon)`` runs what
+    the class needs (and may make its report); the daemon is cleaned up when that fails, and after the class."""
+
+    SEED = 3
+    LAB_TOML: str | None = None
+
+    @classmethod
+    def campaigns(cls, daemon) -> None:
+        raise NotImplementedError
+
+    @classmethod
+    def setUpClass(cls):
+        cls.daemon = start_daemon(seed=cls.SEED, lab_toml=cls.LAB_TOML)
+        try:
+            cls.campaigns(cls.daemon)
+        except BaseException:
+            cls.daemon.cleanup()
+            raise
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.daemon.cleanup()
 
 
 def make_report(daemon, run_ids, name: str) -> Path:

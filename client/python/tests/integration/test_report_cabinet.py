@@ -13,8 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from daemon_fixture import Daemon
-from report_support import check_in_browser, make_report, parse
+from report_support import ReportCase, check_in_browser, make_report, parse
 
 THESIS = Path(os.environ.get("COLORLAB_DISSERTATION", "/work/shared/seed/ulbricht-2006-dissertation.txt"))
 
@@ -78,24 +77,16 @@ def difference_map(half):
     return full - full.min()
 
 
-class CabinetReport(unittest.TestCase):
-    @classmethod
-    def setUpClass(cls):
-        cls.daemon = Daemon(time_scale=500, seed=7)
-        try:
-            cls.full = cls.daemon.run_to_end("cabinet-grid", lamps=["D65"], dimmer_levels=[100, 50, 25, 15],
-                                             settle_s=0)["run_id"]
-            cls.small = cls.daemon.run_to_end("cabinet-grid", rows=2, cols=5, lamps=["D65", "TL84", "CWF"],
-                                              dimmer_levels=[100, 50], settle_s=0)["run_id"]
-            cls.path = make_report(cls.daemon, [cls.full, cls.small], "cabinet-grid")
-            cls.tables, cls.ids = parse(cls.path)
-        except BaseException:
-            cls.daemon.cleanup()
-            raise
+class CabinetReport(ReportCase):
+    SEED = 7
 
     @classmethod
-    def tearDownClass(cls):
-        cls.daemon.cleanup()
+    def campaigns(cls, d):
+        cls.full = d.run_to_end("cabinet-grid", lamps=["D65"], dimmer_levels=[100, 50, 25, 15], settle_s=0)["run_id"]
+        cls.small = d.run_to_end("cabinet-grid", rows=2, cols=5, lamps=["D65", "TL84", "CWF"], dimmer_levels=[100, 50],
+                                 settle_s=0)["run_id"]
+        cls.path = make_report(d, [cls.full, cls.small], "cabinet-grid")
+        cls.tables, cls.ids = parse(cls.path)
 
     def check_run(self, run_id):
         grids = stored_grids(self.daemon, run_id)

@@ -11,8 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-import daemon_fixture
-from report_support import check_in_browser, make_report, parse
+from report_support import ReportCase, check_in_browser, make_report, parse
 
 THESIS = Path(os.environ.get("COLORLAB_DISSERTATION", "/work/shared/seed/ulbricht-2006-dissertation.txt"))
 # The chart must span hundreds of pixels for the locator (as tests/integration/characterize_camera_test.cpp).
@@ -83,37 +82,25 @@ def thesis_stats(number):
     return rows
 
 
-class CharacterizationReport(unittest.TestCase):
-    @classmethod
-    def setUpClass(cls):
-        saved = daemon_fixture.LAB_TOML
-        daemon_fixture.LAB_TOML = LAB_TOML
-        try:
-            cls.daemon = daemon_fixture.Daemon(time_scale=500, seed=5)
-        finally:
-            daemon_fixture.LAB_TOML = saved
-        try:
-            cls.ref = cls.daemon.run_to_end("chart-read")["run_id"]
-            cls.cc = cls.daemon.run_to_end("characterize-camera", reference_run=cls.ref, frames=2,
-                                           prior_exclude=["Canon_20D"])["run_id"]
-            cls.path = make_report(cls.daemon, [cls.cc], "characterize-camera")
-            cls.tables, _ = parse(cls.path)
-            stored_ref = cls.daemon.stored_measurements(cls.ref)
-            ref = {m["data"]["id"]: np.array(m["data"]["Lab"]) for m in stored_ref}
-            cls.xyz = {m["data"]["id"]: np.array(m["data"]["XYZ"]) for m in stored_ref}
-            cls.patches = {}
-            for m in cls.daemon.stored_measurements(cls.cc):
-                p = re.match(r"^patch/(\w+)/(\w+)$", m["step"])
-                if p:
-                    cls.patches.setdefault(p[1], []).append((p[2], np.array(m["data"]["rgb"]), ref[p[2]]))
-            cls.result = cls.daemon.client.run(cls.cc)["summary"]["script"]
-        except BaseException:
-            cls.daemon.cleanup()
-            raise
+class CharacterizationReport(ReportCase):
+    SEED = 5
+    LAB_TOML = LAB_TOML
 
     @classmethod
-    def tearDownClass(cls):
-        cls.daemon.cleanup()
+    def campaigns(cls, d):
+        cls.ref = d.run_to_end("chart-read")["run_id"]
+        cls.cc = d.run_to_end("characterize-camera", reference_run=cls.ref, frames=2, prior_exclude=["Canon_20D"])["run_id"]
+        cls.path = make_report(d, [cls.cc], "characterize-camera")
+        cls.tables, _ = parse(cls.path)
+        stored_ref = d.stored_measurements(cls.ref)
+        ref = {m["data"]["id"]: np.array(m["data"]["Lab"]) for m in stored_ref}
+        cls.xyz = {m["data"]["id"]: np.array(m["data"]["XYZ"]) for m in stored_ref}
+        cls.patches = {}
+        for m in d.stored_measurements(cls.cc):
+            p = re.match(r"^patch/(\w+)/(\w+)$", m["step"])
+            if p:
+                cls.patches.setdefault(p[1], []).append((p[2], np.array(m["data"]["rgb"]), ref[p[2]]))
+        cls.result = d.client.run(cls.cc)["summary"]["script"]
 
     def t(self, name):
         return self.tables[f"{short(self.cc)}-{name}"]
@@ -186,13 +173,23 @@ class CharacterizationReport(unittest.TestCase):
     def test_table13_from_the_stored_residuals(self):
         t = self.t("table13")
         published = thesis_stats(13)
-        res = self.result["formats"]["raw"]["approaches"]["black_box"]["residuals"]["training"]
+        residuals = self.result["formats"]["raw"]["approaches"]["black_box"]["residuals"]
+        res = residuals["training"]
+        per_patch = residuals["patches"]["training"]
+        self.assertEqual(len(set(per_patch["ids"])), 140)  # the SG's patches, each once, all in the reference
+        self.assertTrue(set(per_patch["ids"]) <= set(self.xyz))
         for k, ch in enumerate("RGB"):
-            for stat in ("Max", "Median", "Mean", "Stdev"):
+            # The statistics recomputed here from the stored per-patch residuals (|predicted − measured| counts).
+            a = np.abs(np.asarray(per_patch[ch], float))
+            own = {"Min": a.min(), "Max": a.max(), "Median": float(np.median(a)), "Mean": a.mean(),
+                   "Stdev": a.std(ddof=1)}
+            for stat in ("Min", "Max", "Median", "Mean", "Stdev"):
                 self.assertEqual(t[(f"{stat}-stored", ch, "stored")], res[ch][stat.lower()])
+                self.assertAlmostEqual(res[ch][stat.lower()], own[stat], delta=1e-9 * max(1.0, a.max()), msg=(ch, stat))
                 self.assertEqual(t[(f"{stat}-published", ch, "published")], published[stat][k])
                 self.assertAlmostEqual(t[(f"{stat}-diff", ch, "difference")],
                                        res[ch][stat.lower()] - published[stat][k], places=9)
+            self.assertLessEqual(res[ch]["min"], res[ch]["mean"])
 
     def test_approaches_table_is_what_the_run_stored(self):
         t = self.t("approaches")

@@ -8,7 +8,7 @@ import unittest
 import numpy as np
 import pandas as pd
 
-from colorlab.report import colour, pareto, stability, tradeoff
+from colorlab.report import analyze, colour, pareto, stability, tradeoff
 from colorlab.report.fetch import RunData
 
 
@@ -85,6 +85,10 @@ def synthetic_chart(n=140, seed=0):
 
 
 class Models(unittest.TestCase):
+    def test_design_term_counts(self):
+        for n, p in zip(range(1, 12), (3, 5, 6, 8, 9, 11, 13, 20, 16, 29, 19)):
+            self.assertEqual(colour.design(np.ones((2, 3)), n).shape, (2, p))
+
     def test_exact_model_cross_validates_to_zero(self):
         # L*a*b* exactly linear in r, g, b: polynomial 1 (r g b) holds it, so every fold predicts it exactly.
         rgb, lab, _ = synthetic_chart()
@@ -167,25 +171,98 @@ class Sections(unittest.TestCase):
         self.assertIsNone(pareto.repeatability([[1.0], [2.0]]))
 
 
+def xyz_to_lab_d50(xyz):
+    """CIE L*a*b* against the ICC D50 white (96.42, 100, 82.49), written out here."""
+    t = xyz / np.array([96.42, 100.0, 82.49])
+    f = np.where(t > 216 / 24389, np.cbrt(t), (24389 / 27 * t + 16) / 116)
+    return np.stack([116 * f[:, 1] - 16, 500 * (f[:, 0] - f[:, 1]), 200 * (f[:, 1] - f[:, 2])], axis=1)
+
+
+def characterization_run(rgb01, xyz, lamp="D65", run_no=2):
+    """A characterize-camera run of 8-bit patch values and its chart-read reference (XYZ and L*a*b*)."""
+    ids = [f"P{k:03d}" for k in range(len(rgb01))]
+    ref = RunData({"id": "00000000-0000-0000-0000-000000000009", "campaign": "chart-read"},
+                  pd.DataFrame({"step": [f"patch/{i}" for i in ids], "data.id": ids,
+                                "data.Lab": list(xyz_to_lab_d50(xyz)), "data.XYZ": list(xyz)}))
+    run = RunData({"id": f"00000000-0000-0000-0000-00000000000{run_no}", "campaign": "characterize-camera",
+                   "params": {"lamp": lamp}},
+                  pd.DataFrame({"step": [f"patch/tiff8/{i}" for i in ids], "data.id": ids,
+                                "data.rgb": list(rgb01 * 255.0)}))
+    run.extra["reference"] = ref
+    return run
+
+
 class Stability(unittest.TestCase):
-    def test_measured_noise_from_repeated_patches(self):
-        rng = np.random.default_rng(4)
-        lab = np.repeat(np.array([[50.0, 0, 0], [70.0, 0, 0], [30.0, 10, 10]]), 10, axis=0)
-        rgb = np.repeat(np.array([[0.5, 0.5, 0.5], [0.7, 0.7, 0.7], [0.3, 0.2, 0.2]]), 10, axis=0)
-        rgb = rgb + rng.normal(0, 0.01, rgb.shape)
-        sigma, _ = stability.measured_noise(rgb, lab)
-        self.assertLess(abs(sigma - 0.01), 4 * 0.01 / np.sqrt(2 * 81))
+    """The report's stability section runs the analysis library's suite (colorlab analyze stability) on the stored
+    values; on a chart whose XYZ is exactly linear in the camera values the answers follow from the mathematics."""
 
-    def test_polynomial_method_is_exact_on_its_own_model(self):
-        rgb, lab, _ = synthetic_chart()
-        m = stability.Polynomial(6)
-        e = stability.cv_residuals(m, rgb, lab, np.full_like(lab, np.nan))
-        self.assertLess(e.max(), 1e-8)
+    @classmethod
+    def setUpClass(cls):
+        try:
+            analyze.colorlab_binary()
+        except analyze.AnalyzeFailed as e:
+            raise unittest.SkipTest(str(e))
+        rng = np.random.default_rng(3)
+        cls.rgb = rng.uniform(0.05, 0.45, (60, 3))  # × 2 stays below full scale: no clipping
+        cls.m = np.array([[41.2, 21.3, 1.9], [35.8, 71.5, 11.9], [18.0, 7.2, 95.0]])
+        cls.cc = characterization_run(cls.rgb, cls.rgb @ cls.m)
+        cls.a = stability.analyse(cls.cc)
 
-    def test_design_term_counts(self):
-        for n, p in zip(range(1, 12), (3, 5, 6, 8, 9, 11, 13, 20, 16, 29, 19)):
-            self.assertEqual(stability.Polynomial(n).params, p)
-            self.assertEqual(colour.design(np.ones((2, 3)), n).shape, (2, p))
+    def case(self, method, kind, level=None):
+        return stability._case(self.a, method, kind, level)
+
+    def test_exact_linear_chart(self):
+        for method in stability.METHODS:
+            # Every method's terms include r, g, b: the linear truth is fitted exactly, held out or not.
+            self.assertLess(self.case(method, "training")["max"], 1e-6, method)
+            self.assertLess(self.case(method, "cross_validated")["max"], 1e-5, method)
+        # poly:1 and rootpoly:2 are homogeneous of degree 1: at any exposure (below full scale) the XYZ ÷ k is exact.
+        for method in ("poly:1", "rootpoly:2"):
+            for k in stability.EXPOSURES:
+                self.assertLess(self.case(method, "exposure", k)["max"], 1e-6, (method, k))
+        # Noise makes the fit worse than none; 10 training patches cannot determine poly:10's 29 terms.
+        self.assertGreater(self.case("poly:1", "noise", 0.02)["mean"], self.case("poly:1", "training")["mean"])
+        few = self.case("poly:10", "training_patches", 10.0)
+        self.assertEqual((few["fitted"], few["fails"], few["mean"]), (0.0, 1.0, None))
+        verdict = next(v for v in self.a["suite"]["verdicts"] if v["method"] == "poly:10")
+        self.assertEqual(verdict["fails"], 1.0)
+        self.assertEqual(self.a["inputs"]["fmt"], "tiff8")
+
+    def test_section_and_another_lamp(self):
+        # The same chart under "TL84" with every value 1 % brighter: the lamp case is the exposure-like shift,
+        # recomputed here with the exact linear model: XYZ(1.01 rgb) = 1.01 XYZ.
+        other = characterization_run(self.rgb * 1.01, self.rgb @ self.m, lamp="TL84", run_no=3)
+        self.cc.extra["other_lamps"] = [other]
+        try:
+            a = stability.analyse(self.cc)
+            html = stability.section(self.cc)
+        finally:
+            self.cc.extra["other_lamps"] = []
+        c = stability._case(a, "poly:1", "other_lamp", lamp="TL84")
+        lab = xyz_to_lab_d50(self.rgb @ self.m)
+        shifted = xyz_to_lab_d50(1.01 * (self.rgb @ self.m))
+        expect = tradeoff.delta_e00(shifted, lab)  # checked against Sharma's pairs above
+        self.assertAlmostEqual(c["mean"], expect.mean(), places=6)
+        self.assertAlmostEqual(c["max"], expect.max(), places=6)
+        for name in ("verdicts", "gamut", "noise", "learning", "exposure", "lamp"):
+            self.assertIn(f'id="{self.cc.short}-stability-{name}"', html)
+        self.assertIn("<svg", html)
+
+    def test_binary_from_the_environment(self):
+        import os
+        saved = {k: os.environ.get(k) for k in ("COLORLAB_BIN", "COLORLAB_BIN_DIR")}
+        try:
+            os.environ["COLORLAB_BIN"] = "/x/colorlab"
+            os.environ["COLORLAB_BIN_DIR"] = "/y"
+            self.assertEqual(str(analyze.colorlab_binary()), "/x/colorlab")
+            del os.environ["COLORLAB_BIN"]
+            self.assertEqual(str(analyze.colorlab_binary()), "/y/colorlab")
+        finally:
+            for k, v in saved.items():
+                if v is None:
+                    os.environ.pop(k, None)
+                else:
+                    os.environ[k] = v
 
 
 if __name__ == "__main__":
