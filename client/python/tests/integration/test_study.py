@@ -57,7 +57,7 @@ class Study(unittest.TestCase):
         lines = p.stdout.strip().splitlines()
         report = self.tmp / "report.html"
         self.assertEqual(lines[-1], str(report.resolve()), "the report's path is the last line")
-        self.assertTrue(any(re.search(r"\[\d/4\] \S+ +\d+\.\d % +ETA", line) for line in lines), p.stdout)
+        self.assertTrue(any(re.search(r"\[\d/5\] \S+ +\d+\.\d % +ETA", line) for line in lines), p.stdout)
         state = json.loads((self.tmp / "study.json").read_text())
         runs = [state["runs"][c] for c in CAMPAIGNS]
         html = report.read_text(encoding="utf-8")
@@ -108,11 +108,11 @@ class Study(unittest.TestCase):
         p = self.run_study("--resume")
         self.assertIn("re-attaching", p.stdout)
         runs = self.check_study(p)
-        self.assertEqual(len(set(runs)), 4)
+        self.assertEqual(len(set(runs)), 5)
         state = json.loads(state_file.read_text())
         items = self.queue_items(state)
-        self.assertEqual([i["state"] for i in items], ["done"] * 4, f"{first_out}\n{p.stdout}")
-        self.assertEqual(len({i["execution_id"] for i in items}), 4, "each step ran once")
+        self.assertEqual([i["state"] for i in items], ["done"] * 5, f"{first_out}\n{p.stdout}")
+        self.assertEqual(len({i["execution_id"] for i in items}), 5, "each step ran once")
 
     def test_3_a_failing_campaign_ends_the_study_with_exit_4(self):
         # Validated (first_x_mm ≤ 310) but the SG's columns then run off the SpectroScan's 310 mm.
