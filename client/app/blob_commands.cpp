@@ -1,5 +1,6 @@
 #include "blob_commands.hpp"
 
+#include <chrono>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -49,12 +50,18 @@ void add_blob_commands(CLI::App& app, GlobalOptions& global) {
   auto sha = std::make_shared<std::string>();
   auto output = std::make_shared<std::string>();
   auto preview = std::make_shared<bool>(false);
-  auto* download = app.add_subcommand("download", "Download a kept frame byte for byte (colorlab blobs RUN lists them), or its PNG preview");
+  auto* download = app.add_subcommand("download", "Download a kept frame byte for byte (colorlab blobs RUN lists them), or its PNG preview; "
+                                                  "with --json before the command (needs -o): one JSON object with the file written, its size and the time taken");
   download->add_option("sha256", *sha, "the frame's SHA-256")->required();
   download->add_option("-o,--output", *output, "file to write, or a directory (default: stdout)");
   download->add_flag("--preview", *preview, "the frame's PNG preview instead of its bytes");
   download->callback([&global, sha, output, preview] {
     check_id(*sha, "a SHA-256", "colorlab blobs RUN lists a run's frames");
+    // The frame's bytes and a JSON description cannot share stdout.
+    if (global.json && output->empty())
+      throw Error(ErrorClass::bad_parameter, "download --json describes the file it writes: give -o FILE or -o DIR",
+                  "colorlab --json download SHA256 -o DIR");
+    const auto started = std::chrono::steady_clock::now();
     const auto r = fetch_bytes(global, "/v1/blobs/" + *sha + (*preview ? "/preview.png" : ""));
     if (output->empty()) {
       std::cout.write(r.body.data(), static_cast<std::streamsize>(r.body.size()));
@@ -75,7 +82,9 @@ void add_blob_commands(CLI::App& app, GlobalOptions& global) {
       path /= file_name(*sha, kind);
     }
     write_bytes(path, r.body);
-    json done{{"path", path.string()}, {"bytes", r.body.size()}, {"sha256", *sha}};
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    json done{{"path", fs::absolute(path).string()}, {"bytes", r.body.size()}, {"sha256", *sha}, {"preview", *preview},
+              {"seconds", seconds}};
     print(global, done, [](const json& j) {
       return "wrote " + j["path"].get<std::string>() + " (" + std::to_string(j["bytes"].get<std::size_t>()) + " bytes)\n";
     });

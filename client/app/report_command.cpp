@@ -48,6 +48,9 @@ struct StudyOptions {
   // The key goes by environment, not argv, where any user's `ps` would see it.
   if (!g.key.empty()) ::setenv("COLORLAB_API_KEY", g.key.c_str(), 1);
   if (!g.cacert.empty()) ::setenv("REQUESTS_CA_BUNDLE", g.cacert.c_str(), 1);
+  // The report runs `colorlab analyze` (the stability suite): this very binary.
+  std::error_code ec;
+  if (const auto self = fs::read_symlink("/proc/self/exe", ec); !ec) ::setenv("COLORLAB_BIN", self.c_str(), 0);
   if (auto path = paths::python_client_dir().string(); !path.empty()) {
     const char* existing = std::getenv("PYTHONPATH");
     const std::string joined = existing && *existing ? path + ":" + existing : path;
@@ -69,13 +72,14 @@ void add_report_command(CLI::App& app, GlobalOptions& global) {
       "report",
       "Write the dissertation's tables and figures for stored runs (frame-average, cabinet-grid, chart-read, "
       "characterize-camera, luminance-spot) as one self-contained HTML file, each beside the published numbers; "
-      "prints its path");
+      "prints its path (with --json before the command: one JSON object with the path, the runs and the timings)");
   cmd->add_option("runs", o->runs, "run ids (colorlab runs lists them)")->required();
   cmd->add_option("-o,--output", o->output, "HTML file to write (default: ./report-<first run>.html)");
   cmd->callback([&global, o] {
     for (const auto& run : o->runs) check_id(run, "a run id", "colorlab runs lists them");
     std::vector<std::string> args = o->runs;
     if (!o->output.empty()) args.insert(args.end(), {"-o", o->output});
+    if (global.json) args.push_back("--json");
     // 0 written, 2 usage, 3 a run not found or the daemon unreachable.
     exec_module(global, "colorlab.report", args);
   });
@@ -84,7 +88,8 @@ void add_report_command(CLI::App& app, GlobalOptions& global) {
   auto* study = app.add_subcommand(
       "study",
       "Run a built-in study — dissertation: the SG chart read, 25-frame averaging, the cabinet grid over lamps and "
-      "dimmer levels, camera characterization — through the night queue, live, then write its report; prints its path");
+      "dimmer levels, camera characterization — through the night queue, live, then write its report; prints its path "
+      "(with --json before the command: progress on stderr, then one JSON object with the runs, the report and the timings)");
   study->add_option("study", s->study, "the study")->required()->check(CLI::IsMember({"dissertation"}));
   study->add_option("-o,--output", s->output, "the report's HTML file (default: ./report-<first run>.html)");
   study->add_option("--set", s->overrides, "override one step's parameter, STEP.KEY=VALUE (repeatable), e.g. cabinet-grid.rows=4");
@@ -100,6 +105,7 @@ void add_report_command(CLI::App& app, GlobalOptions& global) {
     if (s->dry_run) args.push_back("--dry-run");
     if (s->small) args.push_back("--small");
     if (s->resume) args.push_back("--resume");
+    if (global.json) args.push_back("--json");
     // 0 done, 2 usage, 3 the daemon, 4 a campaign of the study failed (named).
     exec_module(global, "colorlab.study", args);
   });

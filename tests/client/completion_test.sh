@@ -39,6 +39,20 @@ locate_options="$(complete_words locate-chart --)"
 for o in --blob --chart --corners --reference-run --fraction --min-confidence --json --help; do
   grep -qx -- "$o" <<<"$locate_options" || { echo "FAIL: locate-chart -- lacks $o"; fail=1; }
 done
+check "analyze" "$(help_subcommands analyze)" "$(complete_words analyze "")"
+grep -qx stability <<<"$(complete_words analyze st)" || { echo "FAIL: analyze st does not offer stability"; fail=1; }
+stability_options="$(complete_words analyze stability --)"
+for o in --train --test --other-lamp --methods --tolerance --noise --exposures --sizes --per-patch --json --help; do
+  grep -qx -- "$o" <<<"$stability_options" || { echo "FAIL: analyze stability -- lacks $o"; fail=1; }
+done
+# The global --json before report, study and download: the subcommand's own options are still offered.
+for o in --output --help; do
+  grep -qx -- "$o" <<<"$(complete_words --json report --)" || { echo "FAIL: --json report -- lacks $o"; fail=1; }
+done
+for o in --dry-run --small --set --state-file --resume --output; do
+  grep -qx -- "$o" <<<"$(complete_words --json study --)" || { echo "FAIL: --json study -- lacks $o"; fail=1; }
+done
+grep -qx -- "--output" <<<"$(complete_words --json download --)" || { echo "FAIL: --json download -- lacks --output"; fail=1; }
 # No daemon at this socket: campaign names are simply not offered, and nothing is printed.
 out="$(complete_words --socket /nonexistent/colorlab.sock run "" 2>&1)"
 check "run without a daemon" "" "$out"

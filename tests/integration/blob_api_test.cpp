@@ -232,6 +232,24 @@ TEST(BlobApi, FrameAverageKeepsItsFramesAndServesThemByteExact) {
   EXPECT_TRUE(read_all(downloaded) == raw_bytes);
   auto missing = run_command({bin_path("colorlab"), "--url", daemon.url(), "download", std::string(64, '0')});
   EXPECT_EQ(missing.exit_code, 2) << missing.err;
+  // --json: one object saying what was written (into a directory: named by the hash), the bytes the same.
+  const auto into = dir / "into";
+  std::filesystem::create_directories(into);
+  auto described = run_command({bin_path("colorlab"), "--url", daemon.url(), "--json", "download",
+                                raw["sha256"].get<std::string>(), "-o", into.string()});
+  ASSERT_EQ(described.exit_code, 0) << described.err;
+  const json d = json::parse(described.out);
+  EXPECT_EQ(d["sha256"], raw["sha256"]);
+  EXPECT_EQ(d["bytes"].get<std::size_t>(), raw_bytes.size());
+  EXPECT_EQ(d["preview"], false);
+  EXPECT_GE(d["seconds"].get<double>(), 0.0);
+  EXPECT_EQ(std::filesystem::path(d["path"].get<std::string>()).parent_path(), std::filesystem::absolute(into));
+  EXPECT_TRUE(read_all(d["path"].get<std::string>()) == raw_bytes);
+  // The frame's bytes and a JSON description cannot share stdout: refused before anything is fetched.
+  auto no_file = run_command({bin_path("colorlab"), "--url", daemon.url(), "--json", "download", raw["sha256"].get<std::string>()});
+  EXPECT_EQ(no_file.exit_code, 1) << no_file.out;
+  EXPECT_NE(no_file.err.find("-o"), std::string::npos) << no_file.err;
+  EXPECT_TRUE(no_file.out.empty());
 
   // Unknown blobs and runs: problem+json 404.
   Fetched unknown = curl(daemon.url() + "/v1/blobs/" + std::string(64, '0'), {}, dir.path());

@@ -1,13 +1,16 @@
-"""python3 -m colorlab.report RUN_ID... [-o report.html] [--url URL | --socket PATH] [--key KEY]
+"""python3 -m colorlab.report RUN_ID... [-o report.html] [--url URL | --socket PATH] [--key KEY] [--json]
 
-Writes one self-contained HTML report of the stored runs and prints its path as the last line of stdout.
+Writes one self-contained HTML report of the stored runs and prints its path as the last line of stdout (with
+--json: one JSON object instead, {"report": path, "runs": [...], "seconds": {"load", "render", "write", "total"}}).
 Exit codes: 0 written, 2 bad usage, 3 a run not found or the daemon unreachable (with the reason on stderr).
 """
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import sys
+import time
 from pathlib import Path
 
 import colorlab
@@ -24,6 +27,8 @@ def parse(argv):
     where.add_argument("--url", help="the daemon's URL (default: COLORLAB_URL, then the local daemon's endpoint file)")
     where.add_argument("--socket", help="the daemon's Unix socket (default: COLORLAB_SOCKET)")
     p.add_argument("--key", help="API key (default: COLORLAB_API_KEY); reading needs the read scope")
+    p.add_argument("--json", action="store_true",
+                   help="print one JSON object (the report's path, the runs, the timings) instead of the path")
     return p.parse_args(argv)
 
 
@@ -33,6 +38,7 @@ def main(argv=None) -> int:
     except SystemExit as e:  # argparse: 0 for --help, 2 for bad usage
         return int(e.code or 0)
     from . import build
+    started = time.monotonic()
     try:
         client = colorlab.Client.from_options(args.url, args.socket, args.key)
     except Exception as e:
@@ -54,14 +60,24 @@ def main(argv=None) -> int:
         return EXIT_USAGE
     finally:
         client.close()
+    loaded = time.monotonic()
     out = Path(args.output or f"report-{args.runs[0]}.html")
     html = build.render(runs)
+    rendered = time.monotonic()
     if out.parent and not out.parent.exists():
         out.parent.mkdir(parents=True, exist_ok=True)
     tmp = out.with_name(out.name + ".tmp")
     tmp.write_text(html, encoding="utf-8")
     os.replace(tmp, out)  # whole or not at all: a reader never sees half a report
-    print(out.resolve())
+    done = time.monotonic()
+    if args.json:
+        print(json.dumps({"report": str(out.resolve()), "runs": [{"id": r.id, "kind": build.fetch.kind_of(r),
+                                                                  "campaign": r.campaign} for r in runs],
+                          "bytes": out.stat().st_size,
+                          "seconds": {"load": loaded - started, "render": rendered - loaded, "write": done - rendered,
+                                      "total": done - started}}, indent=2))
+    else:
+        print(out.resolve())
     return EXIT_OK
 
 

@@ -12,8 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
-from daemon_fixture import SOURCE_DIR, Daemon
-from report_support import check_in_browser, make_report, parse
+from daemon_fixture import SOURCE_DIR
+from report_support import ReportCase, check_in_browser, make_report, parse
 
 THESIS = Path(os.environ.get("COLORLAB_DISSERTATION", "/work/shared/seed/ulbricht-2006-dissertation.txt"))
 
@@ -31,21 +31,14 @@ def thesis_table2():
     return out
 
 
-class FrameAverageReport(unittest.TestCase):
-    @classmethod
-    def setUpClass(cls):
-        cls.daemon = Daemon(time_scale=500, seed=11)
-        try:
-            cls.fa = cls.daemon.run_to_end("frame-average", frames=25)["run_id"]
-            cls.ls = cls.daemon.run_to_end("luminance-spot", readings=6)["run_id"]
-            cls.cr = cls.daemon.run_to_end("chart-read")["run_id"]
-        except BaseException:
-            cls.daemon.cleanup()
-            raise
+class FrameAverageReport(ReportCase):
+    SEED = 11
 
     @classmethod
-    def tearDownClass(cls):
-        cls.daemon.cleanup()
+    def campaigns(cls, d):
+        cls.fa = d.run_to_end("frame-average", frames=25)["run_id"]
+        cls.ls = d.run_to_end("luminance-spot", readings=6)["run_id"]
+        cls.cr = d.run_to_end("chart-read")["run_id"]
 
     def report(self):
         if not hasattr(type(self), "_path"):
@@ -150,6 +143,36 @@ class FrameAverageReport(unittest.TestCase):
                            env=env, timeout=60)
         self.assertNotEqual(p.returncode, 0)
         self.assertIn("not a run id", p.stderr)
+
+    def test_json_output(self):
+        """`colorlab --json report` (and the module's --json): stdout is one JSON object — the report's path, its
+        runs in order with their kinds, its size and where the time went — instead of the path."""
+        import json
+        from daemon_fixture import BIN_DIR
+        out = Path(self.daemon.dir) / "as-json.html"
+        env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+        p = subprocess.run([str(BIN_DIR / "colorlab"), "--socket", self.daemon.endpoint["unix_socket"], "--json",
+                            "report", self.fa, self.ls, "-o", str(out)], capture_output=True, text=True, env=env,
+                           timeout=120)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        j = json.loads(p.stdout)
+        self.assertEqual(j["report"], str(out.resolve()))
+        self.assertEqual([(r["id"], r["kind"]) for r in j["runs"]],
+                         [(self.fa, "frame-average"), (self.ls, "luminance-spot")])
+        self.assertEqual(j["bytes"], out.stat().st_size)
+        parts = j["seconds"]
+        self.assertTrue(all(parts[k] >= 0 for k in ("load", "render", "write")), parts)
+        self.assertAlmostEqual(parts["total"], parts["load"] + parts["render"] + parts["write"], places=6)
+        # The module itself, as `colorlab study` and the daemon run it; failures stay on stderr with their exit codes.
+        menv = dict(os.environ, PYTHONPATH=str(SOURCE_DIR / "client" / "python"))
+        p = subprocess.run([sys.executable, "-m", "colorlab.report", "--json", "--url", self.daemon.url, self.fa, "-o",
+                            str(out)], capture_output=True, text=True, env=menv, timeout=120)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertEqual(json.loads(p.stdout)["runs"][0]["id"], self.fa)
+        p = subprocess.run([sys.executable, "-m", "colorlab.report", "--json", "--url", self.daemon.url,
+                            "01900000-0000-7000-8000-00000000dead", "-o", os.devnull], capture_output=True, text=True,
+                           env=menv, timeout=60)
+        self.assertEqual((p.returncode, p.stdout), (3, ""))
 
     def test_the_daemon_serves_the_report_of_an_ended_run(self):
         """GET /v1/runs/{id}/report: 202 with Retry-After while the daemon's child process makes it, then the HTML,
