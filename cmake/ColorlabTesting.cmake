@@ -1,10 +1,12 @@
 # colorlab_add_gtest(NAME name LABEL unit|integration|conformance|hardware SOURCES ... LIBS ... [TIMEOUT s]
-#                   [RESOURCE_LOCK name])  — tests sharing a lock never run at the same time (e.g. the one
-#                   GigE Vision fake camera that can serve 127.0.0.1).
+#                   [RESOURCE_LOCK name] [TUNING pattern...])  — tests sharing a lock never run at the same time
+#                   (e.g. the one GigE Vision fake camera that can serve 127.0.0.1). TUNING names, as gtest filter
+#                   patterns, the tests that check the simulator's tuning to the dissertation rather than the code:
+#                   they get the label `tuning` beside LABEL (docs/TESTING.md, "Analytic truth and tuning checks").
 # Tests find the built executables through COLORLAB_BIN_DIR and the source tree through
 # COLORLAB_SOURCE_DIR; the shared reference data is optional (tests skip with a reason).
 function(colorlab_add_gtest)
-  cmake_parse_arguments(T "" "NAME;LABEL;TIMEOUT;RESOURCE_LOCK" "SOURCES;LIBS" ${ARGN})
+  cmake_parse_arguments(T "" "NAME;LABEL;TIMEOUT;RESOURCE_LOCK" "SOURCES;LIBS;TUNING" ${ARGN})
   if(NOT T_TIMEOUT)
     set(T_TIMEOUT 300)
   endif()
@@ -19,5 +21,22 @@ function(colorlab_add_gtest)
   if(T_RESOURCE_LOCK)
     list(APPEND _props RESOURCE_LOCK ${T_RESOURCE_LOCK})
   endif()
-  gtest_discover_tests(${T_NAME} PROPERTIES ${_props} DISCOVERY_TIMEOUT 60)
+  if(T_TUNING)
+    # Two discoveries of the same binary, split by gtest filter: every test is registered exactly once, under its
+    # usual name. gtest_discover_tests cannot pass a list-valued property (LABELS "unit;tuning" arrives split), so
+    # the second label is set by a script ctest runs after the discovered tests are loaded, from their TEST_LIST.
+    list(JOIN T_TUNING ":" _tuning)
+    gtest_discover_tests(${T_NAME} TEST_FILTER "-${_tuning}" TEST_LIST ${T_NAME}_TESTS
+                         PROPERTIES ${_props} DISCOVERY_TIMEOUT 60)
+    gtest_discover_tests(${T_NAME} TEST_FILTER "${_tuning}" TEST_LIST ${T_NAME}_TUNING_TESTS
+                         PROPERTIES ${_props} DISCOVERY_TIMEOUT 60)
+    set(_labels_file "${CMAKE_CURRENT_BINARY_DIR}/${T_NAME}_tuning_labels.cmake")
+    file(WRITE "${_labels_file}"
+         "foreach(_test IN LISTS ${T_NAME}_TUNING_TESTS)\n"
+         "  set_tests_properties(\"\${_test}\" PROPERTIES LABELS \"${T_LABEL};tuning\")\n"
+         "endforeach()\n")
+    set_property(DIRECTORY APPEND PROPERTY TEST_INCLUDE_FILES "${_labels_file}")
+  else()
+    gtest_discover_tests(${T_NAME} PROPERTIES ${_props} DISCOVERY_TIMEOUT 60)
+  endif()
 endfunction()

@@ -128,6 +128,8 @@ TEST(AnalysisRobustPatch, BayerChannelsSeparated) {
   EXPECT_FLOAT_EQ(bggr[2].value, 1000);
 }
 
+// Its 8 % is a tolerance, not a bound: the chi-square bounds and the exact (Hadamard) case are in
+// AnalyticTruthAveraging.* (analytic_truth_test.cpp).
 TEST(AnalysisNoiseVsAveraging, Table2LayoutFallsAsOneOverRootN) {
   const std::size_t w = 60, h = 40, frames = 25;
   const float sigma = 2.0f;

@@ -12,6 +12,7 @@ namespace ca = colorlab::analysis;
 namespace {
 
 // A cabinet brightest in the middle of the front (row 7, column 9 of the left half), like the dissertation's D65.
+// Checked against independent recomputation here; closed-form answers are in AnalyticTruthUniformity.*.
 Eigen::MatrixXd cabinet(double scale) {
   Eigen::MatrixXd g(8, 10);
   for (int r = 0; r < 8; ++r)

@@ -55,6 +55,9 @@ TEST(EmbeddedDefault, DaemonWithoutConfigStartsTheSimulatedLab) {
   EXPECT_EQ(daemon.process().wait(std::chrono::seconds(10)), 0) << "colorlabd must stop cleanly on SIGTERM";
 }
 
+// Tuning (ctest label `tuning`): checks the simulator's tuning to the dissertation, not the analysis; the analysis is
+// checked by AnalyticTruthAveraging.* (analysis_analytic_truth_test), the stored rows by
+// BlobApi.FrameAverageKeepsItsFramesAndServesThemByteExact (recomputed from the kept average).
 // §6.1.3 / Table 2 through the whole stack: GigE Vision over loopback, the camera driver, the
 // analysis code, the store. Truth is the shape physics demands: the spread of an averaged uniform
 // region falls with N, roughly as 1/√N at first, then levels off at the fixed-pattern floor.

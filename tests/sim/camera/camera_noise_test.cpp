@@ -29,6 +29,8 @@ double patch_green_std(const std::vector<double>& img, int width, const CameraMo
   return std::sqrt(std::max(0.0, s2 / n - mean * mean));
 }
 
+// Tuning: checks the simulator's tuning to the dissertation (Table 2's shape), not the analysis; the analysis is
+// checked by AnalyticTruthAveraging.* (analysis_analytic_truth_test).
 TEST(SimFrameAveraging, NoiseFallsAsInverseRootNDownToTheFixedPatternFloor) {
   const CameraModel cam(test::d65_scene(), test::small_camera());
   const CameraSettings s;

@@ -224,6 +224,8 @@ TEST(SimTable, ApertureSeesPatchesSurroundAndPlate) {
 namespace colorlab::sim {
 namespace {
 
+// Tuning: checks the simulator's tuning to the dissertation, not the analysis; the analysis is checked by
+// AnalyticTruthUniformity.* (analysis_analytic_truth_test).
 // §6.2's reason for choosing the chart position: equal white border patches must not differ much, but the
 // field's non-uniformity does show on them.
 TEST(SimChart, FieldNonUniformityShowsOnIdenticalBorderPatches) {

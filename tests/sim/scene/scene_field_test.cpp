@@ -26,6 +26,8 @@ Grid lamp_grid(const Scene& s, Lamp l, double dimmer) {
 
 class SimFieldTest : public ::testing::TestWithParam<std::uint64_t> {};
 
+// Tuning (ctest label `tuning`): checks the simulator's tuning to the dissertation, not the analysis; the analysis is
+// checked by AnalyticTruthUniformity.* (analysis_analytic_truth_test). Likewise every SimFieldTest below.
 TEST_P(SimFieldTest, D65FullRangeAndBrightestSpotMatchSection62) {
   const Scene scene(synthetic_config(GetParam()), std::make_shared<SimClock>());
   const Grid g = lamp_grid(scene, Lamp::d65, 100);
@@ -76,6 +78,8 @@ TEST_P(SimFieldTest, Tl84AndCwfAreLessUniformThanD65) {
   EXPECT_GT(test::best_window_std(lamp_grid(scene, Lamp::cwf, 100)), best_d65);
 }
 
+// Tuning: checks the simulator's tuning to the dissertation, not the analysis; the analysis is checked by
+// AnalyticTruthUniformity.* (closed-form windows, best placement, dimmer proportionality).
 // The same numbers through analysis' §6.2 implementation, fed the way the dissertation measured: the left
 // half of the grid (8 × 10 spots), mirrored.
 TEST_P(SimFieldTest, AnalysisLibraryMeasuresTheDissertationsNumbers) {
@@ -108,6 +112,8 @@ TEST_P(SimFieldTest, AnalysisLibraryMeasuresTheDissertationsNumbers) {
 
 INSTANTIATE_TEST_SUITE_P(SimSeeds, SimFieldTest, ::testing::Values(1u, 7u, 12345u));
 
+// Tuning: checks the simulator's tuning to the dissertation (its dimmer's response), not the analysis; the analysis
+// is checked by AnalyticTruthUniformity.DimmerProportionalityIsExactForProportionalLightAndMeasuresAShortfall.
 TEST(SimDimmer, ResponseIsMonotonicAndNotProportional) {
   EXPECT_DOUBLE_EQ(Scene::dimmer_output(100), 1.0);
   EXPECT_DOUBLE_EQ(Scene::dimmer_output(0), 0.0);
