@@ -66,9 +66,9 @@ class Study(unittest.TestCase):
             run = self.daemon.client.conn.get(f"/v1/runs/{run_id}")
             self.assertEqual((run["campaign"], run["status"]), (campaign, "finished_ok"))
             self.assertIn(f'data-run="{run_id}" data-kind="{campaign}"', html)
-        cc = self.daemon.client.conn.get(f"/v1/runs/{runs[3]}")
+        cc = self.daemon.client.conn.get(f"/v1/runs/{runs[CAMPAIGNS.index('characterize-camera')]}")
         self.assertEqual(cc["params"]["reference_run"], runs[0], "characterized against the study's chart-read")
-        grid = self.daemon.client.conn.get(f"/v1/runs/{runs[2]}")["params"]
+        grid = self.daemon.client.conn.get(f"/v1/runs/{runs[CAMPAIGNS.index('cabinet-grid')]}")["params"]
         self.assertEqual((grid["rows"], grid["cols"], grid["lamps"]), (2, 5, ["D65", "TL84"]))
         return runs
 
