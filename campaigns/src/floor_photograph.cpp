@@ -8,6 +8,7 @@
 #include <boost/asio/use_awaitable.hpp>
 
 #include "colorlab/analysis/floor_luminance.hpp"
+#include "colorlab/campaigns/frame_statistics.hpp"
 #include "colorlab/core/error.hpp"
 #include "colorlab/drivers/camera/asio_camera.hpp"
 #include "colorlab/drivers/camera/camera_instrument.hpp"
@@ -159,17 +160,7 @@ json spot_json(const Spot& spot, const std::array<double, 2>& px, std::size_t pi
 boost::asio::awaitable<json> photograph_floor(cam::CameraInstrument& instrument, const json& options, FrameKeeper* keeper) {
   const FloorOptions p = parse(options);
   auto& camera = instrument.camera();
-  // The sensor's counts, as camera.capture asks a GenICam camera for them.
-  const auto formats = camera.limits().pixel_formats;
-  if (!formats.empty() && !camera.settings().pixel_format) {
-    cam::CameraSettings settings;
-    settings.pixel_format = formats.front();
-    for (auto preferred : {cam::PixelFormat::bayer_rg16, cam::PixelFormat::bayer_rg12}) {
-      if (std::find(formats.begin(), formats.end(), preferred) != formats.end()) settings.pixel_format = preferred;
-    }
-    auto error = co_await cam::async_configure(camera, settings, boost::asio::use_awaitable);
-    if (error) throw *error;
-  }
+  co_await use_sensor_counts(camera);
   auto series = std::make_shared<FloorSeries>();
   auto kept = std::make_shared<detail::SeriesFrames>();
   kept->keep_first = p.keep.wants("raw");

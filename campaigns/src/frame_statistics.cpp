@@ -66,6 +66,19 @@ void choose_uniform_region(const cam::RawImage& image, RegionFrames& g) {
 
 }  // namespace
 
+boost::asio::awaitable<void> use_sensor_counts(cam::Camera& camera) {
+  // Averaging needs the sensor's counts: ask a GenICam camera for its raw Bayer (or mono) format.
+  const auto formats = camera.limits().pixel_formats;
+  if (formats.empty() || camera.settings().pixel_format) co_return;
+  cam::CameraSettings settings;
+  settings.pixel_format = formats.front();
+  for (auto preferred : {cam::PixelFormat::bayer_rg16, cam::PixelFormat::bayer_rg12}) {
+    if (std::find(formats.begin(), formats.end(), preferred) != formats.end()) settings.pixel_format = preferred;
+  }
+  auto error = co_await cam::async_configure(camera, settings, boost::asio::use_awaitable);
+  if (error) throw *error;
+}
+
 boost::asio::awaitable<json> capture_noise_table(cam::CameraInstrument& instrument, const json& options, FrameKeeper* keeper) {
   const int frames = options.value("frames", 25);
   const auto keep = detail::parse_keep(options, "camera.capture", {"average", "raw", "preview"}, {"average", "raw", "preview"});
@@ -74,17 +87,7 @@ boost::asio::awaitable<json> capture_noise_table(cam::CameraInstrument& instrume
   const bool keeping = keeper && keep.any();
   if (frames < 1 || frames > 256) throw Error(ErrorClass::bad_parameter, "camera.capture: frames must be from 1 to 256");
   auto& camera = instrument.camera();
-  // Averaging needs the sensor's counts: ask a GenICam camera for its raw Bayer (or mono) format.
-  const auto formats = camera.limits().pixel_formats;
-  if (!formats.empty() && !camera.settings().pixel_format) {
-    cam::CameraSettings settings;
-    settings.pixel_format = formats.front();
-    for (auto preferred : {cam::PixelFormat::bayer_rg16, cam::PixelFormat::bayer_rg12}) {
-      if (std::find(formats.begin(), formats.end(), preferred) != formats.end()) settings.pixel_format = preferred;
-    }
-    auto error = co_await cam::async_configure(camera, settings, boost::asio::use_awaitable);
-    if (error) throw *error;
-  }
+  co_await use_sensor_counts(camera);
 
   auto region = std::make_shared<RegionFrames>();
   if (options.contains("region") && options["region"].is_array() && options["region"].size() == 4) {

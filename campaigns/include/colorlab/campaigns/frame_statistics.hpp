@@ -9,6 +9,7 @@
 #include "colorlab/campaigns/frame_keeper.hpp"
 
 namespace colorlab::drivers::camera {
+class Camera;
 class CameraInstrument;
 }
 
@@ -18,6 +19,10 @@ namespace colorlab::campaigns {
 // {frames, region = {x, y, w, h}, rows = [{frames, channel, stdev, mean}], unit = "DN above black",
 // blobs = [kept blob references]}. `keep` (with a keeper): the series' average as a float array, the
 // first frame as captured (its raw file, or its counts as a <u2 array), a PNG preview of the average.
+// A camera that offers pixel formats (GenICam) and has none set is asked for its raw Bayer counts (16, else 12 bit,
+// else its first format): what averaging and spot values need. Error from the camera otherwise.
+boost::asio::awaitable<void> use_sensor_counts(drivers::camera::Camera& camera);
+
 boost::asio::awaitable<nlohmann::json> capture_noise_table(drivers::camera::CameraInstrument& camera,
                                                            const nlohmann::json& options, FrameKeeper* keeper = nullptr);
 
