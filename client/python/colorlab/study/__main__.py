@@ -1,9 +1,10 @@
 """python3 -m colorlab.study dissertation [--url URL | --socket PATH] [--key KEY] [-o report.html] [--dry-run]
-                                        [--small] [--set STEP.KEY=VALUE …] [--state-file FILE] [--resume]
+                                        [--small] [--set STEP.KEY=VALUE …] [--state-file FILE] [--resume] [--json]
 
 Runs the study's campaigns through the daemon's night queue (so it survives a restart of colorlabd), follows
 them by the event stream printing progress lines, then writes the report of all the study's runs; the report's
-path is the last line of stdout. Exit codes: 0 ok, 2 usage, 3 daemon/run problem, 4 a campaign of the study
+path is the last line of stdout. With --json the progress lines go to stderr and stdout is one JSON object: the
+study's runs by step, the report's path and the timings (a dry run: each step's estimate). Exit codes: 0 ok, 2 usage, 3 daemon/run problem, 4 a campaign of the study
 failed (named, with its problem on stderr).
 """
 from __future__ import annotations
@@ -36,6 +37,8 @@ def parse(argv):
     p.add_argument("--state-file", help="where the study keeps its queue items (default: ./colorlab-study-STUDY.json)")
     p.add_argument("--resume", action="store_true",
                    help="re-attach to the study in --state-file (after this command or the daemon was stopped)")
+    p.add_argument("--json", action="store_true",
+                   help="progress on stderr; stdout one JSON object (runs, report path, timings) at the end")
     args = p.parse_args(argv)
     overrides: dict = {}
     names = {s["name"] for s in definition.STUDIES[args.study]}
@@ -67,7 +70,7 @@ def main(argv=None) -> int:
         print(f"colorlab study: cannot reach the daemon: {e}", file=sys.stderr)
         return EXIT_DAEMON
     steps = definition.steps(args.study, small=args.small, overrides=args.overrides)
-    study = Study(client, args.study, steps, state_file=args.state_file, resume=args.resume)
+    study = Study(client, args.study, steps, state_file=args.state_file, resume=args.resume, json_output=args.json)
     try:
         if args.dry_run:
             return study.dry_run()

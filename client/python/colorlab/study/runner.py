@@ -30,10 +30,6 @@ class StudyFailed(Exception):
     """A campaign of the study failed or could not be queued: exit 4."""
 
 
-def _say(*a) -> None:
-    print(*a, flush=True)
-
-
 def _duration(s: float | None) -> str:
     if s is None:
         return "?"
@@ -45,8 +41,12 @@ def _duration(s: float | None) -> str:
 
 class Study:
     def __init__(self, client: colorlab.Client, name: str, steps: list[dict], *, state_file: str,
-                 resume: bool = False):
+                 resume: bool = False, json_output: bool = False):
         self.client, self.name, self.steps, self.state_file = client, name, steps, state_file
+        # With --json, stdout carries one JSON object at the end: progress goes to stderr.
+        self.json_output = json_output
+        self.started = time.monotonic()
+        self.timings: dict = {}
         if resume:
             with open(state_file) as f:
                 self.state = json.load(f)
@@ -58,6 +58,12 @@ class Study:
             self.state = {"study": name, "id": str(uuid.uuid4()), "steps": steps, "items": {}, "runs": {}}
         self._progress: dict = {}  # execution id -> (first seen monotonic, its progress then)
         self._last_print = 0.0
+
+    def _say(self, *a) -> None:
+        print(*a, flush=True, file=sys.stderr if self.json_output else sys.stdout)
+
+    def _emit(self, obj: dict) -> None:
+        print(json.dumps(obj, indent=2), flush=True)
 
     # -- state ------------------------------------------------------------------------------------------
     def _save(self) -> None:
@@ -93,7 +99,7 @@ class Study:
                                   f"{e.detail or e}") from e
         self.state["items"][step["name"]] = item["id"]
         self._save()
-        _say(f"study {self.name}: queued {step['name']} as item {item['id']} (position {item.get('position')})")
+        self._say(f"study {self.name}: queued {step['name']} as item {item['id']} (position {item.get('position')})")
         return item
 
     # -- running ----------------------------------------------------------------------------------------
@@ -121,7 +127,7 @@ class Study:
                     ex = self.client.conn.get(f"/v1/executions/{item['execution_id']}")
                     self.state["runs"][step["name"]] = ex["run_id"]
                     self._save()
-                    _say(f"study {self.name}: {step['name']} finished ok: run {ex['run_id']}")
+                    self._say(f"study {self.name}: {step['name']} finished ok: run {ex['run_id']}")
                 continue
             if item["state"] in ENDED_BAD:
                 problem = item.get("reason") or item["state"]
@@ -143,7 +149,7 @@ class Study:
             with contextlib.suppress(colorlab.ColorlabError):
                 if self.client.conn.get(f"/v1/queue/{item_id}")["state"] == "queued":
                     self.client.conn.delete(f"/v1/queue/{item_id}")
-                    _say(f"study {self.name}: removed {name} (item {item_id}) from the queue")
+                    self._say(f"study {self.name}: removed {name} (item {item_id}) from the queue")
 
     def _progress_line(self, step: dict, progress: float, label: str, execution_id: str, force=False) -> None:
         now = time.monotonic()
@@ -155,15 +161,15 @@ class Study:
         if progress > first[1] and now > first[0]:
             eta = (now - first[0]) / (progress - first[1]) * (1 - progress)
         index = [s["name"] for s in self.steps].index(step["name"]) + 1
-        _say(f"[{index}/{len(self.steps)}] {step['name']:<20} {progress * 100:5.1f} %  "
-             f"ETA {_duration(eta):>8}  {label or ''}")
+        self._say(f"[{index}/{len(self.steps)}] {step['name']:<20} {progress * 100:5.1f} %  "
+                  f"ETA {_duration(eta):>8}  {label or ''}")
 
     def run(self) -> list[str]:
         """Queues the study, follows it to its end; returns the run ids in the study's order."""
         if self.state["items"]:
-            _say(f"study {self.name}: re-attaching to study {self.state['id']} ({self.state_file})")
+            self._say(f"study {self.name}: re-attaching to study {self.state['id']} ({self.state_file})")
         else:
-            _say(f"study {self.name} {self.state['id']}: {len(self.steps)} campaigns, state in {self.state_file}")
+            self._say(f"study {self.name} {self.state['id']}: {len(self.steps)} campaigns, state in {self.state_file}")
         self._save()
         events = self.client.events(give_up_after=300.0)
         try:
@@ -175,14 +181,14 @@ class Study:
             ours = set(self.state["items"].values())
             ahead = [i for i in queue.get("items") or [] if i["id"] not in ours]
             if ahead:
-                _say(f"study {self.name}: {len(ahead)} other queue item(s) run first: "
-                     f"{', '.join(i['campaign'] for i in ahead)}")
+                self._say(f"study {self.name}: {len(ahead)} other queue item(s) run first: "
+                          f"{', '.join(i['campaign'] for i in ahead)}")
             if queue.get("state") != "running":
                 # A running queue starts an item as soon as it is queued: one of ours may already have failed and
                 # halted it, and starting the queue would clear that halt. Look first.
                 self._check()
                 self.client.conn.post("/v1/queue/start")
-                _say(f"study {self.name}: queue started")
+                self._say(f"study {self.name}: queue started")
             current = None
             while True:
                 pending = self._check()
@@ -212,6 +218,7 @@ class Study:
                                f"--resume --state-file {self.state_file}") from e
         finally:
             events.close()
+        self.timings["campaigns"] = time.monotonic() - self.started
         return [self.state["runs"][s["name"]] for s in self.steps]
 
     def report(self, run_ids: list[str], args) -> int:
@@ -229,8 +236,10 @@ class Study:
             argv += ["--url", self.client.url]
         if args.key:
             argv += ["--key", args.key]
-        _say(f"study {self.name}: all {len(run_ids)} campaigns finished ok; writing the report of "
-             f"{' '.join(run_ids)}")
+        if self.json_output:
+            argv.append("--json")
+        self._say(f"study {self.name}: all {len(run_ids)} campaigns finished ok; writing the report of "
+                  f"{' '.join(run_ids)}")
         started = time.monotonic()
         out = io.StringIO()
         with contextlib.redirect_stdout(out):
@@ -239,23 +248,35 @@ class Study:
         if rc != 0 or not lines:
             print(f"colorlab study: the report failed (exit {rc})", file=sys.stderr)
             return EXIT_DAEMON
+        self.timings["report"] = time.monotonic() - started
+        if self.json_output:
+            written = json.loads(out.getvalue())
+            self._say(f"study {self.name}: report written in {self.timings['report']:.1f} s")
+            self._emit({"study": self.name, "id": self.state["id"], "state_file": os.path.abspath(self.state_file),
+                        "runs": {s["name"]: self.state["runs"][s["name"]] for s in self.steps},
+                        "run_ids": run_ids, "report": written["report"],
+                        "seconds": {**self.timings, "report_detail": written["seconds"],
+                                    "total": time.monotonic() - self.started}})
+            return EXIT_OK
         for line in lines[:-1]:
-            _say(line)
-        _say(f"study {self.name}: report written in {time.monotonic() - started:.1f} s")
-        _say(lines[-1])
+            self._say(line)
+        self._say(f"study {self.name}: report written in {self.timings['report']:.1f} s")
+        self._say(lines[-1])
         return EXIT_OK
 
     # -- dry run ----------------------------------------------------------------------------------------
     def dry_run(self) -> int:
-        total, problems = 0.0, []
+        total, problems, estimates = 0.0, [], []
         for step in self.steps:
             params = self._params(step)
             if params is None:
                 ref = step["reference"]
                 found = self._latest_run(self.steps_by_name()[ref["step"]]["campaign"])
                 if not found:
-                    _say(f"{step['name']:<20} not estimated: needs a finished {ref['step']} run "
-                         f"(the study's own, once it ran)")
+                    self._say(f"{step['name']:<20} not estimated: needs a finished {ref['step']} run "
+                              f"(the study's own, once it ran)")
+                    estimates.append({"step": step["name"], "campaign": step["campaign"], "estimated": False,
+                                      "reason": f"needs a finished {ref['step']} run"})
                     continue
                 params = {**step["params"], ref["param"]: found}
             try:
@@ -266,13 +287,20 @@ class Study:
             wall = float(est.get("wall_seconds") or 0.0)
             total += wall
             share = est.get("measured_share")
-            _say(f"{step['name']:<20} {_duration(wall):>9} wall ({_duration(est.get('lab_seconds'))} lab at "
-                 f"time scale {est.get('time_scale')}; measured share "
-                 f"{'?' if share is None else f'{share * 100:.0f} %'})  {'ok' if r.get('ok') else 'PROBLEMS'}")
+            self._say(f"{step['name']:<20} {_duration(wall):>9} wall ({_duration(est.get('lab_seconds'))} lab at "
+                      f"time scale {est.get('time_scale')}; measured share "
+                      f"{'?' if share is None else f'{share * 100:.0f} %'})  {'ok' if r.get('ok') else 'PROBLEMS'}")
+            estimates.append({"step": step["name"], "campaign": step["campaign"], "estimated": True,
+                              "wall_seconds": wall, "lab_seconds": est.get("lab_seconds"),
+                              "time_scale": est.get("time_scale"), "measured_share": share, "ok": bool(r.get("ok")),
+                              "problems": r.get("problems") or []})
             for p in r.get("problems") or []:
                 problems.append(f"{step['name']}: {p.get('kind')}: {p.get('message')}")
-                _say(f"  problem: {p.get('kind')}: {p.get('message')}")
-        _say(f"study {self.name}: estimated total {_duration(total)} ({total:.0f} s wall)")
+                self._say(f"  problem: {p.get('kind')}: {p.get('message')}")
+        self._say(f"study {self.name}: estimated total {_duration(total)} ({total:.0f} s wall)")
+        if self.json_output:
+            self._emit({"study": self.name, "dry_run": True, "steps": estimates, "total_wall_seconds": total,
+                        "ok": not problems, "seconds": {"total": time.monotonic() - self.started}})
         if problems:
             print("colorlab study: the dry run found problems:\n  " + "\n  ".join(problems), file=sys.stderr)
             return EXIT_FAILED

@@ -52,14 +52,27 @@ class Study(unittest.TestCase):
         return subprocess.run(study_command(self.daemon, self.tmp, *extra), capture_output=True, text=True, env=ENV,
                               timeout=timeout, cwd=self.tmp)
 
-    def check_study(self, p: subprocess.CompletedProcess) -> list[str]:
+    def check_study(self, p: subprocess.CompletedProcess, as_json=False) -> list[str]:
         self.assertEqual(p.returncode, 0, f"{p.stdout}\n{p.stderr}\n{self.daemon.log_text()}")
-        lines = p.stdout.strip().splitlines()
         report = self.tmp / "report.html"
-        self.assertEqual(lines[-1], str(report.resolve()), "the report's path is the last line")
-        self.assertTrue(any(re.search(r"\[\d/5\] \S+ +\d+\.\d % +ETA", line) for line in lines), p.stdout)
         state = json.loads((self.tmp / "study.json").read_text())
         runs = [state["runs"][c] for c in CAMPAIGNS]
+        if as_json:
+            # stdout is one JSON object; the progress lines went to stderr.
+            j = json.loads(p.stdout)
+            self.assertEqual((j["study"], j["id"], j["report"]), ("dissertation", state["id"], str(report.resolve())))
+            self.assertEqual(j["runs"], state["runs"])
+            self.assertEqual(j["run_ids"], runs)
+            self.assertEqual(j["state_file"], str((self.tmp / "study.json").resolve()))
+            seconds = j["seconds"]
+            self.assertGreaterEqual(seconds["total"], seconds["campaigns"] + seconds["report"] - 1e-6)
+            self.assertGreaterEqual(seconds["report"], seconds["report_detail"]["total"])
+            lines = p.stderr.strip().splitlines()
+        else:
+            lines = p.stdout.strip().splitlines()
+            self.assertEqual(lines[-1], str(report.resolve()), "the report's path is the last line")
+        self.assertTrue(any(re.search(r"\[\d/5\] \S+ +\d+\.\d % +ETA", line) for line in lines) or as_json,
+                        p.stdout)
         html = report.read_text(encoding="utf-8")
         self.assertNotIn('data-error="true"', html)
         for campaign, run_id in zip(CAMPAIGNS, runs):
@@ -105,9 +118,9 @@ class Study(unittest.TestCase):
             proc.kill()
             first_out = proc.communicate()[0]
         self.daemon.start()
-        p = self.run_study("--resume")
-        self.assertIn("re-attaching", p.stdout)
-        runs = self.check_study(p)
+        p = self.run_study("--resume", "--json")
+        self.assertIn("re-attaching", p.stderr)
+        runs = self.check_study(p, as_json=True)
         self.assertEqual(len(set(runs)), 5)
         state = json.loads(state_file.read_text())
         items = self.queue_items(state)
@@ -147,6 +160,16 @@ class Study(unittest.TestCase):
         self.assertRegex(p.stdout.splitlines()[-1], r"^study dissertation: estimated total .* \(\d+ s wall\)$")
         for campaign in CAMPAIGNS[:3]:
             self.assertRegex(p.stdout, rf"(?m)^{campaign} +\S+ wall")
+        # --json: the same estimates as one object; the text went to stderr.
+        j = json.loads(self.run_study("--dry-run", "--json", timeout=120).stdout)
+        self.assertTrue(j["dry_run"])
+        self.assertEqual([s["step"] for s in j["steps"]], CAMPAIGNS)
+        estimated = [s for s in j["steps"] if s["estimated"]]
+        # characterize-camera is estimated only when a chart-read run exists to reference (else it says why).
+        self.assertEqual([s["step"] for s in estimated][:3], CAMPAIGNS[:3])
+        self.assertTrue(all(s["reason"] for s in j["steps"] if not s["estimated"]), j["steps"])
+        self.assertAlmostEqual(j["total_wall_seconds"], sum(s["wall_seconds"] for s in estimated), places=6)
+        self.assertEqual(j["ok"], all(s["ok"] for s in estimated))
 
     def test_7_the_colorlab_cli_runs_the_study(self):
         """`colorlab study` (the C++ CLI, as scripts/quickstart.sh runs it) is this package: same options, same exits."""
@@ -158,6 +181,11 @@ class Study(unittest.TestCase):
         self.assertRegex(p.stdout.splitlines()[-1], r"^study dissertation: estimated total .* \(\d+ s wall\)$")
         p = subprocess.run(cli + ["--set", "no-dot"], capture_output=True, text=True, env=env, timeout=60, cwd=self.tmp)
         self.assertEqual(p.returncode, 2, f"{p.stdout}\n{p.stderr}")
+        # `colorlab --json study` hands --json to the module: one JSON object on stdout.
+        cli_json = cli[:1] + ["--json"] + cli[1:]
+        p = subprocess.run(cli_json + ["--dry-run"], capture_output=True, text=True, env=env, timeout=120, cwd=self.tmp)
+        self.assertEqual(p.returncode, 0, f"{p.stdout}\n{p.stderr}")
+        self.assertEqual(json.loads(p.stdout)["study"], "dissertation")
 
 
 if __name__ == "__main__":
