@@ -84,7 +84,7 @@ return {
     -- A photograph the locator refused (no chart, partly covered, unsure) fails the run — never fitted to wrong
     -- patches —, but only after recording it with the kept frame, so the operator can find the corners in exactly
     -- that photograph and give them to the next run.
-    local refusals, commands, params = {}, {}, {}
+    local refusals, commands, params, shown = {}, {}, {}, nil
     for _, format in ipairs(p.formats) do
       local f = shots.formats[format]
       if f.refused then
@@ -101,6 +101,7 @@ return {
         refusals[#refusals + 1] = string.format("the %s photograph%s: %s", format,
                                                 f.from_corners and " (with corners_" .. format .. ")" or "", f.refused.message)
         if sha then
+          shown = shown or sha
           commands[#commands + 1] = string.format("colorlab locate-chart --blob %s --chart %s --reference-run %s --corners x1,y1,x2,y2,x3,y3,x4,y4",
                                                   sha, p.chart, p.reference_run)
         else
@@ -114,7 +115,8 @@ return {
         class = "needs_operator",
         message = "the chart was not located in " .. table.concat(refusals, "; "),
         hint = "check that the whole chart is in the frame, lit and in focus; or find its four corners (the outer corners of the "
-               .. "patch grid, the first patch's first, clockwise; `colorlab download SHA256 --preview -o chart.png` shows the photograph) "
+               .. "patch grid, the first patch's first, clockwise"
+               .. (shown and "; `colorlab download " .. shown .. " --preview -o chart.png` shows the photograph" or "") .. ") "
                .. "until `" .. table.concat(commands, "` and `") .. "` locates it, then start characterize-camera again with "
                .. "the same parameters and " .. table.concat(params, " "),
       })

@@ -306,6 +306,7 @@ TEST_F(LocateChartApi, CharacterizeCameraRefusesADarkPhotographWithTheBlobAndCom
   const json error = failed["error"];
   EXPECT_EQ(error["code"], "needs_operator") << error.dump(2);
   const std::string hint = error["hint"];
+  std::printf("[ refused ] %s\n  hint: %s\n", error["detail"].get<std::string>().c_str(), hint.c_str());
   EXPECT_NE(hint.find("colorlab locate-chart --blob "), std::string::npos) << hint;
   EXPECT_NE(hint.find("-p corners_raw=["), std::string::npos) << hint;
   // The photograph named is the one the run kept (the average the locator saw), though keep asked for none.
@@ -313,7 +314,8 @@ TEST_F(LocateChartApi, CharacterizeCameraRefusesADarkPhotographWithTheBlobAndCom
   const json blobs = a.get("/v1/runs/" + run_id + "/blobs")["items"];
   ASSERT_EQ(blobs.size(), 1u) << blobs.dump(2);
   EXPECT_EQ(blobs[0]["kind"], "average");
-  EXPECT_NE(hint.find(blobs[0]["sha256"].get<std::string>()), std::string::npos) << hint;
+  EXPECT_NE(hint.find("colorlab locate-chart --blob " + blobs[0]["sha256"].get<std::string>()), std::string::npos) << hint;
+  EXPECT_NE(hint.find("colorlab download " + blobs[0]["sha256"].get<std::string>() + " --preview"), std::string::npos) << hint;
   EXPECT_EQ(locate(a, blobs[0]["sha256"], {{"reference_run", *reference_}}).first, 422);
 
   // Lit, with the operator's corners (here: the corners found in the first series' raw, the chart has not moved).
