@@ -385,7 +385,15 @@ asio::awaitable<json> Lab::perform(const std::string& call, const json& args, co
     co_return json(nullptr);
   }
   if (call == "camera.configure" || call == "camera.capture") {
-    auto camera = co_await acquire<cam::CameraInstrument>("camera");
+    // A lab with two cameras: configure{camera = id or kind} sets the one a later photograph_chart names.
+    const bool named = call == "camera.configure" && !args.empty() && args[0].is_object() && args[0].contains("camera");
+    std::shared_ptr<cam::CameraInstrument> camera;
+    if (named) {
+      camera = select_camera(instruments_, args[0]["camera"]);
+      co_await ready(*camera);
+    } else {
+      camera = co_await acquire<cam::CameraInstrument>("camera");
+    }
     if (call == "camera.capture") {
       // Named, not a temporary in the co_await: GCC 12 destroys such temporaries twice.
       json options = args.empty() ? json::object() : args[0];
@@ -395,13 +403,14 @@ asio::awaitable<json> Lab::perform(const std::string& call, const json& args, co
     cam::CameraSettings s;
     const json& o = args[0];
     for (const auto& [key, value] : o.items()) {
+      if (key == "camera") continue;
       if (!value.is_number()) throw Error(ErrorClass::script_error, "lab.camera.configure: " + key + " must be a number");
       if (key == "iso") s.iso = value.get<int>();
       else if (key == "shutter_s") s.shutter_s = value.get<double>();
       else if (key == "aperture_f") s.aperture_f = value.get<double>();
       else if (key == "exposure_us") s.exposure_us = value.get<double>();
       else if (key == "gain") s.gain = value.get<double>();
-      else throw Error(ErrorClass::script_error, "lab.camera.configure: unknown setting '" + key + "' (iso, shutter_s, aperture_f, exposure_us, gain)");
+      else throw Error(ErrorClass::script_error, "lab.camera.configure: unknown setting '" + key + "' (iso, shutter_s, aperture_f, exposure_us, gain, camera)");
     }
     auto error = co_await cam::async_configure(camera->camera(), s, asio::use_awaitable);
     if (error) throw *error;

@@ -4,7 +4,7 @@ from __future__ import annotations
 import datetime as dt
 import sys
 
-from . import cabinet_grid, characterization, common, fetch, frame_average, imaging_meter, pareto, stability, summaries
+from . import cabinet_grid, characterization, common, exposure, fetch, frame_average, imaging_meter, pareto, stability, summaries
 from .html import document, esc
 
 TITLES = {
@@ -14,11 +14,12 @@ TITLES = {
     "chart-read": "Chart reference values (§6.3)",
     "luminance-spot": "Spot luminance",
     "floor-luminance": "The camera as an imaging luminance meter (§6.2's floor)",
+    "dimmer-exposure": "Which dimmer setting to use: exposure against dimmer level (§6.2, Tables 7, 8)",
     "other": "Run summary",
 }
 
 
-SECTIONS = {"frame-average": frame_average.section, "cabinet-grid": cabinet_grid.section,
+SECTIONS = {"dimmer-exposure": exposure.section, "frame-average": frame_average.section, "cabinet-grid": cabinet_grid.section,
             "characterize-camera": characterization.section, "floor-luminance": imaging_meter.section}
 
 

@@ -45,12 +45,13 @@ def load(client, run_id: str) -> RunData:
 
 def kind_of(run: RunData) -> str:
     """The campaign by name; a lab's own copy under another name by the steps it stored."""
-    known = {"frame-average", "cabinet-grid", "characterize-camera", "chart-read", "luminance-spot", "floor-luminance"}
+    known = {"frame-average", "cabinet-grid", "characterize-camera", "chart-read", "luminance-spot", "floor-luminance",
+             "dimmer-exposure"}
     if run.campaign in known:
         return run.campaign
     steps = run.measurements.step if not run.measurements.empty else pd.Series([], dtype=str)
     for prefix, kind in (("noise/N", "frame-average"), ("L/", "cabinet-grid"),
-                         ("characterization/", "characterize-camera"), ("reading/", "luminance-spot")):
+                         ("characterization/", "characterize-camera"), ("reading/", "luminance-spot"), ("interval/", "dimmer-exposure")):
         if steps.str.startswith(prefix).any():
             return kind
     if not run.measurements.empty and (run.measurements.quantity == "reflectance_spectrum").any():

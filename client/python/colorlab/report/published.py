@@ -158,6 +158,25 @@ TABLE13 = _stats_table("Table 13", "Black-box residuals of R, G, B against the R
     ("0.81", "0.36", "0.15"), ("193.93", "295.46", "167.69"), ("57.44", "51.70", "46.30"), ("65.57", "63.98", "52.99"),
     ("45.24", "51.31", "40.77")), unit="RAW counts (0-4095)")
 
-ALL_TABLES = (TABLE2, *WINDOW_TABLES.values(), TABLE9, TABLE10, TABLE11, TABLE12, TABLE13)
+# §6.2's end, "which dimmer setting to use": one photograph per dimmer level, the exposure doubled as the light
+# halves (Table 7; exposure times printed as fractions of a second), and the interval length (max - min) of R, G, B
+# over the SG's 14 dark border patches (Table 8; 8-bit values). The text's B row label is a Cyrillic "В".
+TABLE7 = Table("Table 7", "Camera settings at 100 %, 50 %, 25 % and 15 %", "6.2", 68, ("100", "50", "25", "15"), (
+    _row("Aperture", 1110, "4.0", "4.0", "4.0", "4.0"),
+    _row("Exposure time", 1111, "1/30", "1/15", "1/8", "1/4")), unit="f-number, s")
+TABLE8 = Table("Table 8", "Interval length of R, G and B values of the dark border patches at 100 %, 50 %, 25 % and 15 %",
+               "6.2", 68, ("100", "50", "25", "15"), (
+    _row("R", 1116, "14.06", "14.53", "15.57", "19.35"),
+    _row("G", 1117, "13.61", "14.56", "14.86", "17.79"),
+    _row("B", 1118, "14.16", "14.77", "15.62", "18.62")), unit="8-bit values")
+
+
+def seconds(printed: str) -> float:
+    """An exposure time as Table 7 prints it ("1/30") in seconds."""
+    num, _, den = printed.partition("/")
+    return float(num) / float(den) if den else float(num)
+
+
+ALL_TABLES = (TABLE2, *WINDOW_TABLES.values(), TABLE7, TABLE8, TABLE9, TABLE10, TABLE11, TABLE12, TABLE13)
 ALL_SCALARS = (D65_MIN, D65_MAX, D65_RANGE, D65_15_RANGE, *DIMMER_MAX_ABS_ERROR.values(),
                *BEST_WINDOW_STDEV.values(), *WORST_WINDOW_STDEV.values())
