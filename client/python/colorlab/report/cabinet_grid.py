@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import cabinet_spots
 from . import published as pub
 from .html import difference, esc, figure, slug, table
 from .plots import subplots, to_svg
@@ -55,6 +56,7 @@ def section(run) -> str:
     if res.get("light_changes"):
         out.append(f'<p class="warn">{len(res["light_changes"])} spot(s) were read again after a lamp drifted '
                    '(the run\'s light_changes).</p>')
+    out.append(cabinet_spots.section(run))  # fig. 35
     out.append(summary_table(run, maps, uni))
     out.append(window_tables(run, uni, list(maps)))
     out.append(dimmer_table(run, res.get("dimmer_proportionality") or {}))
