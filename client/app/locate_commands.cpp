@@ -46,6 +46,15 @@ json parse_corners(const std::string& text) {
   return out;
 }
 
+// Numbers as `colorlab analyze locate-chart` prints them in CSV: six significant digits, no "1156.0".
+std::string number(const json& v) {
+  if (!v.is_number()) return v.is_string() ? v.get<std::string>() : "";
+  std::ostringstream o;
+  const double x = v.get<double>();
+  o << std::setprecision(6) << (std::abs(x) < 1e-9 ? 0.0 : x);
+  return o.str();
+}
+
 std::string text(const json& j, const char* key) {
   if (!j.contains(key)) return "";
   return j[key].is_string() ? j[key].get<std::string>() : j[key].dump();
@@ -54,17 +63,17 @@ std::string text(const json& j, const char* key) {
 // The summary a person reads, then the patches as CSV (the columns `colorlab analyze locate-chart` prints).
 void print_human(const json& r) {
   const json& c = r["chart"][0];
-  std::cout << std::fixed << std::setprecision(2);
   std::cout << "chart " << text(c, "chart") << " in blob " << r["blob"].value("sha256", std::string()) << " ("
             << r["blob"].value("media_type", std::string()) << ", " << r["blob"].value("width", 0) << "×"
             << r["blob"].value("height", 0) << ")\n";
-  std::cout << "confidence " << c.value("confidence", 0.0) << ", rotation " << c.value("rotation_deg", 0.0) << "°, "
+  std::cout << "confidence " << number(c["confidence"]) << ", rotation " << number(c["rotation_deg"]) << "°, "
             << (text(c, "from_corners") == "yes" ? "from the corners given" : "found automatically") << ", "
-            << c.value("patches_detected", 0.0) << " patches detected, reprojection rms " << c.value("reprojection_rms_px", 0.0) << " px\n";
+            << number(c["patches_detected"]) << " of " << r["patches"].size() << " patches detected, reprojection rms "
+            << number(c["reprojection_rms_px"]) << " px\n";
   std::cout << "self-check (" << text(c, "check") << "): " << (text(c, "check_passed") == "yes" ? "passed" : "FAILED")
-            << ", worst " << text(c, "check_worst_patch") << " " << c.value("check_worst_pct", 0.0) << " %\n";
+            << ", worst " << text(c, "check_worst_patch") << " " << number(c["check_worst_pct"]) << " %\n";
   std::cout << "corners:";
-  for (const auto& k : r["corners"]) std::cout << " " << k.value("x", 0.0) << "," << k.value("y", 0.0);
+  for (const auto& k : r["corners"]) std::cout << " " << number(k["x"]) << "," << number(k["y"]);
   std::cout << "\n";
   if (!text(c, "notes").empty()) std::cout << "notes: " << text(c, "notes") << "\n";
   const auto& patches = r["patches"];
@@ -75,12 +84,9 @@ void print_human(const json& r) {
   cols.emplace_back("used");
   std::cout << "\n";
   for (std::size_t i = 0; i < cols.size(); ++i) std::cout << (i ? "," : "") << cols[i];
-  std::cout << "\n" << std::setprecision(6) << std::defaultfloat;
+  std::cout << "\n";
   for (const auto& p : patches) {
-    for (std::size_t i = 0; i < cols.size(); ++i) {
-      const json& v = p[cols[i]];
-      std::cout << (i ? "," : "") << (v.is_string() ? v.get<std::string>() : v.is_null() ? "" : v.dump());
-    }
+    for (std::size_t i = 0; i < cols.size(); ++i) std::cout << (i ? "," : "") << number(p[cols[i]]);
     std::cout << "\n";
   }
 }
