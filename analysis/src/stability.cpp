@@ -32,6 +32,8 @@ void check_options(const StabilityOptions& o) {
   for (double k : o.exposures)
     if (!(k > 0 && std::isfinite(k))) throw Error(ErrorClass::bad_parameter, "stability: an exposure factor must be > 0");
   if (o.draws < 1) throw Error(ErrorClass::bad_parameter, "stability: draws must be at least 1");
+  if (o.cv.kind == CvSpec::Kind::none)
+    throw Error(ErrorClass::bad_parameter, "stability: the cross-validated case needs leave-one-out or k folds, not none");
   if (o.saturation < 0) throw Error(ErrorClass::bad_parameter, "stability: the saturation level must be ≥ 0");
 }
 

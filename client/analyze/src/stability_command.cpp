@@ -1,7 +1,6 @@
 #include "stability_command.hpp"
 
 #include <iostream>
-#include <map>
 #include <memory>
 #include <string>
 #include <utility>
@@ -18,10 +17,9 @@ namespace {
 namespace ca = colorlab::analysis;
 
 struct StabilityCliOptions {
-  std::string train, test, cv = "loo";
+  std::string train, test, cv = "loo", target = "xyz";
   std::vector<std::string> other_lamps;
   ca::StabilityOptions suite;
-  std::vector<double> sizes;
   bool per_patch = false, json = false;
 };
 
@@ -37,12 +35,9 @@ void run_stability(StabilityCliOptions o) {
     others.emplace_back(spec.substr(0, eq), ca::read_chart(spec.substr(eq + 1)));
   }
   o.suite.cv = ca::CvSpec::parse(o.cv);
-  o.suite.training_sizes.clear();
-  for (double s : o.sizes) {
-    if (!(s >= 1) || s != static_cast<double>(static_cast<std::size_t>(s)))
-      throw Error(ErrorClass::bad_parameter, "--sizes: " + std::to_string(s) + " is not a number of patches");
-    o.suite.training_sizes.push_back(static_cast<std::size_t>(s));
-  }
+  o.suite.fit.target = o.target == "lab" ? ca::FitTarget::lab_direct
+                       : o.target == "xyzw" ? ca::FitTarget::xyz_lightness_weighted
+                                            : ca::FitTarget::xyz_then_lab;
   const auto r = ca::run_stability(train, o.suite, test ? &*test : nullptr, others);
 
   Table cases{"cases", {"method", "case", "level", "label", "evaluated", "fitted", "min", "max", "median", "mean", "stdev",
@@ -73,7 +68,6 @@ void run_stability(StabilityCliOptions o) {
 
 void add_stability_command(CLI::App& analyze) {
   auto o = std::make_shared<StabilityCliOptions>();
-  o->sizes.assign(o->suite.training_sizes.begin(), o->suite.training_sizes.end());
   auto* c = analyze.add_subcommand(
       "stability",
       "Where each characterization method fails: fitted on a chart, then patches outside the training gamut, noise, "
@@ -86,14 +80,11 @@ void add_stability_command(CLI::App& analyze) {
   c->add_option("--methods", o->suite.methods, "Comma-separated: poly:1..11, hong:N, rootpoly:1..4, ccm, rbf:<term set>")
       ->delimiter(',')
       ->capture_default_str();
-  const std::map<std::string, ca::FitTarget> targets{{"xyz", ca::FitTarget::xyz_then_lab},
-                                                     {"xyzw", ca::FitTarget::xyz_lightness_weighted},
-                                                     {"lab", ca::FitTarget::lab_direct}};
-  c->add_option("--target", o->suite.fit.target, "xyz (fit XYZ, then L*a*b*), xyzw (lightness-weighted XYZ) or lab (direct)")
-      ->transform(CLI::CheckedTransformer(targets, CLI::ignore_case))
-      ->default_str("xyz");
+  c->add_option("--target", o->target, "xyz (fit XYZ, then L*a*b*), xyzw (lightness-weighted XYZ) or lab (direct)")
+      ->check(CLI::IsMember({"xyz", "xyzw", "lab"}))
+      ->capture_default_str();
   c->add_option("--input-scale", o->suite.fit.input_scale, "Divide RGB by this (0 = largest training value)")->capture_default_str();
-  c->add_option("--cv", o->cv, "The cross-validated case: loo, kN or none")->capture_default_str();
+  c->add_option("--cv", o->cv, "The cross-validated case: loo or kN (e.g. k10)")->capture_default_str();
   c->add_option("--tolerance", o->suite.tolerance_mean, "A case fails above this mean ΔE00 (the dissertation: 4-8 acceptable)")
       ->capture_default_str();
   c->add_option("--max-tolerance", o->suite.tolerance_max, "... or above this largest ΔE00")->capture_default_str();
@@ -106,7 +97,10 @@ void add_stability_command(CLI::App& analyze) {
   c->add_option("--saturation", o->suite.saturation, "Clip camera values here after noise or exposure (0 = never; 1 for "
                                                      "values scaled to full scale)")
       ->capture_default_str();
-  c->add_option("--sizes", o->sizes, "Training-set sizes for the few-patch case, comma-separated")->delimiter(',')->capture_default_str();
+  c->add_option("--sizes", o->suite.training_sizes, "Training-set sizes for the few-patch case, comma-separated")
+      ->delimiter(',')
+      ->check(CLI::Range(std::size_t{1}, std::size_t{1000000}))
+      ->capture_default_str();
   c->add_option("--gamut-fraction", o->suite.gamut_fraction, "Share of the most chromatic patches held out")->capture_default_str();
   c->add_option("--draws", o->suite.draws, "Random draws per noise level and training-set size")->capture_default_str();
   c->add_option("--seed", o->suite.seed, "Seed of the draws (a run is reproducible)")->capture_default_str();

@@ -22,10 +22,11 @@ struct StabilityOptions {
   // Any fit_method name: poly:N, hong:N, rootpoly:D, ccm, rbf:<term set>.
   std::vector<std::string> methods = {"poly:1", "poly:6", "poly:10", "rootpoly:2"};
   FitOptions fit;            // target, ridge, input scale (0 = largest training value)
-  CvSpec cv = CvSpec::loo();  // the cross-validated case
+  CvSpec cv = CvSpec::loo();  // the cross-validated case (leave-one-out or k folds)
   // A case fails when a model could not be fitted, its mean ΔE00 exceeds `tolerance_mean` or its largest exceeds
-  // `tolerance_max`. The defaults are the dissertation's: ΔE 4–8 is acceptable depending on the application (§3.2,
-  // after [Sha04]); §7.3 calls a polynomial acceptable when its maximum is close to 8.
+  // `tolerance_max`. The defaults are the dissertation's: ΔE*ab 4–8 is acceptable depending on the application (§3.2,
+  // after [Sha04]); §7.3 calls a polynomial acceptable when its maximum is close to 8. Applied here to ΔE00, which
+  // reads below ΔE*ab on saturated colours: the same numbers are, if anything, the more lenient rule.
   double tolerance_mean = 4.0;
   double tolerance_max = 8.0;
   // Out of gamut: this share of the patches with the largest reference C*ab is held out and predicted by a model
