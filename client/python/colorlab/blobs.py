@@ -180,6 +180,26 @@ class BlobsMixin:
         # bytearray: a writable array (frombuffer over bytes is read-only), at the cost of one copy.
         return np.frombuffer(bytearray(data), dtype=dtype).reshape(shape)
 
+    def locate_chart(self, blob, chart: str = "sg", *, corners=None, reference_run=None,
+                     sample_fraction: float | None = None, min_confidence: float | None = None) -> dict:
+        """Find the chart in a kept photograph (``POST /v1/blobs/{sha256}/locate-chart``): its corners, confidence,
+        orientation and every patch's centre and robust value, as ``colorlab locate-chart --json`` prints them.
+
+        ``corners`` are the operator's four ``(x, y)`` (A1's corner first, clockwise) when the locator is unsure;
+        ``reference_run`` a chart-read run whose luminances tell light patches from the chart's surround. A refusal
+        raises ``Unprocessable`` whose ``code`` is ``chart-not-found`` or ``chart-needs-corners`` and whose
+        ``hint`` says how to give corners."""
+        body: dict = {"chart": chart}
+        if corners is not None:
+            body["corners"] = [[float(x), float(y)] for x, y in corners]
+        if reference_run is not None:
+            body["reference_run"] = run_id(reference_run)
+        if sample_fraction is not None:
+            body["sample_fraction"] = sample_fraction
+        if min_confidence is not None:
+            body["min_confidence"] = min_confidence
+        return self.conn.post(f"/v1/blobs/{blob_sha(blob)}/locate-chart", body)
+
     def preview(self, blob) -> bytes:
         """A frame's PNG preview (``IPython.display.Image(client.preview(sha))`` shows it)."""
         return self.conn.request("GET", f"/v1/blobs/{blob_sha(blob)}/preview.png").content

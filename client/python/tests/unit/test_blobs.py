@@ -1,5 +1,6 @@
 """Blobs: arrays from their dtype/shape/CFA headers, parts through Range, integrity by sha256."""
 import hashlib
+import json
 import re
 import tempfile
 import unittest
@@ -103,6 +104,34 @@ class BlobTest(unittest.TestCase):
         df = self.lab.blobs("r1")
         self.assertEqual(df["sha256"].tolist(), [SHA])
         np.testing.assert_array_equal(self.lab.read_array(df.iloc[0]), FRAME)  # a row is a blob too
+
+
+class LocateChartTest(unittest.TestCase):
+    def setUp(self):
+        self.fake = self.enterContext(FakeDaemon())
+        self.lab = self.enterContext(colorlab.Client(self.fake.url))
+        self.path = f"/v1/blobs/{DNG_SHA}/locate-chart"
+
+    def test_the_operators_corners_and_reference_go_in_the_body(self):
+        located = {"chart": {"kind": "sg", "confidence": 0.97, "from_corners": True}, "patches": []}
+        self.fake.routes[("POST", self.path)] = lambda h: h.send_json(200, located)
+        got = self.lab.locate_chart({"sha256": DNG_SHA}, "sg", corners=[(10, 20), (110, 20), (110, 90), (10, 90)],
+                                    reference_run={"id": "r7"}, sample_fraction=0.5)
+        self.assertEqual(got, located)
+        (_, _, _, headers, body), = self.fake.requests_to("POST", self.path)
+        self.assertEqual(headers.get("Content-Type"), "application/json")
+        self.assertEqual(json.loads(body), {"chart": "sg", "corners": [[10.0, 20.0], [110.0, 20.0], [110.0, 90.0],
+                                                                       [10.0, 90.0]],
+                                            "reference_run": "r7", "sample_fraction": 0.5})
+
+    def test_a_refusal_is_unprocessable_with_the_daemons_hint(self):
+        self.fake.routes[("POST", self.path)] = lambda h: h.send_problem(
+            422, "chart-needs-corners", "Chart needs corners", "the locator is not sure (confidence 0.41)",
+            hint='give "corners"')
+        with self.assertRaises(colorlab.Unprocessable) as caught:
+            self.lab.locate_chart(DNG_SHA)
+        self.assertEqual((caught.exception.code, caught.exception.hint), ("chart-needs-corners", 'give "corners"'))
+        self.assertEqual(json.loads(self.fake.requests_to("POST", self.path)[0][4]), {"chart": "sg"})
 
 
 class ExportTest(unittest.TestCase):
