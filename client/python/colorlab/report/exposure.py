@@ -103,7 +103,9 @@ def section(run) -> str:
                            "border patches of the ColorChecker SG — C1, F1, I1, L1, C10, F10, I10, L10, A2, A5, A8, N3, "
                            "N6, N9 (the border's repeated black, L* 6.5) — per channel. The dissertation's numbers are "
                            "8-bit values of its 20D's photographs; the measured ones are the run's "
-                           f"{esc(fmt8)} values." + ("" if fmt8 == "tiff8" else " (The run has no 8-bit TIFF: the "
+                           f"{esc(fmt8)} values. The dissertation puts its spread down to noise from the longer "
+                           "exposures; the simulated camera's noise, averaged over each patch's pixels, and its smooth "
+                           "light across the chart leave a spread about ten times smaller." + ("" if fmt8 == "tiff8" else " (The run has no 8-bit TIFF: the "
                                                      "published values compare only in trend.)"))))
     dp = dark_patches(run)
     if "raw" in iv and "raw" in dp:

@@ -52,6 +52,15 @@ DISSERTATION = [
         "reference": {"param": "reference_run", "step": "chart-read"},
         "covers": "Tables 9-13, figs. 51-60, black box",
     },
+    {
+        "name": "dimmer-exposure",
+        "campaign": "dimmer-exposure",
+        # §6.2's end: one SG photograph per dimmer level, exposure doubled as the light halves (Table 7), the dark
+        # border patches' interval lengths (Table 8). Last: it leaves the camera at 1/30 s, f/4 and the dimmer at 100 %.
+        "params": {"levels": [100, 50, 25, 15]},
+        "reference": {"param": "reference_run", "step": "chart-read"},
+        "covers": "Tables 7, 8",
+    },
 ]
 
 # --small: the same campaigns, reduced (tests, a first look): a 2 x 5 grid at two lamps and levels,
@@ -62,6 +71,7 @@ SMALL_OVERRIDES = {
     "characterize-camera": {"frames": 2},
     "floor-luminance": {"rows": 2, "cols": 5, "lamps": ["D65", "TL84"], "dimmer_levels": [100, 50], "settle_s": 0,
                         "frames": 2},
+    "dimmer-exposure": {"levels": [100, 15], "shutter_s": [1 / 30, 1 / 4]},
 }
 
 STUDIES = {"dissertation": DISSERTATION}

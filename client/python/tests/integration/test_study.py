@@ -20,7 +20,7 @@ from daemon_fixture import SOURCE_DIR
 # The chart must be located in the DSLR's photographs: the size characterize-camera's report test uses.
 LAB_TOML = "[genicam]\nenabled = false\n[dslr]\nsize = [1752, 1168]\n"
 ENV = dict(os.environ, PYTHONPATH=str(SOURCE_DIR / "client" / "python"), PYTHONUNBUFFERED="1")
-CAMPAIGNS = ["chart-read", "frame-average", "cabinet-grid", "floor-luminance", "characterize-camera"]
+CAMPAIGNS = ["chart-read", "frame-average", "cabinet-grid", "floor-luminance", "characterize-camera", "dimmer-exposure"]
 
 
 def study_command(daemon, tmp: Path, *extra) -> list[str]:
@@ -71,7 +71,7 @@ class Study(unittest.TestCase):
         else:
             lines = p.stdout.strip().splitlines()
             self.assertEqual(lines[-1], str(report.resolve()), "the report's path is the last line")
-        self.assertTrue(any(re.search(r"\[\d/5\] \S+ +\d+\.\d % +ETA", line) for line in lines) or as_json,
+        self.assertTrue(any(re.search(rf"\[\d/{len(CAMPAIGNS)}\] \S+ +\d+\.\d % +ETA", line) for line in lines) or as_json,
                         p.stdout)
         html = report.read_text(encoding="utf-8")
         self.assertNotIn('data-error="true"', html)
@@ -81,6 +81,8 @@ class Study(unittest.TestCase):
             self.assertIn(f'data-run="{run_id}" data-kind="{campaign}"', html)
         cc = self.daemon.client.conn.get(f"/v1/runs/{runs[CAMPAIGNS.index('characterize-camera')]}")
         self.assertEqual(cc["params"]["reference_run"], runs[0], "characterized against the study's chart-read")
+        de = runs[CAMPAIGNS.index("dimmer-exposure")]
+        self.assertIn(f'id="r{de.replace("-", "")[-12:]}-table8"', html, "Tables 7 and 8 from the study's dimmer-exposure")
         grid = self.daemon.client.conn.get(f"/v1/runs/{runs[CAMPAIGNS.index('cabinet-grid')]}")["params"]
         self.assertEqual((grid["rows"], grid["cols"], grid["lamps"]), (2, 5, ["D65", "TL84"]))
         return runs
@@ -121,11 +123,11 @@ class Study(unittest.TestCase):
         p = self.run_study("--resume", "--json")
         self.assertIn("re-attaching", p.stderr)
         runs = self.check_study(p, as_json=True)
-        self.assertEqual(len(set(runs)), 5)
+        self.assertEqual(len(set(runs)), len(CAMPAIGNS))
         state = json.loads(state_file.read_text())
         items = self.queue_items(state)
-        self.assertEqual([i["state"] for i in items], ["done"] * 5, f"{first_out}\n{p.stdout}")
-        self.assertEqual(len({i["execution_id"] for i in items}), 5, "each step ran once")
+        self.assertEqual([i["state"] for i in items], ["done"] * len(CAMPAIGNS), f"{first_out}\n{p.stdout}")
+        self.assertEqual(len({i["execution_id"] for i in items}), len(CAMPAIGNS), "each step ran once")
 
     def test_3_a_failing_campaign_ends_the_study_with_exit_4(self):
         # Validated (first_x_mm ≤ 310) but the SG's columns then run off the SpectroScan's 310 mm.
