@@ -2,13 +2,17 @@
 // queued items keep positions 1..N through move, remove and start; only queued items can be
 // removed or moved (typed errors); a retried enqueue returns the same item; the queue's rows and
 // state survive a reopen; an execution started under an item's key is adopted, never duplicated;
-// every change is in the event log.
+// every change is in the event log. References to an earlier item's run (issue 11): the 5 → 6
+// migration keeps queued items; an unknown or ended reference is refused at enqueue, a move that puts
+// an item before its reference is refused, each with its typed code; resolve writes the run in; a
+// sequence's items go in as one group.
 #include <functional>
 
 #include <gtest/gtest.h>
 #include <sqlite3.h>
 
 #include "colorlab/core/error.hpp"
+#include "colorlab/core/ids.hpp"
 #include "colorlab/store/queue.hpp"
 #include "colorlab/store/schema.hpp"
 #include "colorlab/store/store.hpp"
@@ -89,7 +93,7 @@ TEST(queue_store, MigrationFromVersionTwoKeepsTheDataAndAddsAStoppedEmptyQueue) 
     execution_id = store.create_execution(run).execution.id;
   }
   // The file as version 2 left it: no queue tables (nor the later call timings).
-  exec_sql(path, "DROP TABLE queue_items; DROP TABLE queue_state; DROP TABLE call_timings; DROP TABLE run_blobs; DROP TABLE blobs; DROP TABLE api_keys; PRAGMA user_version = 2;");
+  exec_sql(path, "DROP TABLE queue_groups; DROP TABLE queue_items; DROP TABLE queue_state; DROP TABLE call_timings; DROP TABLE run_blobs; DROP TABLE blobs; DROP TABLE api_keys; PRAGMA user_version = 2;");
   Store store(path);
   {
     colorlab::store::Database db(path.string(), true);
@@ -287,4 +291,183 @@ TEST(queue_store, EveryChangeIsInTheEventLog) {
   auto last = store.events(0, 100, "queue").back().payload["item"];
   EXPECT_EQ(last["reason"], "finished_error: the tile is dirty");
   EXPECT_EQ(last["execution_id"], execution);
+}
+
+namespace {
+
+std::string conflict_code(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const colorlab::store::QueueConflict& e) {
+    EXPECT_EQ(e.cls(), ErrorClass::conflict);
+    return e.code();
+  } catch (const Error& e) {
+    ADD_FAILURE() << "not a QueueConflict: " << e.what();
+    return "";
+  }
+  ADD_FAILURE() << "no error thrown";
+  return "";
+}
+
+NewQueueItem taking_run_of(const std::string& item_id) {
+  NewQueueItem n{"characterize-camera", {{"reference_run", {{"$run_of", item_id}}}}, OnFailure::stop, std::nullopt};
+  n.param_refs = colorlab::store::run_of_references(n.params);
+  return n;
+}
+
+}  // namespace
+
+TEST(queue_store, MigrationFromVersionFiveKeepsQueuedItemsWithoutReferences) {
+  TempDir dir;
+  auto path = dir / "colorlab.db";
+  std::string id;
+  {
+    Store store(path);
+    QueueStore queue(store);
+    id = queue.enqueue(spot(3)).item.id;
+  }
+  exec_sql(path,
+           "DROP INDEX queue_items_by_group; DROP TABLE queue_groups; ALTER TABLE queue_items DROP COLUMN param_refs; "
+           "ALTER TABLE queue_items DROP COLUMN group_id; ALTER TABLE queue_items DROP COLUMN step; "
+           "PRAGMA user_version = 5;");
+  Store store(path);
+  {
+    colorlab::store::Database db(path.string(), true);
+    EXPECT_EQ(colorlab::store::schema_version(db), colorlab::store::kSchemaVersion);
+  }
+  QueueStore queue(store);
+  auto item = queue.item(id);
+  ASSERT_TRUE(item);
+  EXPECT_EQ(item->params["readings"], 3);
+  EXPECT_EQ(item->position, 1);
+  EXPECT_TRUE(item->param_refs.empty());
+  EXPECT_FALSE(item->group_id);
+  EXPECT_FALSE(item->has_unresolved_references());
+}
+
+TEST(queue_store, RunOfReferencesAreReadAndMalformedOnesRefused) {
+  using colorlab::store::run_of_references;
+  auto refs = run_of_references({{"a", {{"$run_of", "x"}}}, {"b", "plain"}, {"c", {{"other", 1}}}});
+  EXPECT_EQ(refs, (std::map<std::string, std::string>{{"a", "x"}}));
+  EXPECT_EQ(error_of([] { run_of_references({{"a", {{"$run_of", 3}}}}); }).cls(), ErrorClass::bad_parameter);
+  EXPECT_EQ(error_of([] { run_of_references({{"a", {{"$run_of", "x"}, {"more", 1}}}}); }).cls(),
+            ErrorClass::bad_parameter);
+  EXPECT_EQ(error_of([] { run_of_references({{"a", {{"$run_of", ""}}}}); }).cls(), ErrorClass::bad_parameter);
+}
+
+TEST(queue_store, AReferenceMustNameAnItemThatExistsAndCanStillRun) {
+  TempDir dir;
+  Store store(dir / "colorlab.db");
+  QueueStore queue(store);
+  EXPECT_EQ(conflict_code([&] { queue.enqueue(taking_run_of("0190a000-0000-7000-8000-000000000000")); }),
+            "queue-reference-unknown");
+  auto first = queue.enqueue(spot(1)).item;
+  auto taker = queue.enqueue(taking_run_of(first.id));
+  ASSERT_TRUE(taker.created);
+  EXPECT_EQ(taker.item.param_refs, (std::map<std::string, std::string>{{"reference_run", first.id}}));
+  EXPECT_TRUE(taker.item.has_unresolved_references());
+  EXPECT_EQ(taker.item.to_json()["param_refs"]["reference_run"], first.id);
+
+  auto gone = queue.enqueue(spot(2)).item;
+  queue.remove(gone.id);
+  EXPECT_EQ(conflict_code([&] { queue.enqueue(taking_run_of(gone.id)); }), "queue-reference-ended");
+  auto failing = queue.enqueue(spot(2)).item;
+  queue.mark_running(failing.id, new_execution(store));
+  queue.finish(failing.id, QueueItemState::failed, "the tile is dirty");
+  EXPECT_EQ(conflict_code([&] { queue.enqueue(taking_run_of(failing.id)); }), "queue-reference-ended");
+  EXPECT_EQ(queued_ids(queue), (std::vector<std::string>{first.id, taker.item.id})) << "a refusal stores nothing";
+
+  // Running and done items can be referenced: their run exists or will.
+  auto running = queue.enqueue(spot(2)).item;
+  queue.mark_running(running.id, new_execution(store));
+  EXPECT_TRUE(queue.enqueue(taking_run_of(running.id)).created);
+  queue.finish(running.id, QueueItemState::done, "");
+  EXPECT_TRUE(queue.enqueue(taking_run_of(running.id)).created);
+}
+
+TEST(queue_store, AMoveThatPutsAnItemBeforeItsReferenceIsRefused) {
+  TempDir dir;
+  Store store(dir / "colorlab.db");
+  QueueStore queue(store);
+  auto a = queue.enqueue(spot(1)).item.id;
+  auto b = queue.enqueue(spot(2)).item.id;
+  auto c = queue.enqueue(taking_run_of(a)).item.id;  // a, b, c: c takes a's run
+  EXPECT_EQ(conflict_code([&] { queue.move(c, 1); }), "queue-reference-order");
+  EXPECT_EQ(conflict_code([&] { queue.move(a, 3); }), "queue-reference-order");
+  EXPECT_EQ(queued_ids(queue), (std::vector<std::string>{a, b, c})) << "a refused move changes nothing";
+  queue.move(c, 2);  // still after a
+  EXPECT_EQ(queued_ids(queue), (std::vector<std::string>{a, c, b}));
+  queue.move(b, 1);
+  EXPECT_EQ(queued_ids(queue), (std::vector<std::string>{b, a, c}));
+  queue.move(a, 1);
+  EXPECT_EQ(queued_ids(queue), (std::vector<std::string>{a, b, c}));
+  // Once a has started, c may go anywhere among the queued.
+  queue.mark_running(a, new_execution(store));
+  queue.move(c, 1);
+  EXPECT_EQ(queued_ids(queue), (std::vector<std::string>{c, b}));
+}
+
+TEST(queue_store, ResolveWritesTheRunIdIntoTheItemDurably) {
+  TempDir dir;
+  auto path = dir / "colorlab.db";
+  std::string taker;
+  {
+    Store store(path);
+    QueueStore queue(store);
+    auto a = queue.enqueue(spot(1)).item.id;
+    taker = queue.enqueue(taking_run_of(a)).item.id;
+    auto item = *queue.item(taker);
+    json params = item.params;
+    params["reference_run"] = "the-run";
+    auto resolved = queue.resolve(taker, params);
+    EXPECT_EQ(resolved.params["reference_run"], "the-run");
+    EXPECT_FALSE(resolved.has_unresolved_references());
+    EXPECT_EQ(resolved.param_refs.at("reference_run"), a) << "the reference is kept beside the resolved value";
+  }
+  Store store(path);
+  QueueStore queue(store);
+  EXPECT_EQ(queue.item(taker)->params["reference_run"], "the-run");
+  bool logged = false;
+  for (const auto& e : store.events(0, 100, "queue")) {
+    if (e.payload.value("change", "") == "resolved") logged = true;
+  }
+  EXPECT_TRUE(logged);
+}
+
+TEST(queue_store, AGroupGoesInAtOnceWithItsReferencesAndARetryReturnsIt) {
+  TempDir dir;
+  Store store(dir / "colorlab.db");
+  QueueStore queue(store);
+  auto other = queue.enqueue(spot(1)).item.id;
+  std::string first_id = colorlab::new_uuid_v7();
+  NewQueueItem first = spot(2);
+  first.id = first_id;
+  first.step = "chart-read";
+  first.idempotency_key = "g/chart-read";
+  NewQueueItem second = taking_run_of(first_id);
+  second.step = "characterize-camera";
+  second.idempotency_key = "g/characterize-camera";
+  auto made = queue.enqueue_group("group-1", "dissertation", {{"small", true}}, {first, second});
+  ASSERT_TRUE(made.created);
+  ASSERT_EQ(made.group.items.size(), 2u);
+  EXPECT_EQ(made.group.sequence, "dissertation");
+  EXPECT_EQ(made.group.options["small"], true);
+  EXPECT_EQ(made.group.items[0].id, first_id);
+  EXPECT_EQ(made.group.items[0].step, "chart-read");
+  EXPECT_EQ(made.group.items[1].group_id, "group-1");
+  EXPECT_EQ(made.group.items[1].param_refs.at("reference_run"), first_id);
+  EXPECT_EQ(queued_ids(queue), (std::vector<std::string>{other, first_id, made.group.items[1].id}));
+
+  auto again = queue.enqueue_group("group-2", "dissertation", json::object(), {first, second});
+  EXPECT_FALSE(again.created);
+  EXPECT_EQ(again.group.id, "group-1");
+  EXPECT_EQ(queued_ids(queue).size(), 3u);
+  EXPECT_FALSE(queue.group("group-2"));
+
+  // A group whose reference is refused stores nothing of itself.
+  NewQueueItem bad = taking_run_of("0190a000-0000-7000-8000-000000000000");
+  EXPECT_EQ(conflict_code([&] { queue.enqueue_group("group-3", "x", json::object(), {spot(1), bad}); }),
+            "queue-reference-unknown");
+  EXPECT_FALSE(queue.group("group-3"));
+  EXPECT_EQ(queued_ids(queue).size(), 3u);
 }

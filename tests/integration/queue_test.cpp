@@ -3,7 +3,10 @@
 // the daemon — SIGTERM or kill -9 in the middle of an item, and after the restart the engine
 // resumes that item's execution (it is not started twice) and the rest follow; autostart, and a
 // halt that autostart does not override; a paused execution holds the queue and stop lets the
-// running item finish; enqueue is validated exactly as a direct start; the CLI.
+// running item finish; enqueue is validated exactly as a direct start; the CLI. An item that takes
+// an earlier item's run ({"$run_of": id}, issue 11): it gets that run's id when it comes up, is skipped
+// with the reason when the referenced item failed, a bad reference and a reorder are refused with typed
+// 409s, and the reference survives kill -9 of the daemon during and between the two items.
 #include <fstream>
 #include <functional>
 #include <map>
@@ -30,6 +33,20 @@ return {
     local r = lab.meter.measure()
     lab.record("before", { quantity = "luminance", value = r.luminance, unit = r.unit, instrument = r.instrument })
     error("the tile is dirty")
+  end,
+}
+)lua";
+
+// Records the run id it was given (its parameter source_run) with one reading.
+const char* kTakesRun = R"lua(
+return {
+  description = "takes an earlier run",
+  needs = { "luminance_meter" },
+  parameters = { source_run = { type = "string", description = "a run id" } },
+  run = function(p)
+    local r = lab.meter.measure()
+    lab.record("given", { quantity = "luminance", value = r.luminance, unit = r.unit, instrument = r.instrument,
+                          data = { source_run = p.source_run } })
   end,
 }
 )lua";
@@ -471,4 +488,162 @@ TEST(queue_daemon, CliAddsListsMovesRemovesStartsAndStops) {
   auto stopped = cli({"--json", "queue", "stop"});
   ASSERT_EQ(stopped.exit_code, 0) << stopped.err;
   EXPECT_EQ(json::parse(stopped.out)["state"], "stopped");
+}
+
+namespace {
+
+json run_of_item(const std::string& item_id) { return {{"source_run", {{"$run_of", item_id}}}}; }
+
+std::string run_id_of(const ApiClient& api, const json& item) {
+  return api.get("/v1/executions/" + item["execution_id"].get<std::string>())["run_id"];
+}
+
+// The source_run the takes-run item's campaign was given, as it recorded it.
+std::string recorded_source_run(const ApiClient& api, const json& item) {
+  auto run = run_of(api, item);
+  if (run["measurements"].empty()) return {};
+  return run["measurements"][0]["data"].value("source_run", std::string());
+}
+
+colorlab::protocol::Problem problem_of(const std::function<void()>& call) {
+  try {
+    call();
+  } catch (const ApiError& e) {
+    return e.problem();
+  }
+  ADD_FAILURE() << "accepted";
+  return colorlab::protocol::Problem{};
+}
+
+}  // namespace
+
+TEST(queue_references, AnItemGetsTheRunOfTheItemItReferencesWhenItComesUp) {
+  TempDir dir;
+  DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), 20, 1));
+  std::ofstream(dir / "state" / "campaigns" / "takes-run.lua") << kTakesRun;
+  auto api = api_for(daemon);
+  std::string first = enqueue(api, "luminance-spot", spot(2))["id"];
+  std::string other = enqueue(api, "luminance-spot", spot(1))["id"];
+  auto taker = enqueue(api, "takes-run", run_of_item(first));
+  EXPECT_EQ(taker["params"]["source_run"], json({{"$run_of", first}})) << "unresolved while queued";
+  EXPECT_EQ(taker["param_refs"]["source_run"], first);
+  api.post("/v1/queue/start", json::object());
+  auto q = wait_queue(api, emptied);
+  ASSERT_TRUE(emptied(q)) << q.dump(1);
+  auto done = item_in(q, taker["id"]);
+  ASSERT_EQ(done["state"], "done") << done.dump(1);
+  std::string first_run = run_id_of(api, item_in(q, first));
+  EXPECT_NE(first_run, run_id_of(api, item_in(q, other)));
+  EXPECT_EQ(done["params"]["source_run"], first_run) << "the item keeps its resolved parameter";
+  EXPECT_EQ(done["param_refs"]["source_run"], first);
+  EXPECT_EQ(recorded_source_run(api, done), first_run) << "the campaign must have been given the run id";
+}
+
+TEST(queue_references, AnItemWhoseReferenceFailedDoesNotStartAndTheItemsPolicyApplies) {
+  TempDir dir;
+  DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), 20, 1));
+  std::ofstream(dir / "state" / "campaigns" / "dirty-tile.lua") << kDirtyTile;
+  std::ofstream(dir / "state" / "campaigns" / "takes-run.lua") << kTakesRun;
+  auto api = api_for(daemon);
+  std::string failing = enqueue(api, "dirty-tile", json::object(), "continue")["id"];
+  std::string taker = enqueue(api, "takes-run", run_of_item(failing), "stop")["id"];
+  std::string last = enqueue(api, "luminance-spot", spot(1))["id"];
+  api.post("/v1/queue/start", json::object());
+  auto q = wait_queue(api, [](const json& q) { return q["halted"] == true; });
+  ASSERT_EQ(q["halted"], true) << q.dump(1);
+  EXPECT_EQ(item_in(q, failing)["state"], "failed");
+  auto skipped = item_in(q, taker);
+  EXPECT_EQ(skipped["state"], "skipped") << skipped.dump(1);
+  EXPECT_TRUE(skipped["execution_id"].is_null()) << "it must not start";
+  std::string reason = skipped["reason"];
+  EXPECT_NE(reason.find(failing), std::string::npos) << reason;
+  EXPECT_NE(reason.find("failed"), std::string::npos) << reason;
+  EXPECT_NE(reason.find("source_run"), std::string::npos) << reason;
+  EXPECT_NE(q["reason"].get<std::string>().find(taker), std::string::npos) << "its on_failure = stop halts the queue";
+  EXPECT_EQ(item_in(q, last)["state"], "queued");
+  EXPECT_EQ(run_count(api), 1u);
+
+  // A removed reference: the item is skipped the same way; with continue the queue goes on.
+  std::string removed = enqueue(api, "luminance-spot", spot(1))["id"];
+  std::string orphan = enqueue(api, "takes-run", run_of_item(removed), "continue")["id"];
+  api.del("/v1/queue/" + removed);
+  api.post("/v1/queue/start", json::object());
+  q = wait_queue(api, emptied);
+  ASSERT_TRUE(emptied(q)) << q.dump(1);
+  EXPECT_EQ(item_in(q, orphan)["state"], "skipped");
+  EXPECT_NE(item_in(q, orphan)["reason"].get<std::string>().find("removed"), std::string::npos);
+  EXPECT_EQ(item_in(q, last)["state"], "done");
+  EXPECT_EQ(q["halted"], false);
+}
+
+TEST(queue_references, ABadReferenceAndAReorderBeforeTheReferenceAreRefusedWithTypedCodes) {
+  TempDir dir;
+  DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), 20, 1));
+  std::ofstream(dir / "state" / "campaigns" / "takes-run.lua") << kTakesRun;
+  auto api = api_for(daemon);
+  auto unknown = problem_of([&] { enqueue(api, "takes-run", run_of_item("0190aaaa-0000-7000-8000-000000000000")); });
+  EXPECT_EQ(unknown.status, 409);
+  EXPECT_EQ(unknown.code, "queue-reference-unknown");
+  EXPECT_FALSE(unknown.hint.empty());
+  auto malformed = problem_of([&] { enqueue(api, "takes-run", {{"source_run", {{"$run_of", 7}}}}); });
+  EXPECT_EQ(malformed.status, 400);
+  std::string a = enqueue(api, "luminance-spot", spot(1))["id"];
+  auto not_a_string = problem_of([&] { enqueue(api, "luminance-spot", {{"readings", {{"$run_of", a}}}}); });
+  EXPECT_EQ(not_a_string.status, 400) << not_a_string.detail;
+  std::string b = enqueue(api, "luminance-spot", spot(1))["id"];
+  std::string c = enqueue(api, "takes-run", run_of_item(a))["id"];
+  auto early = problem_of([&] { api.post("/v1/queue/" + c + "/move", {{"position", 1}}); });
+  EXPECT_EQ(early.status, 409);
+  EXPECT_EQ(early.code, "queue-reference-order");
+  EXPECT_NE(early.detail.find(a), std::string::npos) << early.detail;
+  EXPECT_EQ(problem_of([&] { api.post("/v1/queue/" + a + "/move", {{"position", 3}}); }).code, "queue-reference-order");
+  auto q = queue_of(api);
+  ASSERT_EQ(q["items"].size(), 3u);
+  EXPECT_EQ(q["items"][0]["id"], a);
+  EXPECT_EQ(q["items"][2]["id"], c);
+  EXPECT_EQ(api.post("/v1/queue/" + c + "/move", {{"position", 2}})["position"], 2) << "after its reference is fine";
+  EXPECT_EQ(run_count(api), 0u);
+}
+
+// kill -9 while the referenced item runs, and again between the two items (the first done, the queue
+// stopped before the second): the next daemon gives the second item the first one's run.
+TEST(queue_references, TheReferenceSurvivesKillNineDuringAndBetweenTheItems) {
+  TempDir dir;
+  DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), 4, 1));
+  std::ofstream(dir / "state" / "campaigns" / "takes-run.lua") << kTakesRun;
+  auto api = api_for(daemon);
+  std::string first = enqueue(api, "luminance-spot", spot(8, 1))["id"];
+  std::string taker = enqueue(api, "takes-run", run_of_item(first))["id"];
+  api.post("/v1/queue/start", json::object());
+  ASSERT_FALSE(wait_current_measurements(api, 2).empty()) << queue_of(api).dump(1);
+  daemon.kill9();
+  EXPECT_EQ(integrity_check(dir / "state"), "ok");
+  daemon.start();
+  api = api_for(daemon);
+  auto q = wait_queue(api, emptied);
+  ASSERT_TRUE(emptied(q)) << q.dump(1);
+  std::string first_run = run_id_of(api, item_in(q, first));
+  EXPECT_EQ(item_in(q, taker)["state"], "done");
+  EXPECT_EQ(item_in(q, taker)["params"]["source_run"], first_run);
+  EXPECT_EQ(recorded_source_run(api, item_in(q, taker)), first_run);
+
+  // Between: the queue (still started) runs a second item and is stopped while it runs, so the item that
+  // takes its run waits in the stopped queue; kill -9 then.
+  std::string second = enqueue(api, "luminance-spot", spot(3, 0.5))["id"];
+  q = wait_queue(api, [&](const json& q) { return item_in(q, second)["state"] != "queued"; });
+  ASSERT_EQ(item_in(q, second)["state"], "running") << q.dump(1);
+  api.post("/v1/queue/stop", json::object());
+  std::string second_taker = enqueue(api, "takes-run", run_of_item(second))["id"];
+  q = wait_queue(api, [&](const json& q) { return item_in(q, second)["state"] == "done"; });
+  ASSERT_EQ(item_in(q, second)["state"], "done") << q.dump(1);
+  ASSERT_EQ(item_in(q, second_taker)["state"], "queued") << "the stopped queue must not have started it";
+  daemon.kill9();
+  daemon.start();
+  api = api_for(daemon);
+  api.post("/v1/queue/start", json::object());
+  q = wait_queue(api, emptied);
+  ASSERT_TRUE(emptied(q)) << q.dump(1);
+  std::string second_run = run_id_of(api, item_in(q, second));
+  EXPECT_EQ(item_in(q, second_taker)["params"]["source_run"], second_run);
+  EXPECT_EQ(recorded_source_run(api, item_in(q, second_taker)), second_run);
 }

@@ -136,6 +136,18 @@ void NightQueue::start_next() {
   if (queue_.adopt_started_executions() > 0) return;
   auto next = queue_.next_queued();
   if (!next) return;
+  if (next->has_unresolved_references()) {
+    std::string why;
+    auto resolved = resolve_references(*next, why);
+    if (!resolved) {
+      auto skipped = queue_.finish(next->id, QueueItemState::skipped, why);
+      log::warning("queue", describe_item(*next) + " skipped: " + why);
+      after_failure(skipped);
+      return;
+    }
+    // Written before the execution starts: a daemon killed in between starts the item with these run ids.
+    next = queue_.resolve(next->id, *resolved);
+  }
   try {
     auto execution = executions_.start(next->campaign, next->params, store::queue_execution_key(next->id));
     queue_.mark_running(next->id, execution.id);
@@ -150,11 +162,65 @@ void NightQueue::start_next() {
   }
 }
 
+// The item's params with each {"$run_of": id} replaced by that item's run id; nullopt (and why) when a
+// referenced item has no run to give: it failed, was skipped or removed (or, impossibly, has not run yet).
+std::optional<json> NightQueue::resolve_references(const QueueItem& item, std::string& why) {
+  json params = item.params;
+  for (const auto& [param, ref] : item.param_refs) {
+    if (!params.contains(param) || !params[param].is_object()) continue;  // resolved before
+    auto target = queue_.item(ref);
+    std::string what = "its parameter '" + param + "' takes the run of item " + ref;
+    if (!target) {
+      why = what + ", which is gone from the store";
+      return std::nullopt;
+    }
+    what += " (" + target->campaign + ")";
+    std::optional<store::ExecutionRecord> execution;
+    if (target->state == QueueItemState::done && target->execution_id) execution = store_.execution(*target->execution_id);
+    if (!execution) {
+      why = what + ", which " +
+            (target->state == QueueItemState::done ? std::string("has no execution in the store")
+                                                   : std::string(store::to_string(target->state))) +
+            (target->reason.empty() ? "" : " (" + target->reason + ")");
+      return std::nullopt;
+    }
+    params[param] = execution->run_id;
+  }
+  return params;
+}
+
+namespace {
+
+// Validates as Executions::start would, with each {"$run_of": id} standing in as a string; returns the
+// validated params with the references put back.
+json validated_with_references(campaigns::ScriptCatalogue& catalogue, const campaigns::Lab& lab,
+                               const std::string& campaign, const json& params,
+                               const std::map<std::string, std::string>& refs) {
+  json standing_in = params;
+  for (const auto& [param, ref] : refs) standing_in[param] = "$run_of:" + ref;
+  auto request = validate_campaign_request(catalogue, lab, campaign, standing_in);
+  json out = request.params;
+  for (const auto& [param, ref] : refs) {
+    if (!out.contains(param) || !out[param].is_string()) {
+      throw Error(ErrorClass::bad_parameter,
+                  "parameter '" + param + "' of " + campaign + " cannot take a run: it is not a string parameter",
+                  "only a run-id (string) parameter takes {\"$run_of\": ...}");
+    }
+    out[param] = json{{store::kRunOfKey, ref}};
+  }
+  return out;
+}
+
+}  // namespace
+
 store::QueueStore::Enqueued NightQueue::enqueue(const std::string& campaign, const json& params,
                                                 store::OnFailure on_failure,
                                                 const std::optional<std::string>& idempotency_key) {
-  auto request = validate_campaign_request(catalogue_, lab_, campaign, params);
-  auto enqueued = queue_.enqueue({campaign, request.params, on_failure, idempotency_key});
+  auto refs = store::run_of_references(params);
+  store::NewQueueItem n{campaign, validated_with_references(catalogue_, lab_, campaign, params, refs), on_failure,
+                        idempotency_key};
+  n.param_refs = refs;
+  auto enqueued = queue_.enqueue(n);
   if (enqueued.created) poke();
   return enqueued;
 }

@@ -90,9 +90,23 @@ HttpResponse post_move(NightQueue& queue, const HttpRequest& req, const std::str
   return item_response(200, queue.move(id, body["position"].get<std::int64_t>()));
 }
 
+std::optional<HttpResponse> dispatch(ApiContext& ctx, const HttpRequest& req);
+
 }  // namespace
 
+// A refusal about references answers 409 with its own code (queue-reference-unknown, -ended, -order),
+// so a client can tell it from another conflict.
 std::optional<HttpResponse> handle_queue_api(ApiContext& ctx, const HttpRequest& req) {
+  try {
+    return dispatch(ctx, req);
+  } catch (const store::QueueConflict& e) {
+    return HttpResponse::problem(409, e.code(), "Conflict", e.what(), e.hint());
+  }
+}
+
+namespace {
+
+std::optional<HttpResponse> dispatch(ApiContext& ctx, const HttpRequest& req) {
   const std::string base = std::string(protocol::kPrefix) + "/queue";
   const std::string& p = req.path;
   if (p != base && p.rfind(base + "/", 0) != 0) return std::nullopt;
@@ -126,5 +140,7 @@ std::optional<HttpResponse> handle_queue_api(ApiContext& ctx, const HttpRequest&
   }
   return std::nullopt;  // handle_api answers 404 with its hint
 }
+
+}  // namespace
 
 }  // namespace colorlab::daemon

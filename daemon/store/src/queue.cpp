@@ -9,7 +9,7 @@ namespace {
 
 constexpr const char* kItemColumns =
     "id, position, campaign, params, on_failure, state, execution_id, reason, created_at, updated_at, started_at, "
-    "finished_at";
+    "finished_at, param_refs, group_id, step";
 
 constexpr const char* kQueueKeyPrefix = "queue-item:";
 
@@ -51,6 +51,28 @@ OnFailure on_failure_from_string(std::string_view s) {
 
 std::string queue_execution_key(const std::string& item_id) { return kQueueKeyPrefix + item_id; }
 
+std::map<std::string, std::string> run_of_references(const nlohmann::json& params) {
+  std::map<std::string, std::string> out;
+  if (!params.is_object()) return out;
+  for (const auto& [name, value] : params.items()) {
+    if (!value.is_object() || !value.contains(kRunOfKey)) continue;
+    if (value.size() != 1 || !value[kRunOfKey].is_string() || value[kRunOfKey].get<std::string>().empty()) {
+      throw Error(ErrorClass::bad_parameter,
+                  "parameter '" + name + "' must be {\"$run_of\": \"<queue item id>\"} alone, not " + value.dump(),
+                  "the item's run id is put in when it comes up");
+    }
+    out[name] = value[kRunOfKey].get<std::string>();
+  }
+  return out;
+}
+
+bool QueueItem::has_unresolved_references() const {
+  for (const auto& [name, ref] : param_refs) {
+    if (params.is_object() && params.contains(name) && params[name].is_object()) return true;
+  }
+  return false;
+}
+
 nlohmann::json QueueItem::to_json() const {
   auto opt = [](const std::optional<std::string>& v) { return v ? nlohmann::json(*v) : nlohmann::json(nullptr); };
   return {{"id", id},
@@ -64,7 +86,10 @@ nlohmann::json QueueItem::to_json() const {
           {"created_at", created_at},
           {"updated_at", updated_at},
           {"started_at", opt(started_at)},
-          {"finished_at", opt(finished_at)}};
+          {"finished_at", opt(finished_at)},
+          {"param_refs", param_refs},
+          {"group_id", opt(group_id)},
+          {"step", opt(step)}};
 }
 
 QueueItem QueueStore::read(Statement& st) {
@@ -82,6 +107,14 @@ QueueItem QueueStore::read(Statement& st) {
   q.updated_at = st.text(9);
   q.started_at = optional_text(st, 10);
   q.finished_at = optional_text(st, 11);
+  auto refs = nlohmann::json::parse(st.text(12), nullptr, false);
+  if (refs.is_object()) {
+    for (const auto& [name, ref] : refs.items()) {
+      if (ref.is_string()) q.param_refs[name] = ref.get<std::string>();
+    }
+  }
+  q.group_id = optional_text(st, 13);
+  q.step = optional_text(st, 14);
   return q;
 }
 
@@ -121,30 +154,123 @@ void QueueStore::renumber() {
 }
 
 QueueStore::Enqueued QueueStore::enqueue(const NewQueueItem& n) {
+  Transaction tx(store_.db_);
+  auto enqueued = insert(n);
+  tx.commit();
+  return enqueued;
+}
+
+namespace {
+
+std::string describe_ref(const std::string& param, const QueueItem& target) {
+  return "parameter '" + param + "' takes the run of queue item " + target.id + " (" + target.campaign + ")";
+}
+
+}  // namespace
+
+QueueStore::Enqueued QueueStore::insert(const NewQueueItem& n) {
   auto& db = store_.db_;
   if (n.idempotency_key) {
     auto st = db.prepare("SELECT id FROM queue_items WHERE idempotency_key = ?1");
     st.bind(1, std::string_view(*n.idempotency_key));
     if (st.step()) return {require(st.text(0)), false};
   }
-  std::string id = new_uuid_v7();
+  // A referenced item is earlier in the queue by construction (this one goes last), unless it ended badly.
+  for (const auto& [param, ref] : n.param_refs) {
+    auto target = item(ref);
+    if (!target) {
+      throw QueueConflict("queue-reference-unknown",
+                          "parameter '" + param + "' references queue item '" + ref + "', which does not exist",
+                          "a reference names an item queued before this one: colorlab queue list shows them");
+    }
+    if (target->state == QueueItemState::failed || target->state == QueueItemState::skipped ||
+        target->state == QueueItemState::removed) {
+      throw QueueConflict("queue-reference-ended",
+                          describe_ref(param, *target) + ", which " + std::string(to_string(target->state)) +
+                              (target->reason.empty() ? "" : " (" + target->reason + ")"),
+                          "it will never have a run: queue that campaign again and reference the new item");
+    }
+  }
+  std::string id = n.id.value_or(new_uuid_v7());
   std::string now = now_iso8601();
-  Transaction tx(db);
+  nlohmann::json refs(n.param_refs);
   db.prepare(
         "INSERT INTO queue_items (id, position, campaign, params, on_failure, state, idempotency_key, created_at, "
-        "updated_at) VALUES (?1, (SELECT COALESCE(MAX(position), 0) + 1 FROM queue_items WHERE state = 'queued'), "
-        "?2, ?3, ?4, 'queued', ?5, ?6, ?6)")
+        "updated_at, param_refs, group_id, step) VALUES (?1, (SELECT COALESCE(MAX(position), 0) + 1 FROM queue_items "
+        "WHERE state = 'queued'), ?2, ?3, ?4, 'queued', ?5, ?6, ?6, ?7, ?8, ?9)")
       .bind(1, std::string_view(id))
       .bind(2, std::string_view(n.campaign))
       .bind(3, std::string_view(n.params.dump()))
       .bind(4, to_string(n.on_failure))
       .bind(5, n.idempotency_key)
       .bind(6, std::string_view(now))
+      .bind(7, std::string_view(refs.dump()))
+      .bind(8, n.group_id)
+      .bind(9, n.step)
       .run();
   auto created = require(id);
   event("enqueued", created);
-  tx.commit();
   return {created, true};
+}
+
+QueueStore::EnqueuedGroup QueueStore::enqueue_group(const std::string& group_id, const std::string& sequence,
+                                                    const nlohmann::json& options,
+                                                    const std::vector<NewQueueItem>& items) {
+  auto& db = store_.db_;
+  if (!items.empty() && items.front().idempotency_key) {
+    auto st = db.prepare("SELECT group_id FROM queue_items WHERE idempotency_key = ?1");
+    st.bind(1, std::string_view(*items.front().idempotency_key));
+    if (st.step() && !st.is_null(0)) {
+      if (auto g = group(st.text(0))) return {*g, false};
+    }
+  }
+  Transaction tx(db);
+  db.prepare("INSERT INTO queue_groups (id, sequence, options, created_at) VALUES (?1, ?2, ?3, ?4)")
+      .bind(1, std::string_view(group_id))
+      .bind(2, std::string_view(sequence))
+      .bind(3, std::string_view(options.dump()))
+      .bind(4, std::string_view(now_iso8601()))
+      .run();
+  for (auto n : items) {
+    n.group_id = group_id;
+    insert(n);
+  }
+  store_.append_event("queue", {{"change", "group-enqueued"}, {"group_id", group_id}, {"sequence", sequence}});
+  tx.commit();
+  return {*group(group_id), true};
+}
+
+std::optional<QueueGroup> QueueStore::group(const std::string& id) {
+  auto& db = store_.db_;
+  QueueGroup g;
+  {
+    auto st = db.prepare("SELECT id, sequence, options, created_at FROM queue_groups WHERE id = ?1");
+    st.bind(1, std::string_view(id));
+    if (!st.step()) return std::nullopt;
+    g.id = st.text(0);
+    g.sequence = st.text(1);
+    g.options = nlohmann::json::parse(st.text(2), nullptr, false);
+    if (!g.options.is_object()) g.options = nlohmann::json::object();
+    g.created_at = st.text(3);
+  }
+  auto st = db.prepare(std::string("SELECT ") + kItemColumns + " FROM queue_items WHERE group_id = ?1 ORDER BY rowid");
+  st.bind(1, std::string_view(id));
+  while (st.step()) g.items.push_back(read(st));
+  return g;
+}
+
+QueueItem QueueStore::resolve(const std::string& id, const nlohmann::json& params) {
+  auto& db = store_.db_;
+  Transaction tx(db);
+  db.prepare("UPDATE queue_items SET params = ?2, updated_at = ?3 WHERE id = ?1 AND state = 'queued'")
+      .bind(1, std::string_view(id))
+      .bind(2, std::string_view(params.dump()))
+      .bind(3, std::string_view(now_iso8601()))
+      .run();
+  auto q = require(id);
+  event("resolved", q);
+  tx.commit();
+  return q;
 }
 
 std::vector<QueueItem> QueueStore::pending() {
@@ -205,6 +331,30 @@ QueueItem QueueStore::remove(const std::string& id) {
   return q;
 }
 
+// The queued items in order with `moved` at `position`: every item's queued references must still
+// come before it.
+void QueueStore::check_order_after_move(const QueueItem& moved, std::int64_t position) {
+  std::vector<QueueItem> order;
+  for (auto& q : pending()) {
+    if (q.state == QueueItemState::queued && q.id != moved.id) order.push_back(q);
+  }
+  order.insert(order.begin() + (position - 1), moved);
+  std::map<std::string, std::size_t> at;
+  for (std::size_t i = 0; i < order.size(); ++i) at[order[i].id] = i;
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    for (const auto& [param, ref] : order[i].param_refs) {
+      auto it = at.find(ref);
+      if (it == at.end() || it->second < i) continue;
+      const auto& target = order[it->second];
+      throw QueueConflict("queue-reference-order",
+                          "moving item " + moved.id + " to position " + std::to_string(position) + " would run item " +
+                              order[i].id + " (" + order[i].campaign + ") before item " + target.id + " (" +
+                              target.campaign + ") whose run its parameter '" + param + "' takes",
+                          "an item that takes another's run must stay after it; move them together");
+    }
+  }
+}
+
 QueueItem QueueStore::move(const std::string& id, std::int64_t position) {
   auto& db = store_.db_;
   Transaction tx(db);
@@ -221,6 +371,7 @@ QueueItem QueueStore::move(const std::string& id, std::int64_t position) {
                 "1 runs next; " + std::to_string(count) + " runs last");
   }
   std::int64_t from = *q.position;
+  check_order_after_move(q, position);
   // Shift the items between the old and the new place by one, then put this one there.
   if (position < from) {
     db.prepare("UPDATE queue_items SET position = position + 1 WHERE state = 'queued' AND position >= ?1 AND position < ?2")

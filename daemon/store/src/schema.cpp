@@ -160,6 +160,22 @@ CREATE TABLE api_keys (
   revoked_at    TEXT
 );
 )sql",
+    // 5 -> 6: queue items that take an earlier item's run, and sequences queued as one group. An item's
+    // params may hold {"$run_of": "<item id>"} for a parameter; param_refs keeps parameter -> item id
+    // (the params get the run id written in when the item comes up, so a restarted daemon starts the
+    // same thing). A group is one sequence's items, queued together; step names the item within it.
+    R"sql(
+ALTER TABLE queue_items ADD COLUMN param_refs TEXT NOT NULL DEFAULT '{}';
+ALTER TABLE queue_items ADD COLUMN group_id TEXT;
+ALTER TABLE queue_items ADD COLUMN step TEXT;
+CREATE INDEX queue_items_by_group ON queue_items(group_id) WHERE group_id IS NOT NULL;
+CREATE TABLE queue_groups (
+  id          TEXT PRIMARY KEY,                    -- UUIDv7
+  sequence    TEXT NOT NULL,                       -- the catalogue's sequence it was queued from
+  options     TEXT NOT NULL DEFAULT '{}',          -- JSON: small, overrides, on_failure as asked
+  created_at  TEXT NOT NULL
+);
+)sql",
 };
 
 int read_pragma_int(Database& db, const char* pragma) {

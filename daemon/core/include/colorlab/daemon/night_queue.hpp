@@ -40,7 +40,9 @@ class NightQueue {
   // SIGTERM: starts nothing more. The queue stays started in the store, so the next daemon goes on.
   void shutdown();
 
-  // Validated exactly as Executions::start validates (400/404 before anything is stored).
+  // Validated exactly as Executions::start validates (400/404 before anything is stored). A parameter
+  // {"$run_of": "<item id>"} takes that earlier item's run id when this item comes up (409
+  // queue-reference-unknown / queue-reference-ended for an item that does not exist or never will run).
   store::QueueStore::Enqueued enqueue(const std::string& campaign, const nlohmann::json& params,
                                       store::OnFailure on_failure, const std::optional<std::string>& idempotency_key);
   store::QueueItem remove(const std::string& id);
@@ -62,6 +64,7 @@ class NightQueue {
   bool follow_running();
   void start_next();
   void after_failure(const store::QueueItem& item);
+  std::optional<nlohmann::json> resolve_references(const store::QueueItem& item, std::string& why);
 
   boost::asio::io_context& io_;
   store::Store& store_;
