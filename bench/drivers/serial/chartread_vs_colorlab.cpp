@@ -1,93 +1,136 @@
-// ArgyllCMS chartread against colorlab's Spectrolino driver, both driven for real on the simulated
-// SpectroScan T at time scale 1 (real device and wire time), on the same strip: row 3 of the Scene's
-// ColorChecker SG, columns A onwards. chartread runs through the conformance tests' harness
-// (tests/sim/conformance/argyll_driver.py: root, unshare, private /dev, a pty for its prompts) under
-// strace, and bench/drivers/serial/serial_timeline.py cuts its serial traffic into phases. Each
-// client gets a fresh colorlab-sim with the same seed. The main prints both, the ratio, and an
-// extrapolation to the 140-patch chart with the calibration schedule each client uses.
-#include <benchmark/benchmark.h>
+// ArgyllCMS chartread against colorlab's Spectrolino driver on the simulated SpectroScan T, reading the
+// same patches of the Scene's ColorChecker SG: whole rows of 14, up to the full 140-patch chart.
+//
+// Timed the same way on both sides, in one run, alternating (Argyll, colorlab, colorlab, Argyll, ...),
+// each client on a fresh colorlab-sim with the same seed and time scale, no tracer on either:
+// - chartread runs through the conformance tests' harness (tests/sim/conformance/argyll_driver.py: root,
+//   unshare, private /dev, a pty for its prompts) on a targen/printtarg chart whose page (160 × 122 mm)
+//   makes passes of 14 patches, one pass per SG row; the "operator" puts the sight on the three patches
+//   chartread asks for (first and last of the first pass, first of the last pass), which fixes the same
+//   19 mm grid. The harness's wall clock stamps its prompts and "Sheet 1 of 1 read OK".
+// - colorlab: connect(), calibrate(), read_chart() over the same rows, stamped with steady_clock. Its
+//   device time is measured in the same run from the driver's own transcript: each D0 07 round trip
+//   (request written .. answer's last byte read) minus the wire time of its bytes at the link's speed.
+// Both sides' readings are checked to be of the same SG patches (each of chartread's spectra is nearest
+// to colorlab's reading of the patch it maps to). With --trace, an extra chartread run under strace (not
+// part of the comparison) cuts Argyll's serial traffic into per-patch parts (serial_timeline.py).
 #include <unistd.h>
 
 #include <boost/asio/io_context.hpp>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
-#include <memory>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
-#include "colorlab/drivers/serpentine.hpp"
 #include "colorlab/drivers/spectrolino.hpp"
-#include "colorlab/sim/scene.hpp"
+#include "colorlab/testing/process.hpp"
 #include "run_support.hpp"   // tests/drivers/serial: runs a driver coroutine with a hard limit
 #include "sim_process.hpp"    // tests/sim/serial: colorlab-sim as a child process
-#include "colorlab/testing/process.hpp"
 
 namespace {
 
 using namespace colorlab;
 using Clock = std::chrono::steady_clock;
 using json = nlohmann::json;
-
-constexpr int kRow = 3;
-constexpr int kChartPatches = 140;
-constexpr int kCalInterval = 50;        // both clients: white recalibration every 50 reflective readings
-constexpr int kArgyllStepsInPass = 39;  // printtarg -i SS -p A4 puts 140 patches in strips of 39
-
-const std::string kLabToml = R"(
-time_scale = 1.0
-[ls110]
-enabled = false
-[dmx]
-enabled = false
-[genicam]
-enabled = false
-)";
-
-// One client's run, in seconds.
-struct Run {
-  bool done = false;
-  std::string why;  // set when the run could not happen
-  double init = 0, locate = 0, calibrate = 0, first_patch = 0, steady_patch = 0, patches = 0;
-  int calibrations = 0, commands = 0;
-  unsigned baud = 0;           // link speed the client left the device at
-  double measure_answer = 0;   // chartread only: mean D0 07 round trip (patches 2..N)
-  double extra_queries = 0;    // chartread only: mean time in the other commands of a patch (BA 09 04)
-  double read_wait = 0;        // chartread only: mean time per patch blocked in read() (VMIN/VTIME)
-  json phase_split;            // chartread only: init and calibration cut into device wait, VTIME, host gaps
-  std::vector<double> cycles;  // per patch, from its measure command to the next one
-  double total() const { return init + locate + calibrate + patches; }
-};
-Run g_argyll, g_colorlab;
-int g_patches = 0;
-
 using colorlab::testing::on_path;
 using colorlab::testing::shell_output;
 
-std::string sg_patch(int column) { return std::string(1, static_cast<char>('A' + column)) + std::to_string(kRow); }
+constexpr int kColumns = 14;  // SG columns A..N: one row is one Argyll pass
+constexpr int kRows = 10;     // SG rows 1..10
+const char* kArgyllPage = "160x122";  // printtarg -i SS: 14 steps per pass, 10 passes on one page
 
-// Table coordinates of the strip's patches, from the simulator's own placement of the head.
-std::vector<std::pair<double, double>> strip_mm(const test::SimProcess& sim, int patches) {
-  std::vector<std::pair<double, double>> xy;
-  for (int c = 0; c < patches; ++c) {
-    auto r = sim.control({{"cmd", "place"}, {"target", "patch"}, {"patch", sg_patch(c)}});
-    if (!r.value("ok", false)) throw std::runtime_error("simulator cannot place the head on " + sg_patch(c));
-    xy.emplace_back(r["spectrolino"]["head_mm"][0].get<double>(), r["spectrolino"]["head_mm"][1].get<double>());
-  }
-  sim.control({{"cmd", "place"}, {"x_mm", 0.0}, {"y_mm", 0.0}});  // both clients start from home
-  return xy;
+struct Options {
+  int patches = 140;
+  double time_scale = 1.0;
+  int pairs = 1;
+  bool trace = false;
+  std::string json_out;
+};
+
+std::string lab_toml(double time_scale) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", time_scale);
+  return std::string("time_scale = ") + buf +
+         "\n[ls110]\nenabled = false\n[dmx]\nenabled = false\n[genicam]\nenabled = false\n[dslr]\nenabled = false\n";
 }
 
-void finish_patch_stats(Run& r) {
-  r.first_patch = r.cycles.front();
-  double sum = 0;
-  for (std::size_t i = 1; i < r.cycles.size(); ++i) sum += r.cycles[i];
-  r.steady_patch = r.cycles.size() > 1 ? sum / static_cast<double>(r.cycles.size() - 1) : r.first_patch;
+std::string loadavg() {
+  std::ifstream f("/proc/loadavg");
+  std::string a, b, c;
+  f >> a >> b >> c;
+  return a + " " + b + " " + c;
+}
+
+double secs(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
+
+std::string sg_name(int column, int row) { return std::string(1, static_cast<char>('A' + column)) + std::to_string(row + 1); }
+
+std::pair<double, double> place(const test::SimProcess& sim, const std::string& patch) {
+  auto r = sim.control({{"cmd", "place"}, {"target", "patch"}, {"patch", patch}});
+  if (!r.value("ok", false)) throw std::runtime_error("simulator cannot place the head on " + patch);
+  return {r["spectrolino"]["head_mm"][0].get<double>(), r["spectrolino"]["head_mm"][1].get<double>()};
+}
+
+// One client's run. Times in wall seconds at the run's time scale.
+struct Run {
+  std::string client;
+  bool done = false;
+  std::string why;
+  std::string load_before, load_after;
+  double init = 0;     // start .. ready for the chart (chartread: its "place sheet" prompt)
+  double locate = 0;   // chartread only: sheet prompt .. the last sight answered
+  double read = 0;     // colorlab: calibrate() + read_chart(); chartread: located .. "read OK" (its calibrations inside)
+  double total() const { return init + locate + read; }
+  unsigned baud = 0;
+  std::uint64_t sim_lines = 0, sim_measurements = 0;  // what the simulator answered (its own counters)
+  // colorlab only, measured in this run:
+  int calibrations = 0;
+  double device_per_patch = 0;  // mean D0 07 round trip minus its wire time
+  double wire_per_patch = 0;    // mean D0 07 request + answer bytes at the link speed
+  double host_per_patch = 0;    // median of a patch's cycle minus its D0 07 round trip (ms resolution)
+  double cycle_per_patch = 0;   // read_chart's time / patches (its recalibrations included)
+  std::map<int, std::vector<double>> spectra;  // chart index (row * 14 + column) → reflectance
+};
+
+json to_json(const Run& r) {
+  json j{{"client", r.client},       {"done", r.done},         {"why", r.why},
+         {"load_before", r.load_before}, {"load_after", r.load_after}, {"init_s", r.init},
+         {"locate_s", r.locate},     {"read_s", r.read},       {"total_s", r.total()},
+         {"baud", r.baud},           {"sim_lines_answered", r.sim_lines}, {"sim_measurements", r.sim_measurements}};
+  if (r.client == "colorlab") {
+    j["calibrations"] = r.calibrations;
+    j["device_per_patch_s"] = r.device_per_patch;
+    j["wire_per_patch_s"] = r.wire_per_patch;
+    j["host_per_patch_s"] = r.host_per_patch;
+    j["cycle_per_patch_s"] = r.cycle_per_patch;
+  }
+  return j;
+}
+
+void read_sim_counters(const test::SimProcess& sim, Run& r) {
+  auto t = sim.control({{"cmd", "truth"}})["spectrolino"];
+  r.baud = t["baud"].get<unsigned>();
+  r.sim_lines = t["lines_answered"].get<std::uint64_t>();
+  r.sim_measurements = t["measurements"].get<std::uint64_t>();
+}
+
+std::string why_argyll_cannot_run(bool trace) {
+  if (::geteuid() != 0) return "chartread needs root for unshare -m and a private /dev (instrument-protocols §5.3)";
+  for (const char* t : {"chartread", "targen", "printtarg", "unshare", "python3"}) {
+    if (!on_path(t)) return std::string(t) + " is not installed";
+  }
+  if (trace && !on_path("strace")) return "strace is not installed (needed for --trace only)";
+  return {};
 }
 
 std::filesystem::path keep_dir() {
@@ -96,249 +139,324 @@ std::filesystem::path keep_dir() {
   return d;
 }
 
-std::string why_argyll_cannot_run() {
-  if (::geteuid() != 0) return "chartread needs root for unshare -m and a private /dev (instrument-protocols §5.3)";
-  for (const char* t : {"chartread", "targen", "printtarg", "unshare", "strace", "python3"}) {
-    if (!on_path(t)) return std::string(t) + " is not installed";
+// chartread on `rows` SG rows; with `trace` under strace (then its figures are not the comparison's).
+Run run_argyll(const Options& o, bool trace, json* timeline = nullptr) {
+  Run r;
+  r.client = "chartread";
+  if (auto why = why_argyll_cannot_run(trace); !why.empty()) {
+    r.why = why;
+    return r;
   }
-  return {};
-}
-
-void BM_ArgyllChartread(benchmark::State& state) {
-  const int patches = static_cast<int>(state.range(0));
-  g_patches = patches;
-  if (auto why = why_argyll_cannot_run(); !why.empty()) {
-    g_argyll.why = why;
-    state.SkipWithError(why.c_str());
-    return;
+  const int rows = o.patches / kColumns;
+  test::SimProcess sim(lab_toml(o.time_scale));
+  // The patches chartread asks the operator to sight: its pass A (SG row 1) steps 1 and 14, and the
+  // first step of its last pass (the SG's last row read), when there is more than one pass.
+  auto coord = [](std::pair<double, double> p) { return std::to_string(p.first) + "," + std::to_string(p.second); };
+  std::string locate = " --locate A1=" + coord(place(sim, sg_name(0, 0))) + " --locate A" + std::to_string(kColumns) +
+                       "=" + coord(place(sim, sg_name(kColumns - 1, 0)));
+  if (rows > 1) locate += " --locate " + std::string(1, static_cast<char>('A' + rows - 1)) + "1=" + coord(place(sim, sg_name(0, rows - 1)));
+  sim.control({{"cmd", "place"}, {"x_mm", 0.0}, {"y_mm", 0.0}});  // both clients start from home
+  const std::string src = COLORLAB_SOURCE_DIR;
+  const auto log = sim.dir() / (trace ? "chartread-traced.log" : "chartread.log");
+  const auto trace_file = sim.dir() / "chartread.strace";
+  std::string cmd = "timeout 1800 /usr/bin/python3 " + src + "/tests/sim/conformance/argyll_driver.py chartread --port " +
+                    sim.port("spectrolino") + " --control " + sim.announcement()["control"].get<std::string>() +
+                    " --workdir " + sim.dir().string() + " --patches " + std::to_string(o.patches) + " --page " +
+                    kArgyllPage + locate + " --read-timeout 1500 --log " + log.string() +
+                    (trace ? " --trace " + trace_file.string() : std::string());
+  r.load_before = loadavg();
+  auto result = json::parse(shell_output(cmd), nullptr, false);
+  r.load_after = loadavg();
+  for (const auto& f : {log, trace_file, sim.dir() / "chart.ti2", sim.dir() / "chart.ti3"}) {
+    std::error_code ec;
+    if (std::filesystem::exists(f)) std::filesystem::copy_file(f, keep_dir() / f.filename(), std::filesystem::copy_options::overwrite_existing, ec);
   }
-  for (auto _ : state) {
-    test::SimProcess sim(kLabToml);
-    auto xy = strip_mm(sim, patches);
-    auto coord = [](std::pair<double, double> p) { return std::to_string(p.first) + "," + std::to_string(p.second); };
-    const std::string src = COLORLAB_SOURCE_DIR;
-    const auto trace = sim.dir() / "chartread.strace";
-    const auto log = sim.dir() / "chartread.log";
-    std::string cmd = "timeout 900 python3 " + src + "/tests/sim/conformance/argyll_driver.py chartread --port " +
-                      sim.port("spectrolino") + " --control " + sim.announcement()["control"].get<std::string>() +
-                      " --workdir " + sim.dir().string() + " --patches " + std::to_string(patches) + " --first " +
-                      coord(xy.front()) + " --last " + coord(xy.back()) + " --read-timeout 600 --log " +
-                      log.string() + " --trace " + trace.string();
-    auto result = json::parse(shell_output(cmd), nullptr, false);
-    for (const auto& f : {trace, log}) {
-      std::error_code ec;
-      std::filesystem::copy_file(f, keep_dir() / f.filename(), std::filesystem::copy_options::overwrite_existing, ec);
-    }
-    if (result.is_discarded() || !result.value("ok", false)) {
-      g_argyll.why = "chartread run failed: " + (result.is_discarded() ? std::string("no JSON") : result.dump()) +
-                     " (log kept in " + keep_dir().string() + ")";
-      state.SkipWithError(g_argyll.why.c_str());
-      return;
-    }
-    if (result["patches"].size() != static_cast<std::size_t>(patches)) {
-      g_argyll.why = "chartread returned " + std::to_string(result["patches"].size()) + " patches";
-      state.SkipWithError(g_argyll.why.c_str());
-      return;
-    }
-    auto t = json::parse(shell_output("python3 " + src + "/bench/drivers/serial/serial_timeline.py " + trace.string() +
-                               " --patches " + std::to_string(patches)),
-                         nullptr, false);
-    if (t.is_discarded()) {
-      g_argyll.why = "could not read chartread's serial trace";
-      state.SkipWithError(g_argyll.why.c_str());
-      return;
-    }
-    Run& r = g_argyll;
-    r.init = t["init_s"];
-    r.locate = t["locate_s"];
-    r.calibrate = t["calibrate_s"];
-    r.patches = t["patches_s"];
-    r.calibrations = t["calibrations"];
-    r.commands = t["commands_to_last_patch"];
-    r.baud = sim.control({{"cmd", "truth"}})["spectrolino"]["baud"].get<unsigned>();
-    r.phase_split = {{"init", t["init_split"]}, {"calibration", t["calibrate_split"]}};
-    const auto& pp = t["per_patch"];
-    for (std::size_t i = 1; i < pp.size(); ++i) {
-      r.measure_answer += pp[i]["measure_answer"].get<double>() / static_cast<double>(pp.size() - 1);
-      r.read_wait += pp[i]["read_wait"].get<double>() / static_cast<double>(pp.size() - 1);
-      r.extra_queries += (pp[i]["in_commands"].get<double>() - pp[i]["measure_answer"].get<double>()) /
-                         static_cast<double>(pp.size() - 1);
-    }
-    // Cycle = from one D0 07 to the next; the last patch ends with its last answer.
-    for (const auto& p : t["per_patch"]) r.cycles.push_back(p["cycle"].get<double>());
-    finish_patch_stats(r);
-    r.done = true;
-    state.SetIterationTime(r.total());
+  if (result.is_discarded() || !result.value("ok", false)) {
+    r.why = "chartread run failed: " + (result.is_discarded() ? std::string("no JSON") : result.dump()) +
+            " (log kept in " + keep_dir().string() + ")";
+    return r;
   }
-  state.counters["init_s"] = g_argyll.init;
-  state.counters["locate_s"] = g_argyll.locate;
-  state.counters["calibrate_s"] = g_argyll.calibrate;
-  state.counters["patch_s"] = g_argyll.steady_patch;
-  state.counters["commands"] = g_argyll.commands;
-}
-
-void BM_ColorlabReadChart(benchmark::State& state) {
-  const int patches = static_cast<int>(state.range(0));
-  g_patches = patches;
-  for (auto _ : state) {
-    test::SimProcess sim(kLabToml);
-    auto xy = strip_mm(sim, patches);
-    boost::asio::io_context io;
-    drivers::SpectrolinoOptions o;
-    o.port = sim.port("spectrolino");
-    o.simulated = true;
-    drivers::Spectrolino driver(io.get_executor(), o);
-    drivers::ChartLayout layout;
-    layout.origin_x_mm = xy[0].first;
-    layout.origin_y_mm = xy[0].second;
-    layout.step_x_mm = xy[1].first - xy[0].first;
-    layout.step_y_mm = xy[1].second - xy[0].second;
-    layout.patches_per_strip = patches;
-    layout.strips = 1;
-
-    Run& r = g_colorlab;
-    auto t0 = Clock::now();
-    test::run(io, driver.connect(), std::chrono::seconds(120));
-    auto t1 = Clock::now();
-    test::run(io, driver.calibrate(), std::chrono::seconds(120));  // read_chart then starts calibrated, as Argyll does
-    auto t2 = Clock::now();
-    std::vector<Clock::time_point> done;
-    auto readings = test::run(io, driver.read_chart(layout, [&](int, int) { done.push_back(Clock::now()); }),
-                              std::chrono::seconds(1800));
-    benchmark::DoNotOptimize(readings);
-    auto secs = [](Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); };
-    r.init = secs(t0, t1);
-    r.calibrate = secs(t1, t2);
-    r.patches = secs(t2, done.back());
-    auto prev = t2;
-    for (auto d : done) {
-      r.cycles.push_back(secs(prev, d));
-      prev = d;
-    }
-    finish_patch_stats(r);
-    r.calibrations = driver.calibrations_done();
-    r.commands = static_cast<int>(driver.commands_sent());
-    r.baud = sim.control({{"cmd", "truth"}})["spectrolino"]["baud"].get<unsigned>();
-    r.done = true;
-    driver.disconnect();
-    state.SetIterationTime(r.total());
+  if (result["patches"].size() != static_cast<std::size_t>(o.patches)) {
+    r.why = "chartread returned " + std::to_string(result["patches"].size()) + " patches";
+    return r;
   }
-  state.counters["init_s"] = g_colorlab.init;
-  state.counters["calibrate_s"] = g_colorlab.calibrate;
-  state.counters["patch_s"] = g_colorlab.steady_patch;
-  state.counters["commands"] = g_colorlab.commands;
-}
-
-BENCHMARK(BM_ArgyllChartread)->Arg(14)->Iterations(1)->UseManualTime()->Unit(benchmark::kSecond);
-BENCHMARK(BM_ColorlabReadChart)->Arg(14)->Iterations(1)->UseManualTime()->Unit(benchmark::kSecond);
-
-// White calibrations for a chart read in rows of these lengths: one before the first row, and one at
-// the start of any row that would carry the count past the interval (Argyll ss.c read_xy; colorlab's
-// read_chart does the same).
-int calibrations_for(const std::vector<int>& rows) {
-  int cals = 0, since = kCalInterval;
-  for (int n : rows) {
-    if (since + n > kCalInterval) {
-      ++cals;
-      since = 0;
-    }
-    since += n;
+  const auto& t = result["times"];
+  r.init = t["sheet_prompt"].get<double>() - t["start"].get<double>();
+  r.locate = t["located"].get<double>() - t["sheet_prompt"].get<double>();
+  r.read = t["read_ok"].get<double>() - t["located"].get<double>();
+  read_sim_counters(sim, r);
+  // chartread's location "<pass><step>": pass = SG row, step = SG column.
+  for (const auto& [loc, spectrum] : result["patches"].items()) {
+    const int row = loc[0] - 'A';
+    const int column = std::stoi(loc.substr(1)) - 1;
+    r.spectra[row * kColumns + column] = spectrum.get<std::vector<double>>();
   }
-  return cals;
+  if (trace && timeline) {
+    *timeline = json::parse(shell_output("/usr/bin/python3 " + src + "/bench/drivers/serial/serial_timeline.py " +
+                                         trace_file.string() + " --patches " + std::to_string(o.patches)),
+                            nullptr, false);
+  }
+  r.done = true;
+  return r;
 }
 
-std::vector<int> chunks(int total, int per_row) {
-  std::vector<int> rows;
-  for (int left = total; left > 0; left -= per_row) rows.push_back(std::min(left, per_row));
-  return rows;
+// Bytes a transcript line carries (its escapes undone).
+std::size_t raw_bytes(const std::string& escaped) {
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < escaped.size(); ++i, ++n) {
+    if (escaped[i] != '\\') continue;
+    if (i + 1 < escaped.size() && escaped[i + 1] == 'x') i += 3;
+    else ++i;
+  }
+  return n;
 }
 
-// The SG's 14 × 10 patches in the order colorlab's serpentine visits them.
-std::vector<int> colorlab_sg_rows() {
-  drivers::ChartLayout l;
-  l.origin_x_mm = 31.2;
-  l.origin_y_mm = 29.5;
-  l.step_y_mm = 19;
-  l.pass_x_mm = 19;
-  l.patches_per_strip = sim::chart_rows;
-  l.strips = sim::chart_columns;
-  std::vector<int> rows;
-  for (const auto& row : drivers::serpentine_rows(l)) rows.push_back(static_cast<int>(row.size()));
-  return rows;
+struct TranscriptLine {
+  long ms = 0;
+  char dir = ' ';  // '>' sent, '<' received
+  std::string bytes;
+};
+
+std::vector<TranscriptLine> parse_transcript(const std::vector<std::string>& lines) {
+  std::vector<TranscriptLine> out;
+  for (const auto& l : lines) {  // "+<ms>ms -> <escaped>"
+    auto ms_end = l.find("ms ");
+    if (l.empty() || l[0] != '+' || ms_end == std::string::npos || l.size() < ms_end + 6) continue;
+    TranscriptLine t;
+    t.ms = std::stol(l.substr(1, ms_end - 1));
+    const std::string dir = l.substr(ms_end + 3, 2);
+    t.dir = dir == "->" ? '>' : dir == "<-" ? '<' : ' ';
+    t.bytes = l.substr(ms_end + 6);
+    out.push_back(std::move(t));
+  }
+  return out;
 }
 
-// Every calibration is followed by one "first patch" (travel from the white tile); the rest run at
-// the steady per-patch time of this strip's 19 mm pitch.
-double extrapolate(const Run& r, int cals) {
-  return r.init + r.locate + cals * (r.calibrate + r.first_patch) + (kChartPatches - cals) * r.steady_patch;
-}
+Run run_colorlab(const Options& o) {
+  Run r;
+  r.client = "colorlab";
+  const int rows = o.patches / kColumns;
+  test::SimProcess sim(lab_toml(o.time_scale));
+  auto a1 = place(sim, sg_name(0, 0)), b1 = place(sim, sg_name(1, 0)), a2 = place(sim, sg_name(0, 1));
+  sim.control({{"cmd", "place"}, {"x_mm", 0.0}, {"y_mm", 0.0}});  // both clients start from home
+  boost::asio::io_context io;
+  drivers::SpectrolinoOptions so;
+  so.port = sim.port("spectrolino");
+  so.simulated = true;
+  drivers::Spectrolino driver(io.get_executor(), so);
+  drivers::ChartLayout layout;  // rows of 14 along X, as colorlab's chart-read plans the SG
+  layout.origin_x_mm = a1.first;
+  layout.origin_y_mm = a1.second;
+  layout.step_x_mm = b1.first - a1.first;
+  layout.step_y_mm = b1.second - a1.second;
+  layout.pass_x_mm = a2.first - a1.first;
+  layout.pass_y_mm = a2.second - a1.second;
+  layout.patches_per_strip = kColumns;
+  layout.strips = rows;
 
-void print_report() {
-  const Run& a = g_argyll;
-  const Run& c = g_colorlab;
-  std::printf("\n== ArgyllCMS chartread vs colorlab Spectrolino driver: %d patches, SG row %d, time scale 1 ==\n",
-              g_patches, kRow);
-  if (!a.done) std::printf("chartread did not run: %s\n", a.why.c_str());
-  if (!c.done) std::printf("colorlab did not run\n");
-  if (!a.done || !c.done) return;
-  auto row = [](const char* what, double av, double cv) {
-    std::printf("%-34s %10.3f %10.3f %8.2fx\n", what, av, cv, cv > 0 ? av / cv : 0.0);
+  r.load_before = loadavg();
+  auto t0 = Clock::now();
+  test::run(io, driver.connect(), std::chrono::seconds(300));
+  auto t1 = Clock::now();
+  test::run(io, driver.calibrate(), std::chrono::seconds(300));  // read_chart then starts calibrated, as chartread does
+  driver.transcript().clear();
+  const auto t2 = Clock::now();
+  std::vector<Clock::time_point> done;
+  std::vector<double> rtt, wire;
+  const double bits_per_byte = 10.0;  // 8N1
+  auto progress = [&](int, int) {
+    done.push_back(Clock::now());
+    // The patch's D0 07: from its request to the last answer chunk before anything else is sent.
+    auto lines = parse_transcript(driver.transcript().lines());
+    driver.transcript().clear();
+    for (std::size_t i = 0; i < lines.size(); ++i) {
+      if (lines[i].dir != '>' || lines[i].bytes.rfind(";D007", 0) != 0) continue;
+      long end = -1;
+      std::size_t bytes = raw_bytes(lines[i].bytes);
+      for (std::size_t k = i + 1; k < lines.size() && lines[k].dir == '<'; ++k) {
+        end = lines[k].ms;
+        bytes += raw_bytes(lines[k].bytes);
+      }
+      if (end < 0) continue;
+      rtt.push_back((end - lines[i].ms) / 1000.0);
+      // The simulator paces wire time like device time: both divided by the time scale.
+      wire.push_back(static_cast<double>(bytes) * bits_per_byte / driver.baud() / o.time_scale);
+    }
   };
-  std::printf("%-34s %10s %10s %9s\n", "phase (s)", "chartread", "colorlab", "ratio");
-  row("init (open .. ready)", a.init, c.init);
-  row("locate (operator prompts, Argyll)", a.locate, c.locate);
-  row("white calibration", a.calibrate, c.calibrate);
-  row("first patch (from the tile)", a.first_patch, c.first_patch);
-  row("per patch, steady (mean 2..N)", a.steady_patch, c.steady_patch);
-  row("all patches", a.patches, c.patches);
-  row("total, init .. last patch", a.total(), c.total());
-  row("total without init/locate", a.calibrate + a.patches, c.calibrate + c.patches);
-  std::printf("%-34s %10d %10d\n", "serial commands", a.commands, c.commands);
-  std::printf("%-34s %10d %10d\n", "white calibrations", a.calibrations, c.calibrations);
-  std::printf("\nper patch cycle (s):\n  #   chartread  colorlab  ratio\n");
-  for (std::size_t i = 0; i < a.cycles.size() && i < c.cycles.size(); ++i) {
-    std::printf("%3zu %10.3f %9.3f %6.2fx\n", i + 1, a.cycles[i], c.cycles[i], a.cycles[i] / c.cycles[i]);
+  auto readings = test::run(io, driver.read_chart(layout, progress), std::chrono::seconds(3600));
+  r.load_after = loadavg();
+  r.init = secs(t0, t1);
+  r.read = secs(t1, done.back());
+  r.calibrations = driver.calibrations_done();
+  const double n = static_cast<double>(rtt.size());
+  for (std::size_t i = 0; i < rtt.size(); ++i) {
+    r.device_per_patch += (rtt[i] - wire[i]) / n;
+    r.wire_per_patch += wire[i] / n;
   }
-  // Where a steady patch's time goes. The D0 07 request and its spectrum answer are 15 + 303 bytes
-  // (10 bits each at 8N1); the device time is the same simulator model for both clients.
-  const double d007_bits = (15 + 303) * 10.0;
-  const double device = a.measure_answer - d007_bits / a.baud;
-  const double wire_a = d007_bits / a.baud, wire_c = d007_bits / c.baud;
-  std::printf("\nsteady patch decomposition (s)     chartread   colorlab\n");
-  std::printf("%-34s %10u %10u\n", "link speed (baud)", a.baud, c.baud);
-  std::printf("%-34s %10.3f %10.3f\n", "device time (D0 07, simulator)", device, device);
-  std::printf("%-34s %10.3f %10.3f\n", "D0 07 wire time", wire_a, wire_c);
-  std::printf("%-34s %10.3f %10.3f\n", "BA 09 04 XYZ query (device+wire)", a.extra_queries - a.read_wait, 0.0);
-  std::printf("%-34s %10.3f %10.3f\n", "read() VMIN/VTIME waits", a.read_wait, 0.0);
-  std::printf("%-34s %10.3f %10.3f\n", "host: gaps between commands", a.steady_patch - device - wire_a - a.extra_queries,
-              c.steady_patch - device - wire_c);
-  std::printf("%-34s %10.3f %10.3f\n", "= per patch", a.steady_patch, c.steady_patch);
-  std::printf("ceiling with zero host and wire time: %.2fx per patch\n", a.steady_patch / device);
-  std::printf("\nchartread phases (s)   waiting for answers (of which read() VTIME)   host gaps\n");
-  for (const char* phase : {"init", "calibration"}) {
-    const auto& p = a.phase_split[phase];
-    std::printf("%-22s %20.3f %12.3f %20.3f\n", phase, p["waiting_for_device"].get<double>(),
-                p["read_wait"].get<double>(), p["host_gaps"].get<double>());
+  // Per patch: its cycle (from the previous patch's completion, the first from the end of calibrate()) minus
+  // its D0 07 round trip is the host's part; the median leaves out the patches that recalibrated first.
+  std::vector<double> host;
+  for (std::size_t i = 0; i < done.size() && i < rtt.size(); ++i) host.push_back(secs(i ? done[i - 1] : t2, done[i]) - rtt[i]);
+  r.cycle_per_patch = done.empty() ? 0 : secs(t2, done.back()) / static_cast<double>(done.size());
+  if (!host.empty()) {
+    std::nth_element(host.begin(), host.begin() + static_cast<long>(host.size() / 2), host.end());
+    r.host_per_patch = host[host.size() / 2];
   }
-  const int cals_a = calibrations_for(chunks(kChartPatches, kArgyllStepsInPass));
-  const int cals_c = calibrations_for(colorlab_sg_rows());
-  const double ta = extrapolate(a, cals_a), tc = extrapolate(c, cals_c);
-  const double ia = a.init + a.locate, ic = c.init + c.locate;
-  std::printf("\n140 patches extrapolated (chartread: %d calibrations, strips of %d; colorlab: %d calibrations, "
-              "rows of %d)\n",
-              cals_a, kArgyllStepsInPass, cals_c, sim::chart_columns);
-  std::printf("%-34s %10.1f %10.1f %8.2fx\n", "init .. last patch (s)", ta, tc, ta / tc);
-  std::printf("%-34s %10.1f %10.1f %8.2fx\n", "chart read only, no init/locate (s)", ta - ia, tc - ic,
-              (ta - ia) / (tc - ic));
+  for (std::size_t i = 0; i < readings.size(); ++i) r.spectra[static_cast<int>(i)] = readings[i].values;
+  read_sim_counters(sim, r);
+  driver.disconnect();
+  test::settle(io, std::chrono::milliseconds(5));
+  r.done = rtt.size() == static_cast<std::size_t>(o.patches);
+  if (!r.done) r.why = "measured " + std::to_string(rtt.size()) + " D0 07 round trips for " + std::to_string(o.patches) + " patches";
+  return r;
+}
+
+// Whether both clients read the same SG patches: per chartread reading, the largest band difference to
+// colorlab's reading of the patch it maps to, and whether colorlab's reading nearest to it is that patch or one
+// alike (the SG repeats its neutrals: two patches are alike when colorlab's readings of them differ by at most
+// kAlike in every band).
+constexpr double kAlike = 0.02;
+
+double max_band_difference(const std::vector<double>& x, const std::vector<double>& y) {
+  double worst = 0;
+  for (std::size_t k = 0; k < std::min(x.size(), y.size()); ++k) worst = std::max(worst, std::abs(x[k] - y[k]));
+  return worst;
+}
+
+json same_patches(const Run& a, const Run& c) {
+  int nearest_is_same = 0, nearest_is_alike = 0;
+  double worst = 0;
+  for (const auto& [idx, sa] : a.spectra) {
+    auto mapped = c.spectra.find(idx);
+    if (mapped == c.spectra.end()) continue;
+    worst = std::max(worst, max_band_difference(sa, mapped->second));
+    auto dist = [&](const std::vector<double>& sc) {
+      double d = 0;
+      for (std::size_t k = 0; k < std::min(sa.size(), sc.size()); ++k) d += (sa[k] - sc[k]) * (sa[k] - sc[k]);
+      return d;
+    };
+    int best = -1;
+    double best_d = 1e300;
+    for (const auto& [j, sc] : c.spectra) {
+      if (double d = dist(sc); d < best_d) best_d = d, best = j;
+    }
+    nearest_is_same += best == idx;
+    nearest_is_alike += best == idx || max_band_difference(c.spectra.at(best), mapped->second) <= kAlike;
+  }
+  return {{"patches", a.spectra.size()},
+          {"nearest_is_same_patch", nearest_is_same},
+          {"nearest_is_same_or_alike_patch", nearest_is_alike},
+          {"max_band_difference", worst}};
+}
+
+Options parse(int argc, char** argv) {
+  Options o;
+  for (int i = 1; i < argc; ++i) {
+    std::string a = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) throw std::runtime_error(a + " needs a value");
+      return argv[++i];
+    };
+    if (a == "--patches") o.patches = std::stoi(value());
+    else if (a == "--time-scale") o.time_scale = std::stod(value());
+    else if (a == "--pairs") o.pairs = std::stoi(value());
+    else if (a == "--trace") o.trace = true;
+    else if (a == "--json") o.json_out = value();
+    else {
+      std::printf("usage: %s [--patches N (whole SG rows: 14, 28, .. 140; default 140)] [--time-scale S (default 1)]\n"
+                  "          [--pairs P (default 1)] [--json FILE] [--trace (one more chartread run under strace, not compared)]\n",
+                  argv[0]);
+      std::exit(a == "--help" ? 0 : 2);
+    }
+  }
+  if (o.patches < kColumns || o.patches > kColumns * kRows || o.patches % kColumns != 0) {
+    throw std::runtime_error("--patches must be whole SG rows of 14: 14 .. 140");
+  }
+  return o;
+}
+
+void print_pair(const Run& a, const Run& c) {
+  auto row = [](const char* what, double av, double cv) {
+    std::printf("  %-40s %10.3f %10.3f %8.2fx\n", what, av, cv, cv > 0 ? av / cv : 0.0);
+  };
+  std::printf("  %-40s %10s %10s %9s\n", "phase (s, wall)", "chartread", "colorlab", "ratio");
+  row("init (start .. ready for the chart)", a.init, c.init);
+  row("locate (chartread's sight prompts)", a.locate, c.locate);
+  row("calibrations + all patches", a.read, c.read);
+  row("total, start .. last patch", a.total(), c.total());
+  std::printf("  %-40s %10s %10s\n", "load average before / after", "", "");
+  std::printf("    chartread %s / %s;  colorlab %s / %s\n", a.load_before.c_str(), a.load_after.c_str(),
+              c.load_before.c_str(), c.load_after.c_str());
+  std::printf("  %-40s %10llu %10llu\n", "serial lines the simulator answered", static_cast<unsigned long long>(a.sim_lines),
+              static_cast<unsigned long long>(c.sim_lines));
+  std::printf("  %-40s %10llu %10llu\n", "measurements the simulator made", static_cast<unsigned long long>(a.sim_measurements),
+              static_cast<unsigned long long>(c.sim_measurements));
+  std::printf("  %-40s %10u %10u\n", "link speed (baud)", a.baud, c.baud);
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  benchmark::Initialize(&argc, argv);
-  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  print_report();
-  return 0;
+  Options o;
+  try {
+    o = parse(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return 2;
+  }
+  std::printf("chartread vs colorlab: %d SG patches (%d rows of %d), time scale %g, %d pair(s), load average %s\n",
+              o.patches, o.patches / kColumns, kColumns, o.time_scale, o.pairs, loadavg().c_str());
+  json out{{"patches", o.patches}, {"time_scale", o.time_scale}, {"pairs", json::array()}};
+  int failures = 0;
+  for (int p = 0; p < o.pairs; ++p) {
+    // Alternate who goes first: A C, C A, A C, ...
+    Run a, c;
+    if (p % 2 == 0) {
+      a = run_argyll(o, false);
+      c = run_colorlab(o);
+    } else {
+      c = run_colorlab(o);
+      a = run_argyll(o, false);
+    }
+    std::printf("\n== pair %d (%s first) ==\n", p + 1, p % 2 == 0 ? "chartread" : "colorlab");
+    if (!a.done) std::printf("  chartread did not run: %s\n", a.why.c_str());
+    if (!c.done) std::printf("  colorlab did not run: %s\n", c.why.c_str());
+    json pj{{"chartread", to_json(a)}, {"colorlab", to_json(c)}};
+    if (a.done && c.done) {
+      print_pair(a, c);
+      auto same = same_patches(a, c);
+      pj["same_patches"] = same;
+      pj["ratio_total"] = a.total() / c.total();
+      pj["ratio_read"] = a.read / c.read;
+      std::printf("  same patches: of %d chartread readings, %d are nearest to colorlab's reading of the SG patch they map"
+                  " to, %d to it or a patch alike (SG neutrals repeat; alike = within %.2f in every band);"
+                  " largest band difference between the two readings of one patch %.2g\n",
+                  o.patches, same["nearest_is_same_patch"].get<int>(), same["nearest_is_same_or_alike_patch"].get<int>(),
+                  kAlike, same["max_band_difference"].get<double>());
+      std::printf("  colorlab, measured in this run: %d white calibrations; per patch: D0 07 device time %.4f s, wire %.4f s,"
+                  " host %.4f s (median); read_chart / patches %.4f s (recalibrations included)\n",
+                  c.calibrations, c.device_per_patch, c.wire_per_patch, c.host_per_patch, c.cycle_per_patch);
+      const double steady = c.device_per_patch + c.wire_per_patch + c.host_per_patch;
+  std::printf("  colorlab's part of a patch beyond the device's own time: wire %.1f %%, host %.1f %% of %.4f s\n",
+              100.0 * c.wire_per_patch / steady, 100.0 * c.host_per_patch / steady, steady);
+    } else {
+      ++failures;
+    }
+    out["pairs"].push_back(pj);
+  }
+  if (o.trace) {
+    json timeline;
+    Run t = run_argyll(o, true, &timeline);
+    out["traced_chartread"] = {{"run", to_json(t)}, {"timeline", timeline}};
+    std::printf("\n== chartread under strace (a separate run, not part of the comparison) ==\n");
+    if (!t.done) {
+      std::printf("  did not run: %s\n", t.why.c_str());
+    } else {
+      std::printf("  total %.3f s (init %.3f, locate %.3f, read %.3f); load %s / %s\n", t.total(), t.init, t.locate, t.read,
+                  t.load_before.c_str(), t.load_after.c_str());
+      std::printf("  timeline: %s\n", timeline.dump().substr(0, 4000).c_str());
+    }
+  }
+  if (!o.json_out.empty()) std::ofstream(o.json_out) << out.dump(2) << "\n";
+  return failures ? 1 : 0;
 }

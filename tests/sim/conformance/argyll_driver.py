@@ -136,11 +136,14 @@ def run_spotread(a, log):
 
 
 def make_chart(a, log):
-    """A one-strip SpectroScan chart of a.patches patches made by Argyll itself (targen + printtarg)."""
+    """A SpectroScan chart of a.patches patches made by Argyll itself (targen + printtarg) on page a.page.
+
+    On A4 up to 39 patches lie in one pass; a custom page such as 160x122 (mm) makes 10 passes of 14,
+    the ColorChecker SG's grid."""
     import subprocess
     base = os.path.join(a.workdir, a.basename)
     for argv in (["targen", "-v0", "-d2", "-f", str(a.patches), base],
-                 ["printtarg", "-i", "SS", "-p", "A4", base]):
+                 ["printtarg", "-i", "SS", "-p", a.page, base]):
         r = subprocess.run(argv, cwd=a.workdir, capture_output=True, text=True)
         log.write(r.stdout + r.stderr)
         if r.returncode != 0:
@@ -174,8 +177,13 @@ def read_ti3(path):
 
 def run_chartread(a, log):
     make_chart(a, log)
-    first = [float(v) for v in a.first.split(",")]
-    last = [float(v) for v in a.last.split(",")]
+    # Where the "operator" puts the sight for each patch chartread asks for: by name (--locate), or the
+    # first and the last patch in the order asked (a one-pass chart).
+    by_name = {}
+    for item in a.locate:
+        name, xy = item.split("=", 1)
+        by_name[name] = [float(v) for v in xy.split(",")]
+    in_order = [[float(v) for v in a.first.split(",")], [float(v) for v in a.last.split(",")]]
     t_start = time.time()
     s = Session(tool_argv(a, ["chartread", "-v", "-c", "1", a.basename]), a.port, a.workdir, log)
     result = {}
@@ -186,9 +194,12 @@ def run_chartread(a, log):
     times["sheet_prompt"] = time.time()
     s.send("\r")
     located = []
-    for xy in (first, last):
+    for i in range(len(by_name) if by_name else len(in_order)):
         m = s.expect(r"locate patch (\S+) with the sight", 60)
         located.append(m.group(1))
+        if by_name and m.group(1) not in by_name:
+            raise EOFError("chartread asks for patch %s; --locate gives %s" % (m.group(1), sorted(by_name)))
+        xy = by_name[m.group(1)] if by_name else in_order[i]
         control(a.control, {"cmd": "place", "x_mm": xy[0], "y_mm": xy[1]})
         s.send("\r")
     result["located"] = located
@@ -213,6 +224,9 @@ def main():
     p.add_argument("--patches", type=int, default=12)
     p.add_argument("--first", default="30,20", help="x,y mm of the strip's first patch")
     p.add_argument("--last", default="250,20", help="x,y mm of the strip's last patch")
+    p.add_argument("--locate", action="append", default=[], metavar="PATCH=X,Y",
+                   help="where the sight goes when chartread asks for PATCH (repeat; replaces --first/--last)")
+    p.add_argument("--page", default="A4", help="printtarg page size: A4, or WWWxHHH in mm")
     p.add_argument("--log", default="-")
     p.add_argument("--read-timeout", type=float, default=120, help="seconds allowed for reading the sheet")
     p.add_argument("--trace", default="", help="run the tool under strace, writing its log here")
