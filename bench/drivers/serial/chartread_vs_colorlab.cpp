@@ -454,7 +454,20 @@ int main(int argc, char** argv) {
     } else {
       std::printf("  total %.3f s (init %.3f, locate %.3f, read %.3f); load %s / %s\n", t.total(), t.init, t.locate, t.read,
                   t.load_before.c_str(), t.load_after.c_str());
-      std::printf("  timeline: %s\n", timeline.dump().substr(0, 4000).c_str());
+      if (timeline.is_object() && timeline.contains("per_patch") && timeline["per_patch"].size() > 1) {
+        // Means over patches 2..N (the first travels from the white tile), in wall seconds at the run's scale.
+        const auto& pp = timeline["per_patch"];
+        std::printf("  per patch (mean of 2..%zu, s):", pp.size());
+        for (const char* k : {"cycle", "measure_answer", "in_commands", "read_wait", "host_gaps"}) {
+          double sum = 0;
+          for (std::size_t i = 1; i < pp.size(); ++i) sum += pp[i].value(k, 0.0);
+          std::printf(" %s %.4f", k, sum / static_cast<double>(pp.size() - 1));
+        }
+        std::printf("\n  init split %s; calibration split %s\n", timeline["init_split"].dump().c_str(),
+                    timeline["calibrate_split"].dump().c_str());
+      } else {
+        std::printf("  could not read the trace's timeline\n");
+      }
     }
   }
   if (!o.json_out.empty()) std::ofstream(o.json_out) << out.dump(2) << "\n";
