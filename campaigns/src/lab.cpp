@@ -444,6 +444,7 @@ asio::awaitable<json> Lab::perform(const std::string& call, const json& args, co
     // Whoever answered may have moved the meter (aiming it is what most requests are about): readings
     // from here on are not comparable with those before.
     light_.moved();
+    aimed_since_stable_ = true;
     co_return answer;
   }
   if (call == "wait") {
@@ -525,6 +526,7 @@ asio::awaitable<json> Lab::restore(const LabState& desired, const ExecutionContr
       if (redone) {
         done.push_back(json{{"operator_action", action}, {"details", details}});
         light_.moved();  // the meter was aimed again after the lamps were found stable
+        aimed_since_stable_ = true;
       }
     }
   }

@@ -78,6 +78,7 @@ Lab::StableLight Lab::light_now(double luminance) const {
 
 void Lab::note_stable(double luminance) {
   stable_light_ = light_now(luminance);
+  aimed_since_stable_ = false;
   light_.stable(stable_light_->lamps, dimmer_percent_, luminance);
 }
 
@@ -108,7 +109,9 @@ void Lab::check_dropout(double luminance, const std::string& unit) const {
   // Proportional to the dimmer as a floor: a real dimmer gives more light at low settings, not less,
   // and the cabinet's floor varies by far less than the factor allowed here.
   double expected = stable_light_->luminance * dimmer_percent_ / stable_light_->dimmer_percent;
-  if (luminance >= options_.suspend.dropout_fraction * expected) return;
+  const double fraction =
+      aimed_since_stable_ ? options_.suspend.dropout_fraction_other_aim : options_.suspend.dropout_fraction;
+  if (luminance >= fraction * expected) return;
   std::string lit;
   for (const auto& l : stable_light_->lamps) lit += (lit.empty() ? "" : "+") + l;
   ErrorInfo info;
@@ -151,6 +154,7 @@ asio::awaitable<json> Lab::await_recovery(const std::string& call, const Error& 
         // A lamp that settled at a new level is not out: the new level is the yardstick from now on, and how
         // far it moved goes with the resumption.
         stable_light_ = light_now(level);
+        aimed_since_stable_ = false;
         light_.settle_at(stable_light_->lamps, dimmer_percent_, level);
         // … and still there after the settle time: stable again (a straight-line fit over a window centred
         // on a drift's turning point reads as stable once), not dark, and not moved on from where it settled.

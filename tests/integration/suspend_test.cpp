@@ -139,6 +139,66 @@ TEST(SuspendNotFail, ALampThatGoesOutSuspendsTheRunUntilItIsBackAndStable) {
   daemon.kill9();
 }
 
+// CWF found stable with the meter at the floor's bright middle, then read at its dark back corner: the floor
+// differs between spots by more than a dropout's bound at one aim, so a reading at another aim is held only to
+// a cabinet gone nearly dark (SuspendPolicy::dropout_fraction_other_aim).
+constexpr const char* kAimedElsewhere = R"(return {
+  description = "CWF stable at the floor's middle, then readings at its back-left corner",
+  needs = { "luminance_meter", "lamps" },
+  parameters = { readings = { type = "integer", default = 30, min = 1, max = 1000 } },
+  run = function(p)
+    local function aim(row, col)
+      lab.operator.request { action = "aim_meter", prompt = "aim", options = { "aimed" }, default = "aimed",
+                             timeout_s = 60, details = { row = row, col = col } }
+    end
+    lab.lamps.select("CWF")
+    lab.dimmer.set(100)
+    aim(4, 9)
+    lab.wait_stable()
+    local r = lab.meter.measure()
+    lab.record("middle", { quantity = "luminance", value = r.luminance, unit = r.unit, instrument = r.instrument })
+    aim(7, 0)
+    for i = 1, p.readings do
+      r = lab.meter.measure()
+      lab.record("corner/" .. i, { quantity = "luminance", value = r.luminance, unit = r.unit, instrument = r.instrument })
+      lab.wait(10)
+    end
+    return {}
+  end,
+})";
+
+TEST(SuspendNotFail, ADimSpotTheMeterWasAimedAtIsNotALampOutButADarkCabinetStillIs) {
+  TempDir dir;
+  DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), kTimeScale, 3, kSuspendConfig));
+  std::filesystem::create_directories(dir / "state" / "campaigns");
+  std::ofstream(dir / "state" / "campaigns" / "aimed.lua") << kAimedElsewhere;
+  auto api = api_for(daemon);
+  auto e = api.post("/v1/executions", {{"campaign", "aimed"}, {"params", {{"readings", 30}}}});
+  wait_for_measurements(api, e, 4);
+  json truth = control(daemon, {{"cmd", "truth"}});
+  json run = colorlab::client::fetch_run(api, e["run_id"].get<std::string>());
+  const double middle = run["measurements"][0]["value"].get<double>();
+  const double corner = truth["ls110"]["luminance"].get<double>();
+  // The premise: at the stable aim's bound (0.2) this spot would read as a lamp gone out.
+  // The premise: held to the stable aim's bound (SuspendPolicy::dropout_fraction, 0.2) this spot would read as a
+  // lamp gone out.
+  ASSERT_LT(corner, 0.2 * middle) << "the simulated CWF floor is no longer that uneven";
+  for (std::size_t i = 1; i < run["measurements"].size(); ++i) {
+    EXPECT_NEAR(run["measurements"][i]["value"].get<double>(), corner, 4 * truth["ls110"]["noise_sigma"].get<double>() + 0.01 * corner);
+  }
+  EXPECT_EQ(api.get("/v1/executions/" + e["id"].get<std::string>())["status"], "running");
+  for (const auto& ev : api.get("/v1/events?topic=execution&limit=300")["items"]) {
+    EXPECT_FALSE(ev["payload"].value("suspended", false)) << "the dim spot itself suspended the run: " << ev.dump();
+  }
+  // The lamp going out at that dim spot is still a dropout.
+  control(daemon, {{"cmd", "fault"}, {"instrument", "cabinet"}, {"faults", {{"lamp_dropout", {{"lamp", "CWF"}, {"seconds", 200}}}}}});
+  std::string reason = wait_suspended(api, e, std::chrono::seconds(30));
+  EXPECT_EQ(reason.rfind("lamp: ", 0), 0u) << reason;
+  auto done = wait_terminal(api, e["id"], std::chrono::seconds(120));
+  ASSERT_EQ(done["status"], "finished_ok") << done.dump(2);
+  daemon.kill9();
+}
+
 // The cabinet grid, reduced: one row of four spots, D65 at two dimmer levels, a minute of settling after
 // each dimmer change so that a lamp's bracket at a spot (its first level, the other, the first again)
 // spans two lab minutes.

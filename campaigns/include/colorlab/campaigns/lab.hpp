@@ -42,8 +42,13 @@ struct SuspendPolicy {
   double retry_s = 30;    // lab seconds between checks (at least 0.2 s of wall time)
   double settle_s = 60;   // lab seconds the condition must stay clear
   double max_s = 8 * 3600;
-  // A reading below this fraction of what the last stable reading predicts means a lamp went out.
+  // A reading below this fraction of what the last stable reading predicts means a lamp went out, at the aim
+  // where the lamps were found stable.
   double dropout_fraction = 0.2;
+  // The same at another aim. The floor of one cabinet differs between spots by far more than a reading's noise
+  // (the simulated CWF's back corner reads an eighth of its middle; the dissertation's CWF windows differ by
+  // 40 cd/m² of stdev), so only a cabinet gone nearly dark can be told from a dimmer spot there.
+  double dropout_fraction_other_aim = 0.05;
   // A reading that differs by more than this from the reading at the same aim, lamps and dimmer level since
   // the lamps were found stable means a lamp drifted. Above what the same light can read: the LS-110's
   // repeatability (4 σ of two readings ≈ 0.6 %) plus what a lamp accepted as stable may still rise (≤ 1 %
@@ -148,6 +153,8 @@ class Lab {
   // process need not wait for them again; a fresh process knows nothing and waits.
   std::set<std::string> known_warm_;
   std::optional<StableLight> stable_light_;
+  // Whether the meter may have been aimed elsewhere since stable_light_ was read (check_dropout's bound).
+  bool aimed_since_stable_ = false;
   // The yardstick for a drift: per dimmer level at the meter's present aim.
   LightReference light_;
   // What the last suspension for the light found (the level it settled at and how far it moved): added to
