@@ -159,7 +159,7 @@ json CampaignScript::validate(const json& params) const {
 }
 
 json CampaignScript::to_json() const {
-  return {{"name", name},     {"description", description}, {"needs", needs},
+  return {{"name", name},     {"kind", "campaign"},  {"description", description}, {"needs", needs},
           {"parameters", parameters}, {"origin", origin},  {"sha256", sha256},
           {"path", path.string()}};
 }

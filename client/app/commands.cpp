@@ -12,6 +12,7 @@
 #include "client_support.hpp"
 #include "follow.hpp"
 #include "format.hpp"
+#include "sequence_commands.hpp"
 
 namespace colorlab::cli {
 
@@ -25,11 +26,30 @@ struct RunOptions {
   bool detach = false;
   bool id_only = false;
   bool dry_run = false;
+  bool small = false;
   std::string idempotency_key;
 };
 
+// A sequence: every step queued as one group, the queue started, the group followed to its end.
+int run_sequence(const GlobalOptions& g, const RunOptions& o, const client::ApiClient& api) {
+  if (o.dry_run) {
+    throw Error(ErrorClass::bad_parameter, o.campaign + " is a sequence: a dry run goes step by step",
+                "colorlab study " + o.campaign + " --dry-run" + (o.small ? " --small" : ""));
+  }
+  json group = queue_sequence(api, o.campaign, o.params, o.small, "stop", o.idempotency_key, true);
+  if (!o.detach) group = follow_group(api, group, o.id_only || g.json);
+  if (o.id_only) {
+    for (const auto& run : group["run_ids"]) std::cout << run.get<std::string>() << "\n";
+  } else {
+    print(g, group, format_queue_group);
+  }
+  return o.detach || group["state"] == "done" ? 0 : 3;
+}
+
 int run_campaign(const GlobalOptions& g, const RunOptions& o) {
   auto api = make_client(g);
+  if (names_sequence(api, o.campaign)) return run_sequence(g, o, api);
+  if (o.small) throw Error(ErrorClass::bad_parameter, "--small is for a sequence; " + o.campaign + " is a campaign");
   json params = parse_params(o.params);
   if (o.dry_run) {
     json report = api.post("/v1/executions", {{"campaign", o.campaign}, {"params", params}, {"dry_run", true}});
@@ -77,9 +97,10 @@ void add_daemon_commands(CLI::App& app, GlobalOptions& global) {
   campaigns->callback([&global] { print(global, make_client(global).get("/v1/campaigns"), format_campaigns); });
 
   auto run_opts = std::make_shared<RunOptions>();
-  auto* run = app.add_subcommand("run", "Start a campaign and follow it to the end (exit 3 if it fails)");
-  run->add_option("campaign", run_opts->campaign, "campaign name, e.g. luminance-spot")->required();
-  run->add_option("-p,--param", run_opts->params, "campaign parameter KEY=VALUE (repeatable)");
+  auto* run = app.add_subcommand("run", "Start a campaign (or queue a sequence's steps) and follow it to the end (exit 3 if it fails)");
+  run->add_option("campaign", run_opts->campaign, "campaign or sequence name, e.g. luminance-spot, dissertation")->required();
+  run->add_option("-p,--param", run_opts->params, "campaign parameter KEY=VALUE, a sequence's STEP.KEY=VALUE (repeatable)");
+  run->add_flag("--small", run_opts->small, "a sequence's small variant (its `small` overrides)");
   run->add_flag("--detach", run_opts->detach, "return as soon as the campaign has started");
   run->add_flag("--id-only", run_opts->id_only, "print only the run id (for scripts)");
   run->add_flag("--dry-run", run_opts->dry_run,

@@ -56,6 +56,10 @@ std::string format_instruments(const json& list) {
 std::string format_campaigns(const json& list) {
   std::ostringstream o;
   for (const auto& c : list["items"]) {
+    if (c.value("kind", std::string()) == "sequence") {
+      o << format_sequence(c);
+      continue;
+    }
     o << str(c, "name") << "  (" << str(c, "origin") << ")\n    " << str(c, "description") << "\n";
     if (c.contains("needs") && !c["needs"].empty()) {
       o << "    needs:";
@@ -182,6 +186,45 @@ std::string format_requests(const json& list) {
   std::string out;
   for (const auto& r : list["items"]) out += format_request(r);
   return out;
+}
+
+// A sequence as GET /v1/campaigns lists it: its steps in order, what each takes from an earlier one,
+// the parameters each is given and the small variant's.
+std::string format_sequence(const json& c) {
+  std::ostringstream o;
+  o << str(c, "name") << "  (sequence, " << str(c, "origin") << ")\n    " << str(c, "description") << "\n";
+  int n = 0;
+  for (const auto& step : c.value("steps", json::array())) {
+    o << "    " << ++n << ". " << str(step, "name");
+    if (str(step, "campaign") != str(step, "name")) o << " (" << str(step, "campaign") << ")";
+    if (step.contains("params") && !step["params"].empty()) o << "  " << step["params"].dump();
+    if (step.contains("reference") && step["reference"].is_object()) {
+      o << "  " << str(step["reference"], "param") << " = the run of " << str(step["reference"], "step");
+    }
+    o << "\n";
+    const json small = c.value("small", json::object());
+    if (small.contains(str(step, "name"))) o << "       --small: " << small[str(step, "name")].dump() << "\n";
+  }
+  o << "    colorlab run " << str(c, "name") << " [--small] [-p STEP.KEY=VALUE]   (queues every step)\n";
+  return o.str();
+}
+
+std::string format_queue_group(const json& g) {
+  std::ostringstream o;
+  o << "group " << str(g, "id") << "  sequence " << str(g, "sequence") << "  " << str(g, "state") << "\n";
+  for (const auto& item : g.value("items", json::array())) {
+    o << "  " << str(item, "step") << "  " << str(item, "state");
+    if (item["position"].is_number()) o << " at position " << item["position"].dump();
+    o << "  item " << str(item, "id");
+    if (item.contains("run_id") && item["run_id"].is_string()) o << "  run " << item["run_id"].get<std::string>();
+    const json refs = item.value("param_refs", json::object());  // kept: items() of a temporary would dangle
+    for (const auto& [param, ref] : refs.items()) {
+      o << "  " << param << " ← " << ref.get<std::string>();
+    }
+    if (!item.value("reason", std::string()).empty()) o << "\n      " << item["reason"].get<std::string>();
+    o << "\n";
+  }
+  return o.str();
 }
 
 std::string format_queue_item(const json& q) {

@@ -17,5 +17,7 @@ std::string format_request(const nlohmann::json& request);
 std::string format_requests(const nlohmann::json& list);
 std::string format_queue(const nlohmann::json& queue);
 std::string format_queue_item(const nlohmann::json& item);
+std::string format_sequence(const nlohmann::json& sequence);
+std::string format_queue_group(const nlohmann::json& group);
 
 }  // namespace colorlab::cli

@@ -3,8 +3,10 @@
 #include <map>
 #include <memory>
 
+#include "colorlab/core/error.hpp"
 #include "client_support.hpp"
 #include "format.hpp"
+#include "sequence_commands.hpp"
 
 namespace colorlab::cli {
 
@@ -17,6 +19,7 @@ struct AddOptions {
   std::vector<std::string> params;
   std::string on_failure = "stop";
   std::string idempotency_key;
+  bool small = false;
 };
 
 }  // namespace
@@ -27,18 +30,31 @@ void add_queue_commands(CLI::App& app, GlobalOptions& global) {
 
   auto add_opts = std::make_shared<AddOptions>();
   auto* add = queue->add_subcommand("add", "Append a campaign to the queue (its parameters are checked now)");
-  add->add_option("campaign", add_opts->campaign, "campaign name, e.g. luminance-spot")->required();
-  add->add_option("-p,--param", add_opts->params, "campaign parameter KEY=VALUE (repeatable)");
+  add->add_option("campaign", add_opts->campaign, "campaign or sequence name, e.g. luminance-spot, dissertation")->required();
+  add->add_option("-p,--param", add_opts->params, "campaign parameter KEY=VALUE, a sequence's STEP.KEY=VALUE (repeatable)");
+  add->add_flag("--small", add_opts->small, "a sequence's small variant (its `small` overrides)");
   add->add_option("--on-failure", add_opts->on_failure, "if it fails: stop the queue, or continue with the next item")
       ->check(CLI::IsMember({"stop", "continue"}))
       ->capture_default_str();
   add->add_option("--idempotency-key", add_opts->idempotency_key, "retry-safe key: the same key never queues twice");
   add->callback([&global, add_opts] {
+    auto api = make_client(global);
+    if (names_sequence(api, add_opts->campaign)) {
+      // Every step at once, as one group; each reference filled in when its step comes up.
+      print(global,
+            queue_sequence(api, add_opts->campaign, add_opts->params, add_opts->small, add_opts->on_failure,
+                           add_opts->idempotency_key, false),
+            format_queue_group);
+      return;
+    }
+    if (add_opts->small) {
+      throw Error(ErrorClass::bad_parameter, "--small is for a sequence; " + add_opts->campaign + " is a campaign");
+    }
     std::map<std::string, std::string> headers;
     if (!add_opts->idempotency_key.empty()) headers["Idempotency-Key"] = add_opts->idempotency_key;
     json body{{"campaign", add_opts->campaign}, {"params", parse_params(add_opts->params)},
               {"on_failure", add_opts->on_failure}};
-    print(global, make_client(global).post("/v1/queue", body, headers), format_queue_item);
+    print(global, api.post("/v1/queue", body, headers), format_queue_item);
   });
 
   auto history = std::make_shared<unsigned>(10);

@@ -7,6 +7,7 @@
 // an earlier item's run ({"$run_of": id}, issue 11): it gets that run's id when it comes up, is skipped
 // with the reason when the referenced item failed, a bad reference and a reorder are refused with typed
 // 409s, and the reference survives kill -9 of the daemon during and between the two items.
+#include <algorithm>
 #include <fstream>
 #include <functional>
 #include <map>
@@ -50,6 +51,17 @@ return {
   end,
 }
 )lua";
+
+// The problem a refused request answers with.
+colorlab::protocol::Problem problem_of(const std::function<void()>& call) {
+  try {
+    call();
+  } catch (const ApiError& e) {
+    return e.problem();
+  }
+  ADD_FAILURE() << "accepted";
+  return colorlab::protocol::Problem{};
+}
 
 json spot(int readings, double interval_s = 0) { return {{"readings", readings}, {"interval_s", interval_s}}; }
 
@@ -369,15 +381,6 @@ TEST(queue_daemon, EnqueueIsValidatedExactlyAsADirectStartAndErrorsStoreNothing)
   std::ofstream(dir / "state" / "campaigns" / "chart.lua")
       << "return { needs = { \"spectrophotometer\" }, run = function(p) lab.spectro.calibrate() end }\n";
   auto api = api_for(daemon);
-  auto problem_of = [](const std::function<void()>& call) {
-    try {
-      call();
-    } catch (const ApiError& e) {
-      return e.problem();
-    }
-    ADD_FAILURE() << "accepted";
-    return colorlab::protocol::Problem{};
-  };
   // The same request refused the same way by POST /v1/executions and POST /v1/queue.
   const json requests[] = {
       {{"campaign", "no-such-campaign"}, {"params", json::object()}},
@@ -503,16 +506,6 @@ std::string recorded_source_run(const ApiClient& api, const json& item) {
   auto run = run_of(api, item);
   if (run["measurements"].empty()) return {};
   return run["measurements"][0]["data"].value("source_run", std::string());
-}
-
-colorlab::protocol::Problem problem_of(const std::function<void()>& call) {
-  try {
-    call();
-  } catch (const ApiError& e) {
-    return e.problem();
-  }
-  ADD_FAILURE() << "accepted";
-  return colorlab::protocol::Problem{};
 }
 
 }  // namespace
@@ -646,4 +639,128 @@ TEST(queue_references, TheReferenceSurvivesKillNineDuringAndBetweenTheItems) {
   std::string second_run = run_id_of(api, item_in(q, second));
   EXPECT_EQ(item_in(q, second_taker)["params"]["source_run"], second_run);
   EXPECT_EQ(recorded_source_run(api, item_in(q, second_taker)), second_run);
+}
+
+namespace {
+
+// A lab's own sequence: a reading, then a campaign that takes that reading's run.
+const char* kPairSequence = R"lua(
+return {
+  description = "a reading and the run that takes it",
+  steps = {
+    { name = "first", campaign = "luminance-spot", params = { readings = 3 } },
+    { name = "second", campaign = "takes-run", reference = { param = "source_run", step = "first" } },
+  },
+  small = { first = { readings = 1 } },
+}
+)lua";
+
+}  // namespace
+
+// A sequence of the catalogue (issue 11): listed by GET /v1/campaigns with kind "sequence"; POST
+// /v1/queue {"sequence"} (or "campaign" naming it) queues every step at once as a group whose items
+// reference each other's item ids; small and per-step overrides apply; a retry with the same key
+// returns the group; the group's route lists its runs once they ran; bad overrides are refused and
+// nothing is stored.
+TEST(queue_sequences, ASequenceIsQueuedAtOnceAsAGroupAndItsRunsAreListed) {
+  TempDir dir;
+  DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), 20, 1));
+  std::ofstream(dir / "state" / "campaigns" / "takes-run.lua") << kTakesRun;
+  std::ofstream(dir / "state" / "campaigns" / "pair.sequence.lua") << kPairSequence;
+  auto api = api_for(daemon);
+  json listed;
+  const json catalogue = api.get("/v1/campaigns");
+  for (const auto& c : catalogue["items"]) {
+    if (c["name"] == "pair") listed = c;
+  }
+  ASSERT_TRUE(listed.is_object());
+  EXPECT_EQ(listed["kind"], "sequence");
+  EXPECT_EQ(listed["steps"].size(), 2u);
+  EXPECT_EQ(listed["steps"][1]["reference"]["step"], "first");
+  EXPECT_EQ(listed["small"]["first"]["readings"], 1);
+
+  EXPECT_EQ(problem_of([&] { api.post("/v1/queue", {{"sequence", "pair"}, {"overrides", {{"third", {{"x", 1}}}}}}); })
+                .status,
+            400);
+  auto refused = problem_of([&] { api.post("/v1/queue", {{"sequence", "pair"}, {"overrides", {{"first", {{"readings", 0}}}}}}); });
+  EXPECT_EQ(refused.status, 400);
+  EXPECT_NE(refused.detail.find("step 'first'"), std::string::npos) << refused.detail;
+  EXPECT_EQ(problem_of([&] { api.post("/v1/queue", {{"sequence", "nope"}}); }).status, 404);
+  EXPECT_EQ(problem_of([&] { api.post("/v1/queue", {{"sequence", "pair"}, {"small", "yes"}}); }).status, 400);
+  EXPECT_TRUE(queue_of(api)["items"].empty()) << "a refused sequence stores nothing";
+
+  json body{{"sequence", "pair"}, {"small", true}, {"overrides", {{"second", json::object()}}}};
+  auto created = api.request("POST", "/v1/queue", body.dump(), {{"Idempotency-Key", "night-2"}});
+  ASSERT_EQ(created.status, 201) << created.body;
+  auto group = json::parse(created.body);
+  EXPECT_EQ(created.headers["Location"], "/v1/queue/groups/" + group["id"].get<std::string>());
+  auto again = api.request("POST", "/v1/queue", body.dump(), {{"Idempotency-Key", "night-2"}});
+  EXPECT_EQ(again.status, 200);
+  EXPECT_EQ(json::parse(again.body)["id"], group["id"]);
+  EXPECT_EQ(group["sequence"], "pair");
+  EXPECT_EQ(group["state"], "queued");
+  ASSERT_EQ(group["items"].size(), 2u);
+  const auto& first = group["items"][0];
+  const auto& second = group["items"][1];
+  EXPECT_EQ(first["step"], "first");
+  EXPECT_EQ(first["params"]["readings"], 1) << "the small variant";
+  EXPECT_EQ(second["group_id"], group["id"]);
+  EXPECT_EQ(second["param_refs"]["source_run"], first["id"]);
+  EXPECT_EQ(second["params"]["source_run"], json({{"$run_of", first["id"]}}));
+  // "campaign" naming the sequence queues it too (colorlab queue add pair).
+  auto by_campaign = api.post("/v1/queue", {{"campaign", "pair"}});
+  EXPECT_EQ(by_campaign["items"].size(), 2u);
+  EXPECT_EQ(by_campaign["items"][0]["params"]["readings"], 3) << "not small unless asked";
+  EXPECT_EQ(queue_of(api)["items"].size(), 4u);
+  api.del("/v1/queue/" + by_campaign["items"][0]["id"].get<std::string>());
+
+  api.post("/v1/queue/start", json::object());
+  auto q = wait_queue(api, emptied);
+  ASSERT_TRUE(emptied(q)) << q.dump(1);
+  auto ran = api.get("/v1/queue/groups/" + group["id"].get<std::string>());
+  EXPECT_EQ(ran["state"], "done") << ran.dump(1);
+  ASSERT_EQ(ran["run_ids"].size(), 2u);
+  EXPECT_EQ(ran["runs"]["first"], ran["run_ids"][0]);
+  EXPECT_EQ(ran["items"][0]["run_id"], ran["run_ids"][0]);
+  EXPECT_EQ(recorded_source_run(api, ran["items"][1]), ran["run_ids"][0]);
+  auto orphaned = api.get("/v1/queue/groups/" + by_campaign["id"].get<std::string>());
+  EXPECT_EQ(orphaned["state"], "failed") << "its first step was removed, so its second was skipped";
+  EXPECT_EQ(orphaned["items"][1]["state"], "skipped");
+  EXPECT_EQ(problem_of([&] { api.get("/v1/queue/groups/0190aaaa-0000-7000-8000-000000000000"); }).status, 404);
+}
+
+TEST(queue_sequences, TheCliRunsASequenceToItsEndAndListsIt) {
+  TempDir dir;
+  DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), 20, 1));
+  std::ofstream(dir / "state" / "campaigns" / "takes-run.lua") << kTakesRun;
+  std::ofstream(dir / "state" / "campaigns" / "pair.sequence.lua") << kPairSequence;
+  auto cli = [&](std::vector<std::string> args) {
+    std::vector<std::string> argv{bin_path("colorlab"), "--socket", daemon.unix_socket()};
+    argv.insert(argv.end(), args.begin(), args.end());
+    return run_command(argv, std::chrono::seconds(60));
+  };
+  auto campaigns = cli({"campaigns"});
+  ASSERT_EQ(campaigns.exit_code, 0) << campaigns.err;
+  EXPECT_NE(campaigns.out.find("pair  (sequence, lab)"), std::string::npos) << campaigns.out;
+  EXPECT_NE(campaigns.out.find("source_run = the run of first"), std::string::npos) << campaigns.out;
+
+  auto run = cli({"--json", "run", "pair", "--small", "-p", "first.interval_s=0.1"});
+  ASSERT_EQ(run.exit_code, 0) << run.out << run.err;
+  auto group = json::parse(run.out);
+  EXPECT_EQ(group["state"], "done");
+  ASSERT_EQ(group["run_ids"].size(), 2u);
+  EXPECT_EQ(group["items"][0]["params"]["interval_s"], 0.1);
+  EXPECT_EQ(group["items"][1]["params"]["source_run"], group["run_ids"][0]);
+
+  auto ids = cli({"run", "pair", "--id-only"});
+  ASSERT_EQ(ids.exit_code, 0) << ids.err;
+  EXPECT_EQ(std::count(ids.out.begin(), ids.out.end(), '\n'), 2) << ids.out;
+
+  auto queued = cli({"queue", "add", "pair", "-p", "second.source_run=x"});
+  EXPECT_EQ(queued.exit_code, 2) << "a reference is the sequence's to fill in: " << queued.err;
+  EXPECT_NE(cli({"queue", "add", "pair", "-p", "nodot=1"}).exit_code, 0);
+  EXPECT_NE(cli({"queue", "add", "luminance-spot", "--small"}).exit_code, 0);
+  auto added = cli({"queue", "add", "pair", "--small"});
+  ASSERT_EQ(added.exit_code, 0) << added.err;
+  EXPECT_NE(added.out.find("source_run ←"), std::string::npos) << added.out;
 }

@@ -87,6 +87,7 @@ HttpResponse get_campaigns(ApiContext& ctx) {
   ctx.catalogue.refresh();
   json items = json::array();
   for (const auto& c : ctx.catalogue.all()) items.push_back(c->to_json());
+  for (const auto& s : ctx.catalogue.sequences()) items.push_back(s->to_json());  // kind "sequence"
   json broken = json::array();
   for (const auto& b : ctx.catalogue.broken()) broken.push_back({{"path", b.path.string()}, {"error", b.error}});
   json dirs = json::array();

@@ -3,6 +3,7 @@
 #include <boost/asio/post.hpp>
 
 #include "colorlab/core/error.hpp"
+#include "colorlab/core/ids.hpp"
 #include "colorlab/core/log.hpp"
 #include "colorlab/daemon/campaign_request.hpp"
 #include "colorlab/protocol/states.hpp"
@@ -223,6 +224,81 @@ store::QueueStore::Enqueued NightQueue::enqueue(const std::string& campaign, con
   auto enqueued = queue_.enqueue(n);
   if (enqueued.created) poke();
   return enqueued;
+}
+
+store::QueueStore::EnqueuedGroup NightQueue::enqueue_sequence(const std::string& name, bool small,
+                                                              const json& overrides, store::OnFailure on_failure,
+                                                              const std::optional<std::string>& idempotency_key) {
+  catalogue_.refresh();
+  auto sequence = catalogue_.find_sequence(name);
+  if (!sequence) throw Error(ErrorClass::not_found, "no sequence named '" + name + "'", "colorlab campaigns lists them");
+  std::map<std::string, std::string> ids;  // step -> its item's id, for the steps after it
+  std::vector<store::NewQueueItem> items;
+  for (const auto& step : sequence->expand(small, overrides)) {
+    std::string id = new_uuid_v7();
+    json params = step.params;
+    std::map<std::string, std::string> refs;
+    if (step.reference_param) {
+      refs[*step.reference_param] = ids.at(*step.reference_step);
+      params[*step.reference_param] = json{{store::kRunOfKey, refs[*step.reference_param]}};
+    }
+    store::NewQueueItem n;
+    try {
+      n = {step.campaign, validated_with_references(catalogue_, lab_, step.campaign, params, refs), on_failure,
+           idempotency_key ? std::optional<std::string>(*idempotency_key + "/" + step.name) : std::nullopt};
+    } catch (const Error& e) {
+      ErrorInfo info = e.info();
+      info.message = "step '" + step.name + "' (" + step.campaign + ") of sequence " + name + ": " + info.message;
+      throw Error(info);
+    }
+    n.param_refs = refs;
+    n.id = id;
+    n.step = step.name;
+    ids[step.name] = id;
+    items.push_back(std::move(n));
+  }
+  json options{{"small", small}, {"overrides", overrides.is_null() ? json::object() : overrides},
+               {"on_failure", store::to_string(on_failure)}};
+  auto enqueued = queue_.enqueue_group(new_uuid_v7(), name, options, items);
+  if (enqueued.created) poke();
+  return enqueued;
+}
+
+json NightQueue::describe_group(const store::QueueGroup& group) {
+  json items = json::array();
+  json runs = json::object();
+  json run_ids = json::array();
+  bool all_done = !group.items.empty(), any_bad = false, any_running = false;
+  for (const auto& item : group.items) {
+    json j = item.to_json();
+    std::optional<store::ExecutionRecord> execution;
+    if (item.execution_id) execution = store_.execution(*item.execution_id);
+    j["run_id"] = execution ? json(execution->run_id) : json(nullptr);
+    if (execution && item.state == QueueItemState::done) {
+      runs[item.step.value_or(item.id)] = execution->run_id;
+      run_ids.push_back(execution->run_id);
+    }
+    all_done = all_done && item.state == QueueItemState::done;
+    any_bad = any_bad || item.state == QueueItemState::failed || item.state == QueueItemState::skipped ||
+              item.state == QueueItemState::removed;
+    any_running = any_running || item.state == QueueItemState::running;
+    items.push_back(j);
+  }
+  std::string state = all_done ? "done" : any_bad ? "failed" : any_running ? "running" : "queued";
+  return {{"id", group.id},       {"sequence", group.sequence}, {"options", group.options},
+          {"created_at", group.created_at}, {"state", state},  {"items", items},
+          {"runs", runs},         {"run_ids", run_ids}};
+}
+
+json NightQueue::group(const std::string& id) {
+  auto g = queue_.group(id);
+  if (!g) throw Error(ErrorClass::not_found, "no queue group with id '" + id + "'", "a sequence queued returns its group's id");
+  return describe_group(*g);
+}
+
+bool NightQueue::is_sequence(const std::string& name) {
+  catalogue_.refresh();
+  return catalogue_.find_sequence(name) && !catalogue_.find(name);
 }
 
 QueueItem NightQueue::remove(const std::string& id) { return queue_.remove(id); }

@@ -60,21 +60,56 @@ HttpResponse item_response(int status, const store::QueueItem& item) {
   return r;
 }
 
+// {"sequence": NAME, "small": bool, "overrides": {step: {key: value}}, "on_failure": ...}: the whole
+// sequence queued as one group; 201 with the group (200 for a retried Idempotency-Key).
+HttpResponse post_sequence(NightQueue& queue, const HttpRequest& req, const json& body, const std::string& name,
+                           store::OnFailure on_failure) {
+  const std::string example = R"({"sequence": "dissertation", "small": true, "overrides": {"frame-average": {"frames": 8}}})";
+  if (body.contains("params") && !(body["params"].is_object() && body["params"].empty())) {
+    throw Error(ErrorClass::bad_parameter, "a sequence takes 'overrides' per step, not 'params'", "e.g. " + example);
+  }
+  bool small = false;
+  if (body.contains("small")) {
+    if (!body["small"].is_boolean()) throw Error(ErrorClass::bad_parameter, "'small' must be true or false", "e.g. " + example);
+    small = body["small"].get<bool>();
+  }
+  bool start = false;
+  if (body.contains("start")) {
+    if (!body["start"].is_boolean()) throw Error(ErrorClass::bad_parameter, "'start' must be true or false", "e.g. " + example);
+    start = body["start"].get<bool>();
+  }
+  json overrides = body.value("overrides", json::object());
+  auto enqueued = queue.enqueue_sequence(name, small, overrides, on_failure, req.header("idempotency-key"));
+  // "start": the queue started in the same request, so a client that dies on the answer leaves a running night.
+  if (start) queue.start();
+  auto r = HttpResponse::json(enqueued.created ? 201 : 200, queue.describe_group(enqueued.group));
+  r.headers["Location"] = std::string(protocol::kPrefix) + "/queue/groups/" + enqueued.group.id;
+  return r;
+}
+
 HttpResponse post_item(NightQueue& queue, const HttpRequest& req) {
   const std::string example = R"({"campaign": "luminance-spot", "params": {"readings": 3}, "on_failure": "continue"})";
   auto parsed = json_body(req, example);
   if (auto* problem = std::get_if<HttpResponse>(&parsed)) return *problem;
   const json& body = std::get<json>(parsed);
-  if (!body.contains("campaign") || !body["campaign"].is_string()) {
-    throw Error(ErrorClass::bad_parameter, "the body needs a string 'campaign'", "e.g. " + example);
-  }
-  json params = body.value("params", json::object());
-  if (!params.is_object()) throw Error(ErrorClass::bad_parameter, "'params' must be an object", "e.g. " + example);
   auto on_failure = store::OnFailure::stop;
   if (body.contains("on_failure")) {
     if (!body["on_failure"].is_string()) throw Error(ErrorClass::bad_parameter, "'on_failure' must be \"stop\" or \"continue\"");
     on_failure = store::on_failure_from_string(body["on_failure"].get<std::string>());
   }
+  if (body.contains("sequence")) {
+    if (!body["sequence"].is_string()) throw Error(ErrorClass::bad_parameter, "'sequence' must be a sequence's name");
+    return post_sequence(queue, req, body, body["sequence"].get<std::string>(), on_failure);
+  }
+  if (!body.contains("campaign") || !body["campaign"].is_string()) {
+    throw Error(ErrorClass::bad_parameter, "the body needs a string 'campaign'", "e.g. " + example);
+  }
+  // A sequence's name where a campaign's is expected queues the sequence (colorlab queue add dissertation).
+  if (queue.is_sequence(body["campaign"].get<std::string>())) {
+    return post_sequence(queue, req, body, body["campaign"].get<std::string>(), on_failure);
+  }
+  json params = body.value("params", json::object());
+  if (!params.is_object()) throw Error(ErrorClass::bad_parameter, "'params' must be an object", "e.g. " + example);
   auto enqueued = queue.enqueue(body["campaign"].get<std::string>(), params, on_failure, req.header("idempotency-key"));
   // A retried POST with the same Idempotency-Key answers with the item it created the first time.
   return item_response(enqueued.created ? 201 : 200, enqueued.item);
@@ -133,6 +168,10 @@ std::optional<HttpResponse> dispatch(ApiContext& ctx, const HttpRequest& req) {
     if (req.method == "GET") return item_response(200, queue.item(rest));
     if (req.method == "DELETE") return item_response(200, queue.remove(rest));
     return method_not_allowed(req, "GET, DELETE");
+  }
+  if (rest.rfind("groups/", 0) == 0 && rest.size() > 7 && rest.find('/', 7) == std::string::npos) {
+    if (req.method != "GET") return method_not_allowed(req, "GET");
+    return HttpResponse::json(200, queue.group(rest.substr(7)));
   }
   if (slash > 0 && rest.substr(slash + 1) == "move") {
     if (req.method != "POST") return method_not_allowed(req, "POST");

@@ -2,7 +2,8 @@
 // Where campaigns come from: the shipped scripts installed with the program and the lab's own
 // directory. refresh() re-reads a file only when its size or mtime changed, so a script dropped in
 // (or edited) is picked up by the next request without a restart. A script that fails to parse is
-// listed with its error instead of silently disappearing.
+// listed with its error instead of silently disappearing. NAME.sequence.lua files are sequences
+// (sequence.hpp): campaigns queued together; a sequence may not share a campaign's name.
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -10,6 +11,7 @@
 #include <vector>
 
 #include "colorlab/campaigns/script.hpp"
+#include "colorlab/campaigns/sequence.hpp"
 
 namespace colorlab::campaigns {
 
@@ -31,6 +33,8 @@ class ScriptCatalogue {
   void refresh();
   std::shared_ptr<const CampaignScript> find(const std::string& name) const;
   std::vector<std::shared_ptr<const CampaignScript>> all() const;
+  std::shared_ptr<const CampaignSequence> find_sequence(const std::string& name) const;
+  std::vector<std::shared_ptr<const CampaignSequence>> sequences() const;
   const std::vector<BrokenScript>& broken() const { return broken_; }
   const std::vector<CampaignDirectory>& directories() const { return directories_; }
 
@@ -39,11 +43,13 @@ class ScriptCatalogue {
     std::filesystem::file_time_type mtime;
     std::uintmax_t size = 0;
     std::shared_ptr<const CampaignScript> script;
+    std::shared_ptr<const CampaignSequence> sequence;
     std::string error;
   };
   std::vector<CampaignDirectory> directories_;
   std::map<std::filesystem::path, Cached> cache_;
   std::map<std::string, std::shared_ptr<const CampaignScript>> by_name_;
+  std::map<std::string, std::shared_ptr<const CampaignSequence>> sequences_;
   std::vector<BrokenScript> broken_;
 };
 

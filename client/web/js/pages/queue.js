@@ -51,7 +51,7 @@ export function mount(section, ctx) {
   async function loadCampaigns() {
     try {
       const r = await get("/v1/campaigns");
-      campaigns = r.items;
+      campaigns = r.items.filter(c => c.kind !== "sequence");  // a sequence is queued whole: colorlab run NAME
       const keep = select.value;
       replace(select, campaigns.map(c => h("option", { value: c.name }, c.name)));
       if (campaigns.some(c => c.name === keep)) select.value = keep;

@@ -22,7 +22,7 @@ export function mount(section, ctx) {
     const fCampaign = h("input", { id: "filter-campaign", type: "search", value: filter.campaign, placeholder: "e.g. luminance-spot",
       list: "campaign-names" });
     const names = h("datalist", { id: "campaign-names" });
-    get("/v1/campaigns").then(c => replace(names, (c.items || []).map(i => h("option", { value: i.name })))).catch(() => {});
+    get("/v1/campaigns").then(c => replace(names, (c.items || []).filter(i => i.kind !== "sequence").map(i => h("option", { value: i.name })))).catch(() => {});
     const fStatus = h("select", { id: "filter-status" }, ["", "running", "finished_ok", "finished_error", "aborted", "interrupted"]
       .map(s => h("option", { value: s, selected: s === filter.status }, s || "any")));
     const table = h("div", { class: "table-wrap" }, h("p", { class: "muted" }, "…"));

@@ -45,6 +45,19 @@ class NightQueue {
   // queue-reference-unknown / queue-reference-ended for an item that does not exist or never will run).
   store::QueueStore::Enqueued enqueue(const std::string& campaign, const nlohmann::json& params,
                                       store::OnFailure on_failure, const std::optional<std::string>& idempotency_key);
+  // A catalogue sequence's steps queued at once as one group, each step validated as enqueue does and
+  // its reference given as {"$run_of": <the referenced step's item>}; `small` applies the sequence's
+  // small overrides, then `overrides` ({step: {key: value}}). A retry with the same Idempotency-Key
+  // returns the group it queued.
+  store::QueueStore::EnqueuedGroup enqueue_sequence(const std::string& name, bool small, const nlohmann::json& overrides,
+                                                    store::OnFailure on_failure,
+                                                    const std::optional<std::string>& idempotency_key);
+  // {id, sequence, options, created_at, state: queued|running|done|failed, items (each with run_id),
+  //  runs: {step: run id} and run_ids (in order) of its done items}
+  nlohmann::json describe_group(const store::QueueGroup& group);
+  nlohmann::json group(const std::string& id);
+  // A catalogue sequence by this name, and no campaign by it.
+  bool is_sequence(const std::string& name);
   store::QueueItem remove(const std::string& id);
   store::QueueItem move(const std::string& id, std::int64_t position);
   store::QueueItem item(const std::string& id);
