@@ -35,8 +35,9 @@ done
 
 "$bin/colorlab" --url "$url" status
 "$bin/colorlab" --url "$url" instruments
-# The study: chart-read, frame-average, cabinet-grid, characterize-camera through the night queue, followed by the
-# event stream, then the report. Over the Unix socket (control needs no key there); its last line is the report.
+# The study: the daemon's sequence `dissertation` (chart-read, frame-average, cabinet-grid, floor-luminance,
+# characterize-camera, dimmer-exposure) queued as one group of the night queue, followed by the event stream, then
+# the report. Over the Unix socket (control needs no key there); its last line is the report.
 report="$state/dissertation-report.html"
 "$bin/colorlab" --socket "$state/colorlabd.sock" study dissertation \
   --state-file "$state/dissertation-study.json" -o "$report" | tee "$state/dissertation-study.log"

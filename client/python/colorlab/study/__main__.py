@@ -1,8 +1,10 @@
 """python3 -m colorlab.study dissertation [--url URL | --socket PATH] [--key KEY] [-o report.html] [--dry-run]
                                         [--small] [--set STEP.KEY=VALUE …] [--state-file FILE] [--resume] [--json]
 
-Runs the study's campaigns through the daemon's night queue (so it survives a restart of colorlabd), follows
-them by the event stream printing progress lines, then writes the report of all the study's runs; the report's
+Queues the study — the daemon's sequence STUDY (GET /v1/campaigns, kind "sequence"; the one definition of its steps) —
+as one group in the night queue, where it runs to its end whatever happens to this process (or to colorlabd: the
+queue is durable); follows the group by the event stream printing progress lines, then writes the report of all
+the study's runs; the report's
 path is the last line of stdout. With --json the progress lines go to stderr and stdout is one JSON object: the
 study's runs by step, the report's path and the timings (a dry run: each step's estimate). Exit codes: 0 ok, 2 usage, 3 daemon/run problem, 4 a campaign of the study
 failed (named, with its problem on stderr).
@@ -23,7 +25,7 @@ from .runner import EXIT_DAEMON, EXIT_FAILED, EXIT_OK, EXIT_USAGE, Study, StudyF
 def parse(argv):
     p = argparse.ArgumentParser(prog="python3 -m colorlab.study",
                                 description="Run a built-in study (its campaigns through the night queue) and write its report.")
-    p.add_argument("study", choices=sorted(definition.STUDIES), help="the study")
+    p.add_argument("study", help="the study: a sequence of the daemon's catalogue, e.g. dissertation")
     where = p.add_mutually_exclusive_group()
     where.add_argument("--url", help="the daemon's URL (default: COLORLAB_URL, then the local daemon's endpoint file)")
     where.add_argument("--socket", help="the daemon's Unix socket (default: COLORLAB_SOCKET)")
@@ -41,12 +43,11 @@ def parse(argv):
                    help="progress on stderr; stdout one JSON object (runs, report path, timings) at the end")
     args = p.parse_args(argv)
     overrides: dict = {}
-    names = {s["name"] for s in definition.STUDIES[args.study]}
     for item in args.set:
         key, eq, raw = item.partition("=")
         step, dot, param = key.partition(".")
-        if not eq or not dot or not param or step not in names:
-            p.error(f"--set {item!r}: expected STEP.KEY=VALUE with STEP one of {', '.join(sorted(names))}")
+        if not eq or not dot or not step or not param:
+            p.error(f"--set {item!r}: expected STEP.KEY=VALUE (colorlab campaigns lists the study's steps)")
         try:
             value = json.loads(raw)
         except ValueError:
@@ -69,9 +70,15 @@ def main(argv=None) -> int:
     except Exception as e:
         print(f"colorlab study: cannot reach the daemon: {e}", file=sys.stderr)
         return EXIT_DAEMON
-    steps = definition.steps(args.study, small=args.small, overrides=args.overrides)
-    study = Study(client, args.study, steps, state_file=args.state_file, resume=args.resume, json_output=args.json)
     try:
+        try:
+            steps = definition.steps(definition.sequence(client, args.study), small=args.small,
+                                     overrides=args.overrides)
+        except definition.UnknownStudy as e:
+            print(f"colorlab study: {e}", file=sys.stderr)
+            return EXIT_USAGE
+        study = Study(client, args.study, steps, state_file=args.state_file, resume=args.resume,
+                      json_output=args.json, small=args.small, overrides=args.overrides)
         if args.dry_run:
             return study.dry_run()
         run_ids = study.run()

@@ -1,89 +1,39 @@
-"""The dissertation study's definition: which campaigns, in which order, with which parameters.
-
-Data only. Each step is one queue item; ``reference`` names an earlier step whose run id goes into the
-given parameter when the item is queued (characterize-camera's ``reference_run`` is the study's own
-chart-read, so it is queued once that chart-read has finished). ``covers`` says what of the report the step
-is for (docs/reports.md, "What it contains").
+"""A study's definition, as the daemon's catalogue has it: the sequence NAME (campaigns/scripts/NAME.sequence.lua,
+GET /v1/campaigns with ``kind: "sequence"``) — which campaigns, in which order, with which parameters, which earlier
+step's run each ``reference`` takes, and the ``small`` variant's overrides. The sequence is the one place the study's
+steps are written; this module only reads it (docs/campaigns.md, "Sequences").
 """
 from __future__ import annotations
 
-DISSERTATION = [
-    {
-        "name": "chart-read",
-        "campaign": "chart-read",
-        # §6.1: the SG's 140 patches on the SpectroScan T; the reference for chapter 7.
-        "params": {"chart": "sg"},
-        "covers": "§6.1 chart reference (a*-b*, L* per patch); reference of characterize-camera",
-    },
-    {
-        "name": "frame-average",
-        "campaign": "frame-average",
-        "params": {"frames": 25},
-        "covers": "Table 2, fig. 34",
-    },
-    {
-        "name": "cabinet-grid",
-        "campaign": "cabinet-grid",
-        # The full 8 x 10 grid (Tables 3-6 are compared cell by cell only on it), three lamps x four levels:
-        # figs. 36-42 (D65 at 100/50/25/15 %), 43-46 (TL84, CWF at 100 and 50 %, and every other level),
-        # dimmer proportionality, lamps compared. Lamp-major: 3 lamp warm-ups instead of 161.
-        "params": {"rows": 8, "cols": 10, "lamps": ["D65", "TL84", "CWF"], "dimmer_levels": [100, 50, 25, 15],
-                   "order": "lamp-major"},
-        "covers": "Tables 3-6, figs. 36-46, dimmer proportionality, lamps compared",
-    },
-    {
-        "name": "floor-luminance",
-        "campaign": "floor-luminance",
-        # The camera as an imaging luminance meter against that grid (issue 11): the same spots, lamps and levels
-        # from one photograph per lamp and level, calibrated on five LS-110 spots. Four frames: averaging more
-        # changes the floor's spot values by less than the LS-110's own noise (the report's Pareto chart shows it).
-        "params": {"rows": 8, "cols": 10, "lamps": ["D65", "TL84", "CWF"], "dimmer_levels": [100, 50, 25, 15],
-                   "frames": 4},
-        "reference": {"param": "grid_run", "step": "cabinet-grid"},
-        "covers": "the camera as an imaging luminance meter: agreement with the grid, time, Pareto chart",
-    },
-    {
-        "name": "characterize-camera",
-        "campaign": "characterize-camera",
-        # The three test cases of ch. 7 (8-bit TIFF, JPEG, 16-bit TIFF) and the raw for the black box.
-        # prior_exclude: the simulated camera is a 20D; its own curves must not be in the black box's prior.
-        "params": {"chart": "sg", "formats": ["raw", "tiff16", "tiff8", "jpeg"], "frames": 25, "lamp": "D65",
-                   "prior_exclude": ["Canon_20D"]},
-        "reference": {"param": "reference_run", "step": "chart-read"},
-        "covers": "Tables 9-13, figs. 51-60, black box",
-    },
-    {
-        "name": "dimmer-exposure",
-        "campaign": "dimmer-exposure",
-        # §6.2's end: one SG photograph per dimmer level, exposure doubled as the light halves (Table 7), the dark
-        # border patches' interval lengths (Table 8). Last: it leaves the camera at 1/30 s, f/4 and the dimmer at 100 %.
-        "params": {"levels": [100, 50, 25, 15]},
-        "reference": {"param": "reference_run", "step": "chart-read"},
-        "covers": "Tables 7, 8",
-    },
-]
-
-# --small: the same campaigns, reduced (tests, a first look): a 2 x 5 grid at two lamps and levels,
-# fewer frames. Tables 3-6 are then not compared cell by cell (the report says so).
-SMALL_OVERRIDES = {
-    "frame-average": {"frames": 4},
-    "cabinet-grid": {"rows": 2, "cols": 5, "lamps": ["D65", "TL84"], "dimmer_levels": [100, 50], "settle_s": 0},
-    "characterize-camera": {"frames": 2},
-    "floor-luminance": {"rows": 2, "cols": 5, "lamps": ["D65", "TL84"], "dimmer_levels": [100, 50], "settle_s": 0,
-                        "frames": 2},
-    "dimmer-exposure": {"levels": [100, 15], "shutter_s": [1 / 30, 1 / 4]},
-}
-
-STUDIES = {"dissertation": DISSERTATION}
+import colorlab
 
 
-def steps(study: str = "dissertation", *, small: bool = False, overrides: dict | None = None) -> list[dict]:
-    """The study's steps with ``--small`` and ``--set STEP.KEY=VALUE`` overrides applied (copies)."""
+class UnknownStudy(Exception):
+    """No sequence of that name, or an override of a step it does not have: a usage error (exit 2)."""
+
+
+def sequence(client: colorlab.Client, study: str) -> dict:
+    """The sequence as GET /v1/campaigns lists it: {name, kind, description, steps: [...], small: {...}}."""
+    items = client.conn.get("/v1/campaigns").get("items") or []
+    for item in items:
+        if item.get("name") == study and item.get("kind") == "sequence":
+            return item
+    names = sorted(i["name"] for i in items if i.get("kind") == "sequence")
+    raise UnknownStudy(f"the daemon has no study (sequence) named {study!r}; sequences: {', '.join(names) or 'none'}")
+
+
+def steps(seq: dict, *, small: bool = False, overrides: dict | None = None) -> list[dict]:
+    """The sequence's steps as the daemon queues them (small overrides, then ``--set STEP.KEY=VALUE``), for a dry run
+    and for display. Each: {name, campaign, params, reference: {param, step} or None, covers}."""
+    names = [s["name"] for s in seq["steps"]]
+    unknown = sorted(set(overrides or {}) - set(names))
+    if unknown:
+        raise UnknownStudy(f"study {seq['name']} has no step {', '.join(unknown)}; steps: {', '.join(names)}")
     out = []
-    for step in STUDIES[study]:
-        s = {**step, "params": dict(step["params"])}
+    for step in seq["steps"]:
+        params = dict(step.get("params") or {})
         if small:
-            s["params"].update(SMALL_OVERRIDES.get(s["name"], {}))
-        s["params"].update((overrides or {}).get(s["name"], {}))
-        out.append(s)
+            params.update((seq.get("small") or {}).get(step["name"], {}))
+        params.update((overrides or {}).get(step["name"], {}))
+        out.append({**step, "params": params})
     return out

@@ -1,9 +1,11 @@
-"""Running a study: its steps queued in the daemon's night queue, followed by the event stream, then reported.
+"""Running a study: its sequence queued in the daemon's night queue as one group, followed by the event stream, then
+reported.
 
-The study's queue items are kept in a small JSON state file (study id, item id per step) and queued with an
-``Idempotency-Key`` of ``colorlab-study/<study id>/<step>``: a re-run with ``--resume`` after this process or
-the daemon was stopped finds its items again (the queue itself is durable and goes on by itself), and a retry
-after a lost answer never queues a step twice.
+The daemon queues every step at once (POST /v1/queue {"sequence": ..., "start": true}); a step that takes an earlier
+step's run gets it from the daemon when it comes up ({"$run_of": item}), so the night completes whatever happens to
+this process. A small JSON state file keeps the study's id and its group; the group is queued with an
+``Idempotency-Key`` of ``colorlab-study/<study id>``, so a re-run with ``--resume`` re-attaches to the group (or, if
+this process died before it saw the answer, gets the same group back) and never queues the study twice.
 """
 from __future__ import annotations
 
@@ -18,7 +20,6 @@ import uuid
 import colorlab
 
 EXIT_OK, EXIT_USAGE, EXIT_DAEMON, EXIT_FAILED = 0, 2, 3, 4
-ENDED_BAD = ("failed", "skipped", "removed")
 PRINT_EVERY_S = 2.0
 
 
@@ -41,7 +42,8 @@ def _duration(s: float | None) -> str:
 
 class Study:
     def __init__(self, client: colorlab.Client, name: str, steps: list[dict], *, state_file: str,
-                 resume: bool = False, json_output: bool = False):
+                 resume: bool = False, json_output: bool = False, small: bool = False,
+                 overrides: dict | None = None):
         self.client, self.name, self.steps, self.state_file = client, name, steps, state_file
         # With --json, stdout carries one JSON object at the end: progress goes to stderr.
         self.json_output = json_output
@@ -52,10 +54,9 @@ class Study:
                 self.state = json.load(f)
             if self.state.get("study") != name:
                 raise StudyProblem(f"{state_file} is the state of study {self.state.get('study')!r}, not {name!r}")
-            # The steps as first queued: a resumed study keeps its parameters.
-            self.steps = self.state.get("steps") or steps
         else:
-            self.state = {"study": name, "id": str(uuid.uuid4()), "steps": steps, "items": {}, "runs": {}}
+            self.state = {"study": name, "id": str(uuid.uuid4()), "small": small, "overrides": overrides or {},
+                          "group": None, "items": {}, "runs": {}}
         self._progress: dict = {}  # execution id -> (first seen monotonic, its progress then)
         self._last_print = 0.0
 
@@ -72,86 +73,64 @@ class Study:
             json.dump(self.state, f, indent=1)
         os.replace(tmp, self.state_file)
 
-    def _params(self, step: dict) -> dict | None:
-        """The step's parameters, with its reference filled in; None while the referenced run is not there."""
-        params = dict(step["params"])
-        ref = step.get("reference")
-        if ref:
-            run_id = self.state["runs"].get(ref["step"])
-            if not run_id:
-                return None
-            params[ref["param"]] = run_id
-        return params
-
-    def _enqueue(self, step: dict, params: dict) -> dict:
-        key = f"colorlab-study/{self.state['id']}/{step['name']}"
-        body = {"campaign": step["campaign"], "params": params, "on_failure": "stop"}
+    def _enqueue(self) -> dict:
+        """The study's sequence queued as one group, the queue started in the same request."""
+        body = {"sequence": self.name, "small": bool(self.state.get("small")),
+                "overrides": self.state.get("overrides") or {}, "on_failure": "stop", "start": True}
+        key = f"colorlab-study/{self.state['id']}"
         for attempt in range(3):
             try:
-                item = self.client.conn.post("/v1/queue", body, headers={"Idempotency-Key": key})
+                group = self.client.conn.post("/v1/queue", body, headers={"Idempotency-Key": key})
                 break
             except colorlab.ConnectionFailed:
                 if attempt == 2:
                     raise
                 time.sleep(1 + attempt)
             except (colorlab.BadRequest, colorlab.NotFound, colorlab.Unprocessable) as e:
-                raise StudyFailed(f"campaign {step['name']} ({step['campaign']}) could not be queued: "
-                                  f"{e.detail or e}") from e
-        self.state["items"][step["name"]] = item["id"]
+                raise StudyFailed(f"study {self.name} could not be queued: {e.detail or e}") from e
+        self._remember(group)
+        self._say(f"study {self.name}: queued its {len(group['items'])} campaigns as group {group['id']} "
+                  f"(the daemon runs them; this process only follows)")
+        return group
+
+    def _remember(self, group: dict) -> None:
+        self.state["group"] = group["id"]
+        self.state["items"] = {i["step"]: i["id"] for i in group["items"]}
+        self.state["steps"] = [i["step"] for i in group["items"]]
         self._save()
-        self._say(f"study {self.name}: queued {step['name']} as item {item['id']} (position {item.get('position')})")
-        return item
 
-    # -- running ----------------------------------------------------------------------------------------
-    def _queue_ready_steps(self) -> None:
-        for step in self.steps:
-            if step["name"] in self.state["items"]:
-                continue
-            params = self._params(step)
-            if params is None:
-                continue  # waits for its reference; the queue keeps order for the rest
-            self._enqueue(step, params)
+    def _group(self) -> dict:
+        group = self.client.conn.get(f"/v1/queue/groups/{self.state['group']}")
+        for item in group["items"]:  # in the study's order
+            step, run_id = item["step"], item.get("run_id")
+            if item["state"] == "done" and step not in self.state["runs"]:
+                self.state["runs"][step] = run_id
+                self._save()
+                self._say(f"study {self.name}: {step} finished ok: run {run_id}")
+        return group
 
-    def _check(self) -> dict | None:
-        """Reads every item of the study; records the runs of the done ones; raises for a failed one.
-        Returns the step that is not done yet (the first), or None when all are done."""
-        pending = None
-        for step in self.steps:
-            item_id = self.state["items"].get(step["name"])
-            if item_id is None:
-                pending = pending or step
-                continue
-            item = self.client.conn.get(f"/v1/queue/{item_id}")
-            if item["state"] == "done":
-                if step["name"] not in self.state["runs"]:
-                    ex = self.client.conn.get(f"/v1/executions/{item['execution_id']}")
-                    self.state["runs"][step["name"]] = ex["run_id"]
-                    self._save()
-                    self._say(f"study {self.name}: {step['name']} finished ok: run {ex['run_id']}")
-                continue
-            if item["state"] in ENDED_BAD:
-                problem = item.get("reason") or item["state"]
-                if item.get("execution_id"):
-                    ex = self.client.conn.get(f"/v1/executions/{item['execution_id']}")
-                    err = ex.get("error")
-                    if isinstance(err, dict):
-                        err = err.get("detail") or err.get("title") or json.dumps(err)
-                    problem = f"execution {ex['id']} {ex['status']}: {err or ex.get('reason') or problem}"
-                self._drop_rest()
-                raise StudyFailed(f"campaign {step['name']} ({step['campaign']}) of study {self.name} "
-                                  f"{item['state']}: {problem}")
-            pending = pending or {**step, "_item": item}
-        return pending
+    def _failure(self, group: dict) -> StudyFailed:
+        """The first item of the group that ended badly, with its execution's problem."""
+        item = next(i for i in group["items"] if i["state"] in ("failed", "skipped", "removed"))
+        problem = item.get("reason") or item["state"]
+        if item.get("execution_id"):
+            ex = self.client.conn.get(f"/v1/executions/{item['execution_id']}")
+            err = ex.get("error")
+            if isinstance(err, dict):
+                err = err.get("detail") or err.get("title") or json.dumps(err)
+            problem = f"execution {ex['id']} {ex['status']}: {err or ex.get('reason') or problem}"
+        return StudyFailed(f"campaign {item['step']} ({item['campaign']}) of study {self.name} {item['state']}: "
+                           f"{problem}")
 
-    def _drop_rest(self) -> None:
+    def _drop_rest(self, group: dict) -> None:
         """After a failure the queue is halted: take the study's still-queued items out (kept in the history)."""
-        for name, item_id in self.state["items"].items():
-            with contextlib.suppress(colorlab.ColorlabError):
-                if self.client.conn.get(f"/v1/queue/{item_id}")["state"] == "queued":
-                    self.client.conn.delete(f"/v1/queue/{item_id}")
-                    self._say(f"study {self.name}: removed {name} (item {item_id}) from the queue")
+        for item in group["items"]:
+            if item["state"] == "queued":
+                with contextlib.suppress(colorlab.ColorlabError):
+                    self.client.conn.delete(f"/v1/queue/{item['id']}")
+                    self._say(f"study {self.name}: removed {item['step']} (item {item['id']}) from the queue")
 
-    def _progress_line(self, step: dict, progress: float, label: str, execution_id: str, force=False) -> None:
+    def _progress_line(self, step: str, progress: float, label: str, execution_id: str, force=False) -> None:
         now = time.monotonic()
         first = self._progress.setdefault(execution_id, (now, progress))
         if not force and now - self._last_print < PRINT_EVERY_S:
@@ -160,46 +139,48 @@ class Study:
         eta = None
         if progress > first[1] and now > first[0]:
             eta = (now - first[0]) / (progress - first[1]) * (1 - progress)
-        index = [s["name"] for s in self.steps].index(step["name"]) + 1
-        self._say(f"[{index}/{len(self.steps)}] {step['name']:<20} {progress * 100:5.1f} %  "
+        names = self.state.get("steps") or [s["name"] for s in self.steps]
+        self._say(f"[{names.index(step) + 1}/{len(names)}] {step:<20} {progress * 100:5.1f} %  "
                   f"ETA {_duration(eta):>8}  {label or ''}")
 
+    # -- running ----------------------------------------------------------------------------------------
     def run(self) -> list[str]:
-        """Queues the study, follows it to its end; returns the run ids in the study's order."""
-        if self.state["items"]:
-            self._say(f"study {self.name}: re-attaching to study {self.state['id']} ({self.state_file})")
+        """Queues the study (or re-attaches to its group), follows it to its end; returns the run ids in order."""
+        if self.state.get("group"):
+            self._say(f"study {self.name}: re-attaching to study {self.state['id']}, group {self.state['group']} "
+                      f"({self.state_file})")
         else:
-            self._say(f"study {self.name} {self.state['id']}: {len(self.steps)} campaigns, state in {self.state_file}")
-        self._save()
+            self._say(f"study {self.name} {self.state['id']}: state in {self.state_file}")
+        self._save()  # the study's id (its idempotency key) is on disk before anything is queued
         events = self.client.events(give_up_after=300.0)
         try:
             snapshot = next(events)  # subscribed before the first look: nothing can slip between
             if snapshot.topic != "snapshot":
                 raise StudyProblem(f"the event stream did not start with a snapshot: {snapshot.topic}")
-            self._queue_ready_steps()
-            queue = self.client.conn.get("/v1/queue")
-            ours = set(self.state["items"].values())
-            ahead = [i for i in queue.get("items") or [] if i["id"] not in ours]
+            if not self.state.get("group"):
+                self._enqueue()  # (again, after a kill before the answer: the same key returns the same group)
+            group = self._group()
+            ours = [i["position"] for i in group["items"] if i["state"] == "queued"]
+            ahead = [i for i in self.client.conn.get("/v1/queue").get("items") or []
+                     if i.get("group_id") != group["id"] and (i["state"] == "running" or
+                                                              (ours and (i.get("position") or 0) < min(ours)))]
             if ahead:
                 self._say(f"study {self.name}: {len(ahead)} other queue item(s) run first: "
                           f"{', '.join(i['campaign'] for i in ahead)}")
-            if queue.get("state") != "running":
-                # A running queue starts an item as soon as it is queued: one of ours may already have failed and
-                # halted it, and starting the queue would clear that halt. Look first.
-                self._check()
-                self.client.conn.post("/v1/queue/start")
-                self._say(f"study {self.name}: queue started")
             current = None
             while True:
-                pending = self._check()
-                if pending is None:
+                group = self._group()
+                if group["state"] == "done":
                     break
-                self._queue_ready_steps()
-                item = pending.get("_item") or {}
-                if item.get("execution_id") and (current is None or current[1] != item["execution_id"]):
-                    current = (pending, item["execution_id"])
-                    ex = self.client.conn.get(f"/v1/executions/{item['execution_id']}")
-                    self._progress_line(pending, ex.get("progress") or 0.0, ex.get("step") or "started",
+                if group["state"] == "failed":
+                    failure = self._failure(group)
+                    self._drop_rest(group)
+                    raise failure
+                running = next((i for i in group["items"] if i["state"] == "running" and i.get("execution_id")), None)
+                if running and (current is None or current[1] != running["execution_id"]):
+                    current = (running["step"], running["execution_id"])
+                    ex = self.client.conn.get(f"/v1/executions/{running['execution_id']}")
+                    self._progress_line(current[0], ex.get("progress") or 0.0, ex.get("step") or "started",
                                         ex["id"], force=True)
                 # Wait for something about the study: its queue items, its running execution's progress.
                 for ev in events:
@@ -219,7 +200,7 @@ class Study:
         finally:
             events.close()
         self.timings["campaigns"] = time.monotonic() - self.started
-        return [self.state["runs"][s["name"]] for s in self.steps]
+        return list(group["run_ids"])
 
     def report(self, run_ids: list[str], args) -> int:
         from ..report.__main__ import main as report_main
@@ -253,7 +234,8 @@ class Study:
             written = json.loads(out.getvalue())
             self._say(f"study {self.name}: report written in {self.timings['report']:.1f} s")
             self._emit({"study": self.name, "id": self.state["id"], "state_file": os.path.abspath(self.state_file),
-                        "runs": {s["name"]: self.state["runs"][s["name"]] for s in self.steps},
+                        "group": self.state["group"],
+                        "runs": {step: self.state["runs"][step] for step in self.state["steps"]},
                         "run_ids": run_ids, "report": written["report"],
                         "seconds": {**self.timings, "report_detail": written["seconds"],
                                     "total": time.monotonic() - self.started}})
@@ -268,9 +250,11 @@ class Study:
     def dry_run(self) -> int:
         total, problems, estimates = 0.0, [], []
         for step in self.steps:
-            params = self._params(step)
-            if params is None:
-                ref = step["reference"]
+            params = dict(step["params"])
+            ref = step.get("reference")
+            if ref:
+                # The study's own run of the referenced step is not there before the study ran: the latest finished
+                # run of that campaign stands in for it (the estimate does not depend on which run it is).
                 found = self._latest_run(self.steps_by_name()[ref["step"]]["campaign"])
                 if not found:
                     self._say(f"{step['name']:<20} not estimated: needs a finished {ref['step']} run "

@@ -1,6 +1,8 @@
 """python3 -m colorlab.study: the dissertation study (reduced with --small) through the night queue on a colorlabd
 with the embedded simulated lab, end to end to its report; re-attached with --resume after the study's process
-and the daemon were killed -9 mid-study; a campaign that fails ends the study with exit 4, naming it; bad usage 2."""
+and the daemon were killed -9 mid-study; the study's process killed right after it queued the study, and the night
+completing in the daemon alone with each reference the right run; a campaign that fails ends the study with exit 4,
+naming it; bad usage 2. The steps are the daemon's sequence `dissertation` (GET /v1/campaigns)."""
 from __future__ import annotations
 
 import json
@@ -52,7 +54,7 @@ class Study(unittest.TestCase):
         return subprocess.run(study_command(self.daemon, self.tmp, *extra), capture_output=True, text=True, env=ENV,
                               timeout=timeout, cwd=self.tmp)
 
-    def check_study(self, p: subprocess.CompletedProcess, as_json=False) -> list[str]:
+    def check_study(self, p: subprocess.CompletedProcess, as_json=False, progress=True) -> list[str]:
         self.assertEqual(p.returncode, 0, f"{p.stdout}\n{p.stderr}\n{self.daemon.log_text()}")
         report = self.tmp / "report.html"
         state = json.loads((self.tmp / "study.json").read_text())
@@ -71,7 +73,8 @@ class Study(unittest.TestCase):
         else:
             lines = p.stdout.strip().splitlines()
             self.assertEqual(lines[-1], str(report.resolve()), "the report's path is the last line")
-        self.assertTrue(any(re.search(rf"\[\d/{len(CAMPAIGNS)}\] \S+ +\d+\.\d % +ETA", line) for line in lines) or as_json,
+        self.assertTrue(any(re.search(rf"\[\d/{len(CAMPAIGNS)}\] \S+ +\d+\.\d % +ETA", line) for line in lines) or as_json
+                        or not progress,
                         p.stdout)
         html = report.read_text(encoding="utf-8")
         self.assertNotIn('data-error="true"', html)
@@ -137,8 +140,8 @@ class Study(unittest.TestCase):
         state = json.loads((self.tmp / "study.json").read_text())
         states = {i["campaign"]: i["state"] for i in self.queue_items(state)}
         self.assertEqual(states["chart-read"], "failed")
-        self.assertEqual({states["frame-average"], states["cabinet-grid"]}, {"removed"}, states)
-        self.assertNotIn("characterize-camera", states)
+        # The whole study was queued at once: the failure takes every later step out of the queue.
+        self.assertEqual({states[c] for c in CAMPAIGNS[1:]}, {"removed"}, states)
         self.assertFalse((self.tmp / "report.html").exists())
 
     def test_4_a_parameter_the_campaign_refuses_is_exit_4(self):
@@ -148,13 +151,16 @@ class Study(unittest.TestCase):
         self.assertIn("could not be queued", p.stderr)
 
     def test_5_usage(self):
+        # The steps are the daemon's: an unknown step or study is known once it is asked.
+        socket = ["--socket", self.daemon.endpoint["unix_socket"]]
         for extra in (["--set", "nosuchstep.x=1"], ["--set", "nodot"], ["--resume", "--state-file", "/nonexistent"]):
-            p = subprocess.run([sys.executable, "-m", "colorlab.study", "dissertation", *extra], capture_output=True,
-                               text=True, env=ENV, timeout=30, cwd=self.tmp)
+            p = subprocess.run([sys.executable, "-m", "colorlab.study", "dissertation", *socket, *extra],
+                               capture_output=True, text=True, env=ENV, timeout=30, cwd=self.tmp)
             self.assertEqual(p.returncode, 2, f"{extra}: {p.stdout}{p.stderr}")
-        p = subprocess.run([sys.executable, "-m", "colorlab.study", "nosuchstudy"], capture_output=True, text=True,
-                           env=ENV, timeout=30, cwd=self.tmp)
-        self.assertEqual(p.returncode, 2)
+        p = subprocess.run([sys.executable, "-m", "colorlab.study", "nosuchstudy", *socket], capture_output=True,
+                           text=True, env=ENV, timeout=30, cwd=self.tmp)
+        self.assertEqual(p.returncode, 2, p.stderr)
+        self.assertIn("dissertation", p.stderr, "the sequences the daemon has are named")
 
     def test_6_dry_run_estimates_the_study(self):
         p = self.run_study("--dry-run", timeout=120)
@@ -188,6 +194,50 @@ class Study(unittest.TestCase):
         p = subprocess.run(cli_json + ["--dry-run"], capture_output=True, text=True, env=env, timeout=120, cwd=self.tmp)
         self.assertEqual(p.returncode, 0, f"{p.stdout}\n{p.stderr}")
         self.assertEqual(json.loads(p.stdout)["study"], "dissertation")
+
+    def test_8_the_night_completes_without_the_study_process(self):
+        """Killed right after it queued the study, the client is not needed: every step runs in the daemon and each
+        reference is the run of the study's own referenced step; --resume then only writes the report."""
+        proc = subprocess.Popen(study_command(self.daemon, self.tmp), stdout=subprocess.PIPE,
+                                stderr=subprocess.STDOUT, text=True, env=ENV, cwd=self.tmp)
+        state_file = self.tmp / "study.json"
+        try:
+            deadline = time.monotonic() + 60
+            group_id = None
+            while time.monotonic() < deadline and not group_id:
+                try:
+                    group_id = json.loads(state_file.read_text()).get("group")
+                except (FileNotFoundError, ValueError):
+                    pass
+                time.sleep(0.01)
+            self.assertTrue(group_id, "the study never queued its group")
+            proc.send_signal(signal.SIGKILL)
+        finally:
+            proc.kill()
+            out = proc.communicate()[0]
+        self.assertNotIn("finished ok", out, "killed before any step ended")
+        deadline = time.monotonic() + 200
+        group = {}
+        while time.monotonic() < deadline:
+            group = self.daemon.client.conn.get(f"/v1/queue/groups/{group_id}")
+            if group["state"] in ("done", "failed"):
+                break
+            time.sleep(0.2)
+        self.assertEqual(group.get("state"), "done", json.dumps(group, indent=1))
+        self.assertEqual([i["step"] for i in group["items"]], CAMPAIGNS)
+        runs = group["runs"]
+        self.assertEqual(group["run_ids"], [runs[c] for c in CAMPAIGNS])
+        params = {c: self.daemon.client.conn.get(f"/v1/runs/{runs[c]}")["params"] for c in CAMPAIGNS}
+        self.assertEqual(params["characterize-camera"]["reference_run"], runs["chart-read"])
+        self.assertEqual(params["dimmer-exposure"]["reference_run"], runs["chart-read"])
+        self.assertEqual(params["floor-luminance"]["grid_run"], runs["cabinet-grid"])
+        for item in group["items"]:
+            for param, ref in item["param_refs"].items():
+                self.assertEqual(item["params"][param], next(i["run_id"] for i in group["items"] if i["id"] == ref))
+        p = self.run_study("--resume")
+        self.assertIn("re-attaching", p.stdout)
+        self.assertEqual(self.check_study(p, progress=False), group["run_ids"], "the night had ended: nothing to follow")
+        self.assertEqual(len(group["run_ids"]), len(set(group["run_ids"])))
 
 
 if __name__ == "__main__":
