@@ -224,6 +224,8 @@ std::string format_queue_group(const json& g) {
     if (!item.value("reason", std::string()).empty()) o << "\n      " << item["reason"].get<std::string>();
     o << "\n";
   }
+  // The daemon makes the study's report of these runs on request (a browser follows the 202s by itself).
+  if (g.contains("links") && g["links"].contains("report")) o << "report  " << g["links"]["report"].get<std::string>() << "\n";
   return o.str();
 }
 

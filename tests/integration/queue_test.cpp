@@ -723,9 +723,25 @@ TEST(queue_sequences, ASequenceIsQueuedAtOnceAsAGroupAndItsRunsAreListed) {
   EXPECT_EQ(ran["runs"]["first"], ran["run_ids"][0]);
   EXPECT_EQ(ran["items"][0]["run_id"], ran["run_ids"][0]);
   EXPECT_EQ(recorded_source_run(api, ran["items"][1]), ran["run_ids"][0]);
+  // The study's report: one file of the group's runs, made by the daemon (202 until made).
+  const std::string report = "/v1/queue/groups/" + group["id"].get<std::string>() + "/report";
+  EXPECT_EQ(ran["links"]["report"], report);
+  auto made = api.request("GET", report);
+  for (int i = 0; i < 600 && made.status == 202; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    made = api.request("GET", report);
+  }
+  ASSERT_EQ(made.status, 200) << made.body;
+  EXPECT_NE(made.headers["Content-Type"].find("text/html"), std::string::npos);
+  for (const auto& run : ran["run_ids"]) {
+    EXPECT_NE(made.body.find("data-run=\"" + run.get<std::string>() + "\""), std::string::npos) << run;
+  }
   auto orphaned = api.get("/v1/queue/groups/" + by_campaign["id"].get<std::string>());
   EXPECT_EQ(orphaned["state"], "failed") << "its first step was removed, so its second was skipped";
   EXPECT_EQ(orphaned["items"][1]["state"], "skipped");
+  EXPECT_FALSE(orphaned.contains("links")) << "no run finished, so no report";
+  EXPECT_EQ(problem_of([&] { api.get("/v1/queue/groups/" + by_campaign["id"].get<std::string>() + "/report"); }).status,
+            409);
   EXPECT_EQ(problem_of([&] { api.get("/v1/queue/groups/0190aaaa-0000-7000-8000-000000000000"); }).status, 404);
 }
 
@@ -755,6 +771,9 @@ TEST(queue_sequences, TheCliRunsASequenceToItsEndAndListsIt) {
   auto ids = cli({"run", "pair", "--id-only"});
   ASSERT_EQ(ids.exit_code, 0) << ids.err;
   EXPECT_EQ(std::count(ids.out.begin(), ids.out.end(), '\n'), 2) << ids.out;
+  auto plain = cli({"run", "pair", "--small"});
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  EXPECT_NE(plain.out.find("report  /v1/queue/groups/"), std::string::npos) << "the study's report is named: " << plain.out;
 
   auto queued = cli({"queue", "add", "pair", "-p", "second.source_run=x"});
   EXPECT_EQ(queued.exit_code, 2) << "a reference is the sequence's to fill in: " << queued.err;

@@ -14,6 +14,7 @@
 #include "colorlab/protocol/api.hpp"
 #include "colorlab/protocol/problem.hpp"
 #include "locate_api.hpp"
+#include "report_response.hpp"
 
 #ifndef COLORLAB_VERSION
 #define COLORLAB_VERSION "dev"
@@ -238,51 +239,14 @@ HttpResponse get_run(ApiContext& ctx, const std::string& id) {
   return HttpResponse::json(200, j);
 }
 
-// The report is made in a child process on first request (seconds): until it is there the answer is 202
-// with Retry-After — for a browser a page that reloads itself, so following the link just works.
+// The report is made in a child process on first request (seconds): report_response.cpp answers meanwhile.
 HttpResponse get_run_report(ApiContext& ctx, const HttpRequest& req, const std::string& id) {
   auto r = ctx.reads().run(id);
   if (!r) throw Error(ErrorClass::not_found, "no run with id '" + id + "'");
   if (!r->finished_at)
     throw Error(ErrorClass::conflict, "run '" + id + "' is " + r->status + ": a report is made when the run has ended",
                 "GET it again after the run has ended");
-  if (!ctx.reports)
-    return HttpResponse::problem(503, "reports-unavailable", "Reports unavailable", "this colorlabd makes no reports");
-  const auto state = ctx.reports->request(id);
-  if (state.kind == ReportService::State::Kind::failed) {
-    return HttpResponse::problem(500, "report-failed", "Report failed", state.error,
-                                 "the daemon retries a minute after a failure; its log says more");
-  }
-  if (state.kind == ReportService::State::Kind::generating) {
-    HttpResponse g;
-    g.status = 202;
-    g.headers["Retry-After"] = "2";
-    g.headers["Cache-Control"] = "no-store";
-    if (req.header("accept").value_or("").find("text/html") != std::string::npos) {
-      g.content_type = "text/html; charset=utf-8";
-      g.body = "<!doctype html><meta charset=utf-8><meta http-equiv=refresh content=2><link rel=icon href=\"data:,\"><title>Making the report…</title>"
-               "<p>Making the report of run " + id + "… this page reloads itself.</p>";
-    } else {
-      g.body = json{{"state", "generating"}, {"run", id}, {"retry_after_s", 2}}.dump();
-    }
-    return g;
-  }
-  std::error_code ec;
-  const auto size = std::filesystem::file_size(state.file, ec);
-  if (ec) throw Error(ErrorClass::io_error, "the report of run '" + id + "' cannot be read: " + ec.message());
-  HttpResponse ok;
-  const std::string etag = "\"report-" + id + "-" + std::to_string(size) + "\"";
-  ok.headers["ETag"] = etag;
-  ok.headers["Cache-Control"] = "no-cache";
-  ok.headers["Content-Disposition"] = "inline; filename=\"report-" + id + ".html\"";
-  if (auto inm = req.header("if-none-match"); inm && none_match_hits(*inm, etag)) {
-    ok.status = 304;
-    ok.content_type.clear();
-    return ok;
-  }
-  ok.content_type = "text/html; charset=utf-8";
-  ok.file = http::FileSpan{state.file, 0, size};
-  return ok;
+  return report_response(ctx.reports, req, id, {id}, "run " + id);
 }
 
 HttpResponse get_run_measurements(ApiContext& ctx, const HttpRequest& req, const std::string& id) {

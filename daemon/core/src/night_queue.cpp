@@ -1,11 +1,14 @@
 #include "colorlab/daemon/night_queue.hpp"
 
+#include <algorithm>
+
 #include <boost/asio/post.hpp>
 
 #include "colorlab/core/error.hpp"
 #include "colorlab/core/ids.hpp"
 #include "colorlab/core/log.hpp"
 #include "colorlab/daemon/campaign_request.hpp"
+#include "colorlab/protocol/api.hpp"
 #include "colorlab/protocol/states.hpp"
 
 namespace colorlab::daemon {
@@ -285,9 +288,28 @@ json NightQueue::describe_group(const store::QueueGroup& group) {
     items.push_back(j);
   }
   std::string state = all_done ? "done" : any_bad ? "failed" : any_running ? "running" : "queued";
-  return {{"id", group.id},       {"sequence", group.sequence}, {"options", group.options},
-          {"created_at", group.created_at}, {"state", state},  {"items", items},
-          {"runs", runs},         {"run_ids", run_ids}};
+  json described{{"id", group.id},       {"sequence", group.sequence}, {"options", group.options},
+                 {"created_at", group.created_at}, {"state", state},  {"items", items},
+                 {"runs", runs},         {"run_ids", run_ids}};
+  // The study's report, of the runs it finished, once nothing of it is left to run.
+  if (group_ended(group) && !run_ids.empty())
+    described["links"] = {{"report", std::string(protocol::kPrefix) + "/queue/groups/" + group.id + "/report"}};
+  return described;
+}
+
+bool NightQueue::group_ended(const store::QueueGroup& group) {
+  return std::none_of(group.items.begin(), group.items.end(), [](const QueueItem& item) {
+    return item.state == QueueItemState::queued || item.state == QueueItemState::running;
+  });
+}
+
+std::pair<std::vector<std::string>, bool> NightQueue::group_runs(const std::string& id) {
+  auto g = queue_.group(id);
+  if (!g) throw Error(ErrorClass::not_found, "no queue group with id '" + id + "'", "a sequence queued returns its group's id");
+  std::vector<std::string> run_ids;
+  const json described = describe_group(*g);  // held: a range-for over a temporary's member would dangle
+  for (const auto& run : described["run_ids"]) run_ids.push_back(run.get<std::string>());
+  return {run_ids, group_ended(*g)};
 }
 
 json NightQueue::group(const std::string& id) {

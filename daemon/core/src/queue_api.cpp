@@ -7,6 +7,7 @@
 #include "colorlab/core/error.hpp"
 #include "colorlab/daemon/night_queue.hpp"
 #include "colorlab/protocol/api.hpp"
+#include "report_response.hpp"
 
 namespace colorlab::daemon {
 
@@ -172,6 +173,19 @@ std::optional<HttpResponse> dispatch(ApiContext& ctx, const HttpRequest& req) {
   if (rest.rfind("groups/", 0) == 0 && rest.size() > 7 && rest.find('/', 7) == std::string::npos) {
     if (req.method != "GET") return method_not_allowed(req, "GET");
     return HttpResponse::json(200, queue.group(rest.substr(7)));
+  }
+  if (rest.rfind("groups/", 0) == 0 && rest.ends_with("/report") && rest.find('/', 7) == rest.size() - 7 &&
+      rest.size() > 14) {
+    if (req.method != "GET" && req.method != "HEAD") return method_not_allowed(req, "GET, HEAD");
+    const std::string id = rest.substr(7, rest.size() - 14);
+    auto [run_ids, ended] = queue.group_runs(id);
+    if (!ended)
+      throw Error(ErrorClass::conflict, "queue group '" + id + "' is still running: its report is made when it has ended",
+                  "GET it again after the group's last item has ended (GET /v1/queue/groups/" + id + " says)");
+    if (run_ids.empty())
+      throw Error(ErrorClass::conflict, "queue group '" + id + "' finished no run: there is nothing to report",
+                  "GET /v1/queue/groups/" + id + " shows why its items ended");
+    return report_response(ctx.reports, req, "group-" + id, run_ids, "queue group " + id);
   }
   if (slash > 0 && rest.substr(slash + 1) == "move") {
     if (req.method != "POST") return method_not_allowed(req, "POST");

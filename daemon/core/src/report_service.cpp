@@ -38,21 +38,23 @@ ReportService::~ReportService() {
   if (worker_.joinable()) worker_.join();
 }
 
-fs::path ReportService::file_for(const std::string& run_id) const {
-  return options_.directory / (run_id + "-" + options_.version + ".html");
+fs::path ReportService::file_for(const std::string& key) const {
+  return options_.directory / (key + "-" + options_.version + ".html");
 }
 
-ReportService::State ReportService::request(const std::string& run_id) {
+ReportService::State ReportService::request(const std::string& run_id) { return request(run_id, {run_id}); }
+
+ReportService::State ReportService::request(const std::string& key, const std::vector<std::string>& run_ids) {
   State s;
   std::error_code ec;
-  const auto file = file_for(run_id);
+  const auto file = file_for(key);
   std::lock_guard lock(mutex_);
   if (fs::is_regular_file(file, ec)) {
     s.kind = State::Kind::ready;
     s.file = file;
     return s;
   }
-  if (auto f = failures_.find(run_id); f != failures_.end()) {
+  if (auto f = failures_.find(key); f != failures_.end()) {
     if (std::chrono::steady_clock::now() - f->second.at < options_.retry_after_failure) {
       s.kind = State::Kind::failed;
       s.error = f->second.error;
@@ -60,8 +62,8 @@ ReportService::State ReportService::request(const std::string& run_id) {
     }
     failures_.erase(f);
   }
-  if (current_ != run_id && std::find(queue_.begin(), queue_.end(), run_id) == queue_.end()) {
-    queue_.push_back(run_id);
+  if (current_ != key && std::none_of(queue_.begin(), queue_.end(), [&](const Job& j) { return j.key == key; })) {
+    queue_.push_back(Job{key, run_ids});
     wake_.notify_one();
   }
   s.kind = State::Kind::generating;
@@ -73,15 +75,15 @@ void ReportService::work() {
   while (true) {
     wake_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
     if (stopping_) return;
-    current_ = queue_.front();
+    const Job job = queue_.front();
     queue_.pop_front();
-    const std::string run_id = current_;
+    current_ = job.key;
     lock.unlock();
-    const std::string error = make(run_id);
+    const std::string error = make(job.key, job.run_ids);
     lock.lock();
     if (!error.empty() && !stopping_) {
-      log::warning("reports", "report of run " + run_id + " failed: " + error);
-      failures_[run_id] = Failure{error, std::chrono::steady_clock::now()};
+      log::warning("reports", "report " + job.key + " failed: " + error);
+      failures_[job.key] = Failure{error, std::chrono::steady_clock::now()};
     }
     current_.clear();
   }
@@ -99,11 +101,12 @@ std::string tail_of(const fs::path& file, std::size_t bytes) {
 
 }  // namespace
 
-std::string ReportService::make(const std::string& run_id) {
-  const auto file = file_for(run_id);
-  const auto log_file = options_.directory / (run_id + ".log");
-  std::vector<std::string> args{options_.python, "-m", "colorlab.report", run_id, "-o", file.string(),
-                                "--socket", options_.unix_socket.string()};
+std::string ReportService::make(const std::string& key, const std::vector<std::string>& run_ids) {
+  const auto file = file_for(key);
+  const auto log_file = options_.directory / (key + ".log");
+  std::vector<std::string> args{options_.python, "-m", "colorlab.report"};
+  args.insert(args.end(), run_ids.begin(), run_ids.end());
+  for (const char* a : {"-o", file.c_str(), "--socket", options_.unix_socket.c_str()}) args.emplace_back(a);
   // The child's environment: the daemon's, plus where the package is, a matplotlib cache it may write
   // (a service's HOME may not be writable), and no key (the Unix socket may read everything).
   std::vector<std::string> env;

@@ -9,6 +9,8 @@
 #include <chrono>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/steady_timer.hpp>
@@ -53,11 +55,14 @@ class NightQueue {
                                                     store::OnFailure on_failure,
                                                     const std::optional<std::string>& idempotency_key);
   // {id, sequence, options, created_at, state: queued|running|done|failed, items (each with run_id),
-  //  runs: {step: run id} and run_ids (in order) of its done items}
+  //  runs: {step: run id} and run_ids (in order) of its done items, links.report once it has ended}
   nlohmann::json describe_group(const store::QueueGroup& group);
   nlohmann::json group(const std::string& id);
+  // The run ids of a group's done items, in order, and whether nothing of it is queued or running.
+  std::pair<std::vector<std::string>, bool> group_runs(const std::string& id);
   // A catalogue sequence by this name, and no campaign by it.
   bool is_sequence(const std::string& name);
+  static bool group_ended(const store::QueueGroup& group);
   store::QueueItem remove(const std::string& id);
   store::QueueItem move(const std::string& id, std::int64_t position);
   store::QueueItem item(const std::string& id);

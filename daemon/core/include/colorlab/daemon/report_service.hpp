@@ -1,7 +1,8 @@
 #pragma once
 // A finished run's report (the dissertation's tables and figures as one HTML file), made by the Python
 // client's report package in a child process and kept under <state>/reports, so the API and the web
-// console can serve it: GET /v1/runs/{id}/report (api.cpp).
+// console can serve it: GET /v1/runs/{id}/report (api.cpp). A study's report covers the runs of a queued
+// sequence's group in one file: GET /v1/queue/groups/{id}/report (queue_api.cpp).
 #include <chrono>
 #include <condition_variable>
 #include <deque>
@@ -10,6 +11,7 @@
 #include <mutex>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <sys/types.h>
 
@@ -39,20 +41,26 @@ class ReportService {
   // For a finished run: its report when made; else starts making it (one at a time, in request order)
   // and says so. A failure is reported for retry_after_failure, then the next request tries again.
   State request(const std::string& run_id);
+  // The same for one report of several runs, kept under `key` (a name of its own, not a run id).
+  State request(const std::string& key, const std::vector<std::string>& run_ids);
 
  private:
   struct Failure {
     std::string error;
     std::chrono::steady_clock::time_point at;
   };
-  std::filesystem::path file_for(const std::string& run_id) const;
+  std::filesystem::path file_for(const std::string& key) const;
   void work();
-  std::string make(const std::string& run_id);  // empty on success, else the reason
+  std::string make(const std::string& key, const std::vector<std::string>& run_ids);  // empty, else the reason
 
   Options options_;
   std::mutex mutex_;
   std::condition_variable wake_;
-  std::deque<std::string> queue_;
+  struct Job {
+    std::string key;
+    std::vector<std::string> run_ids;
+  };
+  std::deque<Job> queue_;
   std::map<std::string, Failure> failures_;
   std::string current_;
   pid_t child_ = -1;
