@@ -80,6 +80,16 @@ std::map<std::string, AveragedPhoto> average_tiffs(const std::vector<std::filesy
   return out;
 }
 
+namespace {
+
+// What every answer about one format's photograph starts with, located or refused.
+json photograph_fields(const AveragedPhoto& a) {
+  return json{{"format", a.format}, {"frames", a.frames}, {"files", a.files},
+              {"width", a.photo.width}, {"height", a.photo.height}, {"bits", a.bits}};
+}
+
+}  // namespace
+
 json locate_and_sample(const AveragedPhoto& a, const SamplingOptions& options) {
   ca::PhotoView view = a.photo.view();
   view.bit_depth = 16;  // scaled to 16 bits: the robust band scales with it
@@ -97,15 +107,11 @@ json locate_and_sample(const AveragedPhoto& a, const SamplingOptions& options) {
     const bool refusal = e.cls() == ErrorClass::not_found || e.cls() == ErrorClass::needs_operator ||
                          (e.cls() == ErrorClass::bad_parameter && lo.corners);
     if (options.return_refusals && refusal) {
-      return json{{"format", a.format},
-                  {"frames", a.frames},
-                  {"files", a.files},
-                  {"width", a.photo.width},
-                  {"height", a.photo.height},
-                  {"bits", a.bits},
-                  {"chart", std::string(ca::to_string(options.chart))},
-                  {"from_corners", lo.corners.has_value()},
-                  {"refused", {{"error", std::string(to_string(e.cls()))}, {"message", e.info().message}, {"hint", e.hint()}}}};
+      json refused = photograph_fields(a);
+      refused["chart"] = std::string(ca::to_string(options.chart));
+      refused["from_corners"] = lo.corners.has_value();
+      refused["refused"] = {{"error", std::string(to_string(e.cls()))}, {"message", e.info().message}, {"hint", e.hint()}};
+      return refused;
     }
     // Which of the four photographs the locator refused matters to the operator.
     ErrorInfo info = e.info();
@@ -127,30 +133,26 @@ json locate_and_sample(const AveragedPhoto& a, const SamplingOptions& options) {
     values.push_back(v);
     detected.push_back(p.detected);
   }
-  return json{{"format", a.format},
-              {"frames", a.frames},
-              {"files", a.files},
-              {"width", a.photo.width},
-              {"height", a.photo.height},
-              {"bits", a.bits},
-              {"black_subtracted", a.cfa.has_value()},
-              {"chart", std::string(ca::to_string(loc.type))},
-              {"confidence", loc.confidence},
-              {"rotation_deg", loc.rotation_deg},
-              {"from_corners", loc.from_corners},
-              {"corners", corners},
-              {"patches_detected", loc.patches_detected},
-              {"reprojection_rms_px", loc.reprojection_rms_px},
-              {"check", {{"passed", loc.check.passed},
-                         {"method", loc.check.method},
-                         {"worst_disagreement", loc.check.worst_disagreement},
-                         {"worst_patch", loc.check.worst_patch},
-                         {"gradient_x", loc.check.gradient_x},
-                         {"gradient_y", loc.check.gradient_y}}},
-              {"ids", ids},
-              {"values", values},
-              {"detected", detected},
-              {"notes", loc.notes}};
+  json located = photograph_fields(a);
+  located.update(json{{"black_subtracted", a.cfa.has_value()},
+                      {"chart", std::string(ca::to_string(loc.type))},
+                      {"confidence", loc.confidence},
+                      {"rotation_deg", loc.rotation_deg},
+                      {"from_corners", loc.from_corners},
+                      {"corners", corners},
+                      {"patches_detected", loc.patches_detected},
+                      {"reprojection_rms_px", loc.reprojection_rms_px},
+                      {"check", {{"passed", loc.check.passed},
+                                 {"method", loc.check.method},
+                                 {"worst_disagreement", loc.check.worst_disagreement},
+                                 {"worst_patch", loc.check.worst_patch},
+                                 {"gradient_x", loc.check.gradient_x},
+                                 {"gradient_y", loc.check.gradient_y}}},
+                      {"ids", ids},
+                      {"values", values},
+                      {"detected", detected},
+                      {"notes", loc.notes}});
+  return located;
 }
 
 }  // namespace colorlab::campaigns::detail
