@@ -101,6 +101,7 @@ def main():
           ("numpy", ms(statistics.median(all_n)), ms(min(all_n)), ms(max(all_n))))
     print("ratio numpy/colorlab per round: median %.2fx (min %.2fx, max %.2fx over %d rounds)" %
           (statistics.median(ratios), min(ratios), max(ratios), len(ratios)))
+    print("per round (numpy/colorlab, in order): " + " ".join("%.2f" % r for r in ratios))
     if len(values) != 1:
         print("MISMATCH: the two halves did not compute the same figure")
         return 1

@@ -11,6 +11,9 @@
 #include <sqlite3.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -36,25 +39,38 @@ BENCHMARK(BM_CommitMeasurement_Full)->Unit(benchmark::kMicrosecond);
 // One campaign step as the engine commits it: a journal entry, a measurement, the progress and the
 // event in one transaction (synchronous=FULL). The issue's target: within 2× of this machine's
 // fdatasync, measured beside it in the same run (BM_Fdatasync4k).
-void BM_CommitCampaignStep_Full(benchmark::State& state) {
-  colorlab::testing::TempDir dir;
-  colorlab::store::Store store(dir / "colorlab.db");
+colorlab::store::NewRun bench_run() {
   colorlab::store::NewRun run{"luminance-spot", nlohmann::json::object(), true, nlohmann::json::array(), std::nullopt};
   run.script_sha256 = "bench";
   run.script_source = "return {}";
-  auto e = store.create_execution(run).execution;
-  std::int64_t i = 0;
-  for (auto _ : state) {
+  return run;
+}
+
+class StoreStepWriter {
+ public:
+  explicit StoreStepWriter(const std::filesystem::path& db) : store_(db), e_(store_.create_execution(bench_run()).execution) {}
+  void commit() {
     colorlab::store::StepRecord step;
     nlohmann::json result{{"luminance", 245.3}, {"unit", "cd/m2"}, {"instrument", "ls110"}, {"raw", "OK00,   245.30"}};
-    step.journal.push_back({i, "meter.measure", nlohmann::json::array(), result});
-    step.measurements.push_back({"reading/" + std::to_string(i), "ls110", true, "luminance", 245.3, "cd/m2",
+    step.journal.push_back({i_, "meter.measure", nlohmann::json::array(), result});
+    step.measurements.push_back({"reading/" + std::to_string(i_), "ls110", true, "luminance", 245.3, "cd/m2",
                                  {{"raw", "OK00,   245.30"}}});
     step.progress = 0.5;
-    step.step = "reading/" + std::to_string(i);
-    store.commit_step(e, step);
-    ++i;
+    step.step = "reading/" + std::to_string(i_);
+    store_.commit_step(e_, step);
+    ++i_;
   }
+
+ private:
+  colorlab::store::Store store_;
+  colorlab::store::ExecutionRecord e_;
+  std::int64_t i_ = 0;
+};
+
+void BM_CommitCampaignStep_Full(benchmark::State& state) {
+  colorlab::testing::TempDir dir;
+  StoreStepWriter store(dir / "colorlab.db");
+  for (auto _ : state) store.commit();
   state.SetItemsProcessed(state.iterations());
 }
 BENCHMARK(BM_CommitCampaignStep_Full)->Unit(benchmark::kMicrosecond);
@@ -85,78 +101,133 @@ void store_settings(sqlite3* db, const char* sync) {
 // The reference for BM_CommitCampaignStep_Full: the same step's rows and statements (journal entry, measurement
 // with its sequence number, the execution's progress, the event) in one transaction through raw SQLite, on the
 // store's own schema with the store's settings, every statement prepared once and the JSON texts made once.
-void BM_RawStep_Full(benchmark::State& state) {
-  colorlab::testing::TempDir dir;
-  colorlab::store::ExecutionRecord e;
-  {
-    colorlab::store::Store store(dir / "colorlab.db");  // schema and one execution, then closed
-    colorlab::store::NewRun run{"luminance-spot", nlohmann::json::object(), true, nlohmann::json::array(), std::nullopt};
-    run.script_sha256 = "bench";
-    run.script_source = "return {}";
-    e = store.create_execution(run).execution;
+class RawStepWriter {
+ public:
+  explicit RawStepWriter(const std::filesystem::path& path) {
+    {
+      colorlab::store::Store store(path);  // schema and one execution, then closed
+      e_ = store.create_execution(bench_run()).execution;
+    }
+    sqlite3_open(path.c_str(), &db_);
+    store_settings(db_, "FULL");
+    begin_ = prepare("BEGIN");
+    commit_ = prepare("COMMIT");
+    journal_ = prepare("INSERT INTO journal (execution_id, seq, call, args, result, at) VALUES (?1, ?2, 'meter.measure', '[]', ?3, ?4)");
+    max_seq_ = prepare("SELECT COALESCE(MAX(seq), 0) FROM measurements WHERE run_id = ?1");
+    measurement_ = prepare(
+        "INSERT INTO measurements (run_id, seq, step, instrument_id, simulated, quantity, value, unit, data, measured_at) "
+        "VALUES (?1, ?2, ?3, 'ls110', 1, 'luminance', 245.3, 'cd/m2', ?4, ?5)");
+    progress_ = prepare(
+        "UPDATE executions SET progress = 0.5, step = ?2, updated_at = ?3, steps_committed = steps_committed + 1, "
+        "resume_attempts = 0 WHERE id = ?1");
+    event_ = prepare("INSERT INTO event_log (time, topic, payload) VALUES (?1, 'progress', ?2)");
   }
-  sqlite3* db = nullptr;
-  sqlite3_open((dir / "colorlab.db").c_str(), &db);
-  store_settings(db, "FULL");
-  auto prepare = [&](const char* sql) {
+  ~RawStepWriter() {
+    for (auto* st : {begin_, commit_, journal_, max_seq_, measurement_, progress_, event_}) sqlite3_finalize(st);
+    sqlite3_close(db_);
+  }
+  RawStepWriter(const RawStepWriter&) = delete;
+  RawStepWriter& operator=(const RawStepWriter&) = delete;
+  bool ok() const { return ok_; }
+
+  void commit() {
+    const std::string step = "reading/" + std::to_string(i_);
+    const std::string payload = R"({"execution_id":")" + e_.id + R"(","measurements":1,"progress":0.5,"run_id":")" +
+                                e_.run_id + R"(","step":")" + step + R"("})";
+    run(begin_);
+    sqlite3_bind_text(journal_, 1, e_.id.c_str(), -1, SQLITE_STATIC);
+    sqlite3_bind_int64(journal_, 2, i_);
+    sqlite3_bind_text(journal_, 3, result_.c_str(), -1, SQLITE_STATIC);
+    sqlite3_bind_text(journal_, 4, now_.c_str(), -1, SQLITE_STATIC);
+    run(journal_);
+    sqlite3_bind_text(max_seq_, 1, e_.run_id.c_str(), -1, SQLITE_STATIC);
+    const std::int64_t seq = sqlite3_step(max_seq_) == SQLITE_ROW ? sqlite3_column_int64(max_seq_, 0) : 0;
+    sqlite3_reset(max_seq_);
+    sqlite3_bind_text(measurement_, 1, e_.run_id.c_str(), -1, SQLITE_STATIC);
+    sqlite3_bind_int64(measurement_, 2, seq + 1);
+    sqlite3_bind_text(measurement_, 3, step.c_str(), -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(measurement_, 4, data_.c_str(), -1, SQLITE_STATIC);
+    sqlite3_bind_text(measurement_, 5, now_.c_str(), -1, SQLITE_STATIC);
+    run(measurement_);
+    sqlite3_bind_text(progress_, 1, e_.id.c_str(), -1, SQLITE_STATIC);
+    sqlite3_bind_text(progress_, 2, step.c_str(), -1, SQLITE_TRANSIENT);
+    sqlite3_bind_text(progress_, 3, now_.c_str(), -1, SQLITE_STATIC);
+    run(progress_);
+    sqlite3_bind_text(event_, 1, now_.c_str(), -1, SQLITE_STATIC);
+    sqlite3_bind_text(event_, 2, payload.c_str(), -1, SQLITE_TRANSIENT);
+    run(event_);
+    run(commit_);
+    ++i_;
+  }
+
+ private:
+  sqlite3_stmt* prepare(const char* sql) {
     sqlite3_stmt* st = nullptr;
-    if (sqlite3_prepare_v2(db, sql, -1, &st, nullptr) != SQLITE_OK) state.SkipWithError(sqlite3_errmsg(db));
+    if (sqlite3_prepare_v2(db_, sql, -1, &st, nullptr) != SQLITE_OK) ok_ = false;
     return st;
-  };
-  sqlite3_stmt* begin = prepare("BEGIN");
-  sqlite3_stmt* commit = prepare("COMMIT");
-  sqlite3_stmt* journal = prepare("INSERT INTO journal (execution_id, seq, call, args, result, at) VALUES (?1, ?2, 'meter.measure', '[]', ?3, ?4)");
-  sqlite3_stmt* max_seq = prepare("SELECT COALESCE(MAX(seq), 0) FROM measurements WHERE run_id = ?1");
-  sqlite3_stmt* measurement = prepare(
-      "INSERT INTO measurements (run_id, seq, step, instrument_id, simulated, quantity, value, unit, data, measured_at) "
-      "VALUES (?1, ?2, ?3, 'ls110', 1, 'luminance', 245.3, 'cd/m2', ?4, ?5)");
-  sqlite3_stmt* progress = prepare(
-      "UPDATE executions SET progress = 0.5, step = ?2, updated_at = ?3, steps_committed = steps_committed + 1, "
-      "resume_attempts = 0 WHERE id = ?1");
-  sqlite3_stmt* event = prepare("INSERT INTO event_log (time, topic, payload) VALUES (?1, 'progress', ?2)");
-  const std::string result = R"({"instrument":"ls110","luminance":245.3,"raw":"OK00,   245.30","unit":"cd/m2"})";
-  const std::string data = R"({"raw":"OK00,   245.30"})";
-  const std::string now = "2026-11-24T00:00:00.000Z";
-  auto run = [](sqlite3_stmt* st) {
+  }
+  static void run(sqlite3_stmt* st) {
     while (sqlite3_step(st) == SQLITE_ROW) {
     }
     sqlite3_reset(st);
-  };
-  std::int64_t i = 0;
-  for (auto _ : state) {
-    const std::string step = "reading/" + std::to_string(i);
-    const std::string payload = R"({"execution_id":")" + e.id + R"(","measurements":1,"progress":0.5,"run_id":")" + e.run_id +
-                                R"(","step":")" + step + R"("})";
-    run(begin);
-    sqlite3_bind_text(journal, 1, e.id.c_str(), -1, SQLITE_STATIC);
-    sqlite3_bind_int64(journal, 2, i);
-    sqlite3_bind_text(journal, 3, result.c_str(), -1, SQLITE_STATIC);
-    sqlite3_bind_text(journal, 4, now.c_str(), -1, SQLITE_STATIC);
-    run(journal);
-    sqlite3_bind_text(max_seq, 1, e.run_id.c_str(), -1, SQLITE_STATIC);
-    std::int64_t seq = sqlite3_step(max_seq) == SQLITE_ROW ? sqlite3_column_int64(max_seq, 0) : 0;
-    sqlite3_reset(max_seq);
-    sqlite3_bind_text(measurement, 1, e.run_id.c_str(), -1, SQLITE_STATIC);
-    sqlite3_bind_int64(measurement, 2, seq + 1);
-    sqlite3_bind_text(measurement, 3, step.c_str(), -1, SQLITE_TRANSIENT);
-    sqlite3_bind_text(measurement, 4, data.c_str(), -1, SQLITE_STATIC);
-    sqlite3_bind_text(measurement, 5, now.c_str(), -1, SQLITE_STATIC);
-    run(measurement);
-    sqlite3_bind_text(progress, 1, e.id.c_str(), -1, SQLITE_STATIC);
-    sqlite3_bind_text(progress, 2, step.c_str(), -1, SQLITE_TRANSIENT);
-    sqlite3_bind_text(progress, 3, now.c_str(), -1, SQLITE_STATIC);
-    run(progress);
-    sqlite3_bind_text(event, 1, now.c_str(), -1, SQLITE_STATIC);
-    sqlite3_bind_text(event, 2, payload.c_str(), -1, SQLITE_TRANSIENT);
-    run(event);
-    run(commit);
-    ++i;
   }
-  for (auto* st : {begin, commit, journal, max_seq, measurement, progress, event}) sqlite3_finalize(st);
-  sqlite3_close(db);
+
+  sqlite3* db_ = nullptr;
+  bool ok_ = true;
+  colorlab::store::ExecutionRecord e_;
+  sqlite3_stmt *begin_ = nullptr, *commit_ = nullptr, *journal_ = nullptr, *max_seq_ = nullptr, *measurement_ = nullptr,
+               *progress_ = nullptr, *event_ = nullptr;
+  const std::string result_ = R"({"instrument":"ls110","luminance":245.3,"raw":"OK00,   245.30","unit":"cd/m2"})";
+  const std::string data_ = R"({"raw":"OK00,   245.30"})";
+  const std::string now_ = "2026-11-24T00:00:00.000Z";
+  std::int64_t i_ = 0;
+};
+
+void BM_RawStep_Full(benchmark::State& state) {
+  colorlab::testing::TempDir dir;
+  RawStepWriter raw(dir / "colorlab.db");
+  if (!raw.ok()) state.SkipWithError("could not prepare the raw step's statements");
+  for (auto _ : state) raw.commit();
   state.SetItemsProcessed(state.iterations());
 }
 BENCHMARK(BM_RawStep_Full)->Unit(benchmark::kMicrosecond);
+
+// The store's step and the raw step alternating commit by commit (store, raw, raw, store, ...), each timed alone,
+// in two databases in the same directory: the disk's moment-to-moment noise falls on both alike. Counters: each
+// side's median commit (µs) and their ratio.
+void BM_StepVsRawStep_Alternating(benchmark::State& state) {
+  colorlab::testing::TempDir dir;
+  StoreStepWriter store(dir / "store.db");
+  RawStepWriter raw(dir / "raw.db");
+  if (!raw.ok()) state.SkipWithError("could not prepare the raw step's statements");
+  std::vector<double> t_store, t_raw;
+  std::int64_t k = 0;
+  for (auto _ : state) {
+    auto timed = [](auto& writer) {
+      auto t0 = std::chrono::steady_clock::now();
+      writer.commit();
+      return std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count();
+    };
+    if (k++ % 2 == 0) {
+      t_store.push_back(timed(store));
+      t_raw.push_back(timed(raw));
+    } else {
+      t_raw.push_back(timed(raw));
+      t_store.push_back(timed(store));
+    }
+    state.SetIterationTime((t_store.back() + t_raw.back()) / 1e6);
+  }
+  auto median = [](std::vector<double> v) {
+    std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
+    return v[v.size() / 2];
+  };
+  if (!t_store.empty()) {
+    state.counters["store_us"] = median(t_store);
+    state.counters["raw_us"] = median(t_raw);
+    state.counters["store_per_raw"] = median(t_store) / median(t_raw);
+  }
+}
+BENCHMARK(BM_StepVsRawStep_Alternating)->UseManualTime()->Unit(benchmark::kMicrosecond)->MinTime(2.0);
 
 // One row per commit through raw SQLite with the store's settings: FULL (durable), NORMAL (no fsync per
 // commit) and one transaction for all.
