@@ -4,10 +4,11 @@
 -- is the study's own chart-read). `covers` says what of the report the step is for (docs/reports.md,
 -- "What it contains"). `small` is the reduced variant (tests, a first look): a 2 x 5 grid at two lamps
 -- and levels, fewer frames; Tables 3-6 are then not compared cell by cell (the report says so).
--- colorlab run dissertation [--small] [-p STEP.KEY=VALUE]; colorlab study dissertation writes the report.
+-- colorlab run dissertation [--small] [-p STEP.KEY=VALUE] queues it and names the report the daemon makes of it
+-- (GET /v1/queue/groups/{id}/report); colorlab study dissertation also writes that report to a file.
 return {
   description = "the dissertation's whole study: chart reference, frame averaging, cabinet grid, the camera "
-    .. "as a luminance meter, camera characterization and dimmer exposure; colorlab study dissertation writes the report",
+    .. "as a luminance meter, camera characterization and dimmer exposure; the group's report once it has ended",
   steps = {
     {
       name = "chart-read",
