@@ -70,8 +70,9 @@ void add_report_command(CLI::App& app, GlobalOptions& global) {
   auto o = std::make_shared<ReportOptions>();
   auto* cmd = app.add_subcommand(
       "report",
-      "Write the dissertation's tables and figures for stored runs (frame-average, cabinet-grid, chart-read, "
-      "characterize-camera, luminance-spot) as one self-contained HTML file, each beside the published numbers; "
+      "Write the dissertation's tables and figures for stored runs (frame-average, cabinet-grid, floor-luminance, "
+      "chart-read, characterize-camera, dimmer-exposure, luminance-spot) as one self-contained HTML file, each beside "
+      "the published numbers; "
       "prints its path (with --json before the command: one JSON object with the path, the runs and the timings)");
   cmd->add_option("runs", o->runs, "run ids (colorlab runs lists them)")->required();
   cmd->add_option("-o,--output", o->output, "HTML file to write (default: ./report-<first run>.html)");
@@ -87,15 +88,18 @@ void add_report_command(CLI::App& app, GlobalOptions& global) {
   auto s = std::make_shared<StudyOptions>();
   auto* study = app.add_subcommand(
       "study",
-      "Run a built-in study — dissertation: the SG chart read, 25-frame averaging, the cabinet grid over lamps and "
-      "dimmer levels, camera characterization — through the night queue, live, then write its report; prints its path "
+      "Run a study — a sequence of the daemon's catalogue, e.g. dissertation: the SG chart read, 25-frame averaging, "
+      "the cabinet grid over lamps and dimmer levels, the camera as a luminance meter, camera characterization, "
+      "dimmer exposure — queued as one group of the night queue, followed live, then write its report; prints its path "
       "(with --json before the command: progress on stderr, then one JSON object with the runs, the report and the timings)");
-  study->add_option("study", s->study, "the study")->required()->check(CLI::IsMember({"dissertation"}));
+  // Which studies exist is the daemon's catalogue's to say (the module refuses an unknown one with exit 2, naming
+  // the sequences there), so a lab's own NAME.sequence.lua runs too.
+  study->add_option("study", s->study, "the study: a sequence (colorlab campaigns lists them), e.g. dissertation")->required();
   study->add_option("-o,--output", s->output, "the report's HTML file (default: ./report-<first run>.html)");
   study->add_option("--set", s->overrides, "override one step's parameter, STEP.KEY=VALUE (repeatable), e.g. cabinet-grid.rows=4");
   study->add_flag("--dry-run", s->dry_run, "each campaign's dry run and the estimated total; nothing is queued");
   study->add_flag("--small", s->small, "a reduced study (a first look): smaller grid, fewer frames");
-  study->add_option("--state-file", s->state_file, "where the study keeps its queue items (for --resume)");
+  study->add_option("--state-file", s->state_file, "where the study keeps its queue group (for --resume)");
   study->add_flag("--resume", s->resume, "carry on a study whose queue items are already in the daemon (after a restart)");
   study->callback([&global, s] {
     std::vector<std::string> args{s->study};

@@ -36,7 +36,7 @@ def parse(argv):
     p.add_argument("--small", action="store_true", help="a reduced study (tests, a first look): smaller grid, fewer frames")
     p.add_argument("--set", action="append", default=[], metavar="STEP.KEY=VALUE",
                    help="override one parameter of one step (VALUE as JSON, else a string), e.g. cabinet-grid.rows=4")
-    p.add_argument("--state-file", help="where the study keeps its queue items (default: ./colorlab-study-STUDY.json)")
+    p.add_argument("--state-file", help="where the study keeps its queue group (default: ./colorlab-study-STUDY.json)")
     p.add_argument("--resume", action="store_true",
                    help="re-attach to the study in --state-file (after this command or the daemon was stopped)")
     p.add_argument("--json", action="store_true",

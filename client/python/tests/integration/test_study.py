@@ -189,6 +189,11 @@ class Study(unittest.TestCase):
         self.assertRegex(p.stdout.splitlines()[-1], r"^study dissertation: estimated total .* \(\d+ s wall\)$")
         p = subprocess.run(cli + ["--set", "no-dot"], capture_output=True, text=True, env=env, timeout=60, cwd=self.tmp)
         self.assertEqual(p.returncode, 2, f"{p.stdout}\n{p.stderr}")
+        # Which studies exist is the daemon's catalogue's to say: an unknown one is a usage error naming its sequences.
+        p = subprocess.run(cli[:-1] + ["no-such-study", "--dry-run"], capture_output=True, text=True, env=env,
+                           timeout=60, cwd=self.tmp)
+        self.assertEqual(p.returncode, 2, f"{p.stdout}\n{p.stderr}")
+        self.assertIn("dissertation", p.stderr)
         # `colorlab --json study` hands --json to the module: one JSON object on stdout.
         cli_json = cli[:1] + ["--json"] + cli[1:]
         p = subprocess.run(cli_json + ["--dry-run"], capture_output=True, text=True, env=env, timeout=120, cwd=self.tmp)
