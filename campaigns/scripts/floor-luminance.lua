@@ -119,25 +119,12 @@ return {
 
     local total, done = #p.lamps * #p.dimmer_levels, 0
     local maps, fits, light_changes = {}, {}, {}
-    -- The lab holds each reading to the lamp's stable one and takes one below 20 % of it for a lamp gone out; under a
-    -- fluorescent tube a back corner of the floor can be an eighth of its middle. So the meter watches the lamp warm up
-    -- at the calibration spot that a first one-frame photograph shows darkest (the lens's fall-off, ≤ 35 %, cannot
-    -- make a spot look darkest that is more than 1.5 times the darkest one): every later reading is then brighter.
-    local cal_spots = {}
-    for i, s in ipairs(calibration) do cal_spots[i] = { s.r, s.c } end
-    local function darkest_calibration_spot()
-      local look = lab.camera.photograph_floor { frames = 1, corners = corners, spots = cal_spots, spot_mm = p.spot_mm, keep = {} }
-      local best = 1
-      for i, s in ipairs(look.spots) do
-        if s.signal[1] < look.spots[best].signal[1] then best = i end
-      end
-      return calibration[best]
-    end
-
+    -- The meter watches each lamp warm up at the first calibration spot; the lab holds readings at the other spots
+    -- only to a cabinet gone nearly dark (a floor's corner under a fluorescent tube can be an eighth of its middle).
     for _, lamp in ipairs(p.lamps) do
       lab.lamps.select(lamp)
       lab.dimmer.set(p.dimmer_levels[1], { settle_s = p.settle_s })
-      aim(darkest_calibration_spot())
+      aim(calibration[1])
       lab.wait_stable()
       maps[lamp], fits[lamp] = {}, {}
       for _, level in ipairs(p.dimmer_levels) do
