@@ -9,6 +9,12 @@
 //   src/arvgvstream.c    by default the stream thread receives through a packet socket (PF_PACKET ring);
 //                        on lo it completed no frame here, for Aravis's own arv-fake-gv-camera-0.8 too,
 //                        so the test streams with --no-packet-socket (its plain UDP receiver)
+#include <sched.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
 #include <regex>
 #include <string>
 
@@ -47,7 +53,7 @@ std::string tool(std::vector<std::string> argv, int seconds = 20) {
 
 std::string feature(const std::string& text, const std::string& name) {
   std::smatch m;
-  if (!std::regex_search(text, m, std::regex("(^|\\n)" + name + " = ([^\\n]*)"))) return "(no " + name + " in: " + text + ")";
+  if (!std::regex_search(text, m, std::regex("(^|\\n)" + name + " = (\\S+)"))) return "(no " + name + " in: " + text + ")";
   return m[2];
 }
 
@@ -56,7 +62,28 @@ std::string feature(const std::string& text, const std::string& name) {
 TEST(AravisTools, DiscoverReadAndStreamTheSimulatedCamera) {
   COLORLAB_REQUIRE_CLIENT(on_path("arv-tool-0.8"), "arv-tool-0.8 is not installed (Debian package aravis-tools-cli)");
   COLORLAB_REQUIRE_CLIENT(on_path("arv-camera-test-0.8"), "arv-camera-test-0.8 is not installed (Debian package aravis-tools)");
+  COLORLAB_REQUIRE_CLIENT(on_path("ip"), "ip is not installed (Debian package iproute2)");
 
+  // As root, the test takes a network namespace of its own with only lo, and a TMPDIR of its own for the
+  // fake camera's per-address lock file, so 127.0.0.1's GVCP port is nobody else's (another simulator, a
+  // colleague's test); without root it shares the machine's loopback under ctest's gigevision_loopback lock.
+  struct RemoveAfterTheSimulator {
+    std::filesystem::path& dir;
+    ~RemoveAfterTheSimulator() {
+      std::error_code ec;
+      if (!dir.empty()) std::filesystem::remove_all(dir, ec);
+    }
+  };
+  std::filesystem::path private_tmp;
+  RemoveAfterTheSimulator cleanup{private_tmp};
+  if (::geteuid() == 0) {
+    ASSERT_EQ(::unshare(CLONE_NEWNET), 0) << "unshare(CLONE_NEWNET): " << std::strerror(errno);
+    auto up = run_command({colorlab::test::tool_path("ip"), "link", "set", "lo", "up"});
+    ASSERT_EQ(up.exit_code, 0) << "ip link set lo up: " << up.err;
+    private_tmp = std::filesystem::temp_directory_path() / ("colorlab-arvclients-" + std::to_string(::getpid()));
+    std::filesystem::create_directories(private_tmp);
+    ::setenv("TMPDIR", private_tmp.c_str(), 1);
+  }
   SimProcess sim(kLab);
   json truth = sim.control({{"cmd", "truth"}});
   ASSERT_TRUE(truth.contains("genicam")) << "the simulated camera did not start (GVCP port on 127.0.0.1 taken?)";
