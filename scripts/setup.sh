@@ -18,6 +18,10 @@ packages=(
   # independent references and test tools
   argyll aravis-tools aravis-tools-cli libraw-bin dcraw python3-numpy hyperfine sqlite3 curl util-linux procps strace
   imagemagick
+  # third-party clients of the simulated lab (tests/clients): OLA, whose olad runs in a network namespace of
+  # its own (iproute2 brings its lo up); node-dmx comes from the npm registry with the machine's Node.js and
+  # npm (not Debian's: the machine's are newer), installed by its test with npm ci
+  ola iproute2
   # the data service: load benches against nginx, fuzzing with clang's libFuzzer, the Python client
   wrk nginx-light clang libfuzzer-14-dev python3-requests python3-pandas openssl
   # reports (plots by matplotlib) and the web console, both tested in headless Chromium

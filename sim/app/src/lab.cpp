@@ -430,12 +430,23 @@ json Lab::control(const json& command) {
                       {"aim", {d.aim_row, d.aim_col}}, {"readings_served", d.ls110->readings_served()}};
       }
       if (d.spectrolino) t["spectrolino"] = d.spectrolino_truth();
+      if (d.genicam) {
+        // what a GigE Vision client should find and how many frames the camera has filled for it
+        t["genicam"] = {{"address", d.genicam->address()}, {"serial", d.genicam->serial()},
+                        {"plugged_in", d.genicam->plugged_in()}, {"frames_filled", d.genicam->frames_filled()},
+                        {"sensor", {d.camera_model->width(), d.camera_model->height()}}};
+      }
       if (d.dmx) {
         const auto& u = d.dmx->universe();
         t["dmx"] = {{"packets", d.dmx->packets()},
                     {"slots", std::vector<int>(u.begin(), u.begin() + static_cast<long>(std::min<std::size_t>(u.size(), 16)))},
+                    {"slot_count", u.size()},  // of the last label 6 packet
                     {"bad_frames", d.dmx->bad_frames()},
-                    {"rejected_requests", d.dmx->rejected_requests()}};
+                    {"rejected_requests", d.dmx->rejected_requests()},
+                    // as the last label 4 set them, so a client's parameter writes are checked at the widget
+                    {"parameters", {{"break_time", d.dmx->parameters().break_time},
+                                    {"mab_time", d.dmx->parameters().mab_time},
+                                    {"output_rate", d.dmx->parameters().output_rate}}}};
       }
       return t;
     }
