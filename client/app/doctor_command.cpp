@@ -122,7 +122,9 @@ std::string utc_stamp(const char* format) {
 std::optional<std::string> ask(const std::string& question) {
   std::cerr << question << " " << std::flush;
   std::string line;
-  if (!std::getline(std::cin, line)) return std::nullopt;
+  const bool ok = static_cast<bool>(std::getline(std::cin, line));
+  if (!::isatty(STDIN_FILENO)) std::cerr << "\n";  // piped answers are not echoed: keep one question a line
+  if (!ok) return std::nullopt;
   while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.pop_back();
   return line;
 }
