@@ -236,6 +236,7 @@ int run_doctor(const GlobalOptions& g, const DoctorOptions& o) {
       for (const auto& x : results) first["ports"].push_back(bu::to_json(x));
       first["cameras"] = cameras;
       first["relays"] = relays;
+      first["interim"] = true;
       std::cout << render_report(first);
       auto a = ask("Take one reading from each of the " + std::to_string(n) +
                    " identified instruments? The SpectroScan moves to its white tile and calibrates, the LS-110 measures; "
@@ -287,7 +288,7 @@ int run_doctor(const GlobalOptions& g, const DoctorOptions& o) {
   report["ok"] = all_ok;
   const int rc = all_ok ? 0 : 3;
   report["exit_code"] = rc;
-  if (!consent && !interactive) {
+  if (std::none_of(results.begin(), results.end(), [](const bu::Examination& x) { return x.measured; })) {
     report["readings"] = "none taken: nothing is measured, moved or lit unasked (run with --measure to take one from each)";
   }
   if (g.json) {

@@ -228,6 +228,25 @@ TEST_F(DoctorSimLab, APortThatAnswersInAnotherInstrumentsProtocolIsNamedForWhatI
   EXPECT_NE(t.out.find("WRONG INSTRUMENT"), std::string::npos) << t.out;
 }
 
+// On a terminal doctor asks before any reading; `script` gives it one. "n" takes none, "y" one.
+TEST_F(DoctorSimLab, OnATerminalTheOperatorIsAskedFirstAndNoMeansNoReading) {
+  ASSERT_TRUE(testing::on_path("script")) << "util-linux's script is part of every Debian system";
+  auto session = [&](const std::string& answers) {
+    const std::string cmd = shell_quote(bin_path("colorlab")) + " doctor --no-host --no-gige --no-record --port " +
+                            shell_quote(ports["ls110"] + "=ls110");
+    return run_command({"/bin/sh", "-c", "printf " + shell_quote(answers) + " | script -qec " + shell_quote(cmd) + " /dev/null"},
+                       kLimit);
+  };
+  auto before = truth();
+  auto no = session("n\n");
+  EXPECT_NE(no.out.find("Take one reading"), std::string::npos) << no.out;
+  EXPECT_NE(no.out.find("none taken"), std::string::npos) << no.out;
+  EXPECT_EQ(truth()["ls110"]["readings_served"], before["ls110"]["readings_served"]);
+  auto yes = session("y\n\n");
+  EXPECT_NE(yes.out.find("operator confirmed: luminance="), std::string::npos) << yes.out;
+  EXPECT_EQ(truth()["ls110"]["readings_served"].get<int>(), before["ls110"]["readings_served"].get<int>() + 1);
+}
+
 // With --measure the operator confirms the display on stdin: Enter for "shows the same". The
 // transcript then replays to the driver; a different value typed is what its replay asserts.
 TEST_F(DoctorSimLab, AConfirmedReadingBecomesATranscriptWhoseReplayAssertsTheOperatorsValue) {
