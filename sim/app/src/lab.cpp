@@ -429,7 +429,11 @@ json Lab::control(const json& command) {
         t["ls110"] = {{"luminance", lt.luminance}, {"noise_sigma", lt.noise_sigma},
                       {"aim", {d.aim_row, d.aim_col}}, {"readings_served", d.ls110->readings_served()}};
       }
-      if (d.spectrolino) t["spectrolino"] = d.spectrolino_truth();
+      if (d.spectrolino) {
+        t["spectrolino"] = d.spectrolino_truth();
+        t["spectrolino"]["serial"] = std::to_string(d.config.spectrolino.device.serial);
+        if (d.config.spectrolino.device.table) t["spectrolino"]["table_serial"] = std::to_string(d.config.spectrolino.device.table_serial);
+      }
       if (d.genicam) {
         // what a GigE Vision client should find and how many frames the camera has filled for it
         t["genicam"] = {{"address", d.genicam->address()}, {"serial", d.genicam->serial()},
@@ -438,7 +442,9 @@ json Lab::control(const json& command) {
       }
       if (d.dmx) {
         const auto& u = d.dmx->universe();
-        t["dmx"] = {{"packets", d.dmx->packets()},
+        // The serial as printed on the widget's label: what an operator confirms (colorlab doctor).
+        t["dmx"] = {{"serial", std::to_string(d.config.dmx.device.serial_decimal)},
+                    {"packets", d.dmx->packets()},
                     {"slots", std::vector<int>(u.begin(), u.begin() + static_cast<long>(std::min<std::size_t>(u.size(), 16)))},
                     {"slot_count", u.size()},  // of the last label 6 packet
                     {"bad_frames", d.dmx->bad_frames()},
