@@ -11,6 +11,7 @@
 # Needs root. Exit 77 (skipped) without root outside CI; every missing tool fails.
 set -euo pipefail
 export LC_ALL=C  # sort orders, and so the chroot cache key, must not depend on the locale
+export PATH="$PATH:/usr/sbin:/sbin"  # chroot, ip, ldconfig: root's tools, whatever PATH ctest was given
 build=$(realpath "$1")
 source_dir=$(realpath "$2")
 cpack=$3
@@ -82,9 +83,11 @@ while read -r name dir; do
   esac
   has "$path"
   executables+=("$path")
-done < <(grep -rhoE --include=CMakeLists.txt --include='*.cmake' \
-           'install\(TARGETS [A-Za-z0-9_.+-]+ RUNTIME DESTINATION [^ )]+' "$source_dir" --exclude-dir=build |
-         awk '{ print $2, $5 }' | sort -u)
+done < <(grep -rhoE --include=CMakeLists.txt --include='*.cmake' --exclude-dir='build*' \
+           'install\(TARGETS [^)]*\)' "$source_dir" |
+         awk '{ dir = /SBINDIR/ ? "SBINDIR" : /BINDIR/ ? "BINDIR" : "unknown"
+                for (i = 2; i <= NF && $i !~ /^(RUNTIME|DESTINATION|LIBRARY|ARCHIVE|COMPONENT|EXPORT|PERMISSIONS)$/; i++)
+                  print $i, dir }' | sort -u)
 ((${#executables[@]} >= 3)) || fail "found only ${#executables[@]} install(TARGETS) rules in $source_dir"
 for e in "${executables[@]}"; do
   [[ -x $x$e ]] || fail "$e is not executable"
@@ -100,7 +103,9 @@ while read -r f; do has "/usr/share/colorlab/console/$f"; done \
   < <(cd "$source_dir/client/web" && find . -type f \( -name '*.html' -o -name '*.css' -o -name '*.js' -o -name '*.svg' \) |
       sed 's|^\./||')
 for f in "$source_dir"/campaigns/scripts/*.lua; do has "/usr/share/colorlab/campaigns/$(basename "$f")"; done
-for f in "$source_dir"/systemd/*.rules; do has "/usr/lib/udev/rules.d/$(basename "$f")"; done
+shopt -s nullglob
+for f in "$source_dir"/systemd/*.rules "$source_dir"/udev/*.rules; do has "/usr/lib/udev/rules.d/$(basename "$f")"; done
+shopt -u nullglob
 for f in /usr/lib/systemd/system/colorlabd.service /usr/lib/sysusers.d/colorlab.conf /usr/lib/tmpfiles.d/colorlab.conf \
          /usr/share/bash-completion/completions/colorlab /usr/share/colorlab/colorlabd.default.toml \
          /usr/share/doc/colorlab/copyright /usr/share/doc/colorlab/changelog.Debian.gz \
