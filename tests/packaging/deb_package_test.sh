@@ -19,9 +19,12 @@ work=$build/packaging-test
 root=$work/root
 
 fail() { echo "FAIL: $*" >&2; exit 1; }
-step() { echo "== $*"; }
 now() { date +%s.%N; }
 elapsed() { awk -v a="$1" -v b="$2" 'BEGIN { printf "%.1f", b - a }'; }
+started=$(now)
+step() { echo "== [$(elapsed "$started" "$(now)") s] $*"; }  # the offsets are docs/PERFORMANCE.md's breakdown
+# shellcheck source=chroot.sh
+source "$(dirname "$0")/chroot.sh"
 
 if [[ $(id -u) -ne 0 ]]; then
   [[ -n ${CI:-} ]] && fail "needs root (mmdebstrap, chroot, mounts in a private namespace); CI runs as root"
@@ -185,66 +188,14 @@ tar -C "$root" --numeric-owner -xf "$base"
 mkdir -p "$root/tmp/debs"
 cp "$deb1" "$deb2" "$root/tmp/debs/"
 
-# Runs the script on stdin as root in the chroot, with /proc, a private /dev/pts and /run and its own loopback.
-in_chroot() {
-  unshare --mount --pid --net --fork --kill-child -- bash -c '
-    set -e
-    root=$1
-    ip link set lo up
-    mount -t proc proc "$root/proc"
-    mount -t devpts -o newinstance,ptmxmode=0666,mode=0620,gid=5 devpts "$root/dev/pts"
-    [ -L "$root/dev/ptmx" ] || mount --bind "$root/dev/pts/ptmx" "$root/dev/ptmx"
-    mount -t tmpfs -o mode=0755 tmpfs "$root/run"
-    exec chroot "$root" /usr/bin/env -i PATH=/usr/sbin:/usr/bin:/sbin:/bin HOME=/root LC_ALL=C.UTF-8 \
-      DEBIAN_FRONTEND=noninteractive bash -s' _ "$root"
-}
-# File names in the chroot, without what dpkg, apt and the kernel keep for themselves.
-listing() {
-  (cd "$root" && find . -xdev \( -path ./proc -o -path ./dev -o -path ./run -o -path ./tmp -o -path ./var/lib/dpkg \
-     -o -path ./var/lib/apt -o -path ./var/cache/apt -o -path ./var/cache/debconf -o -path ./var/cache/ldconfig \
-     -o -path ./var/log/apt -o -path ./var/log/dpkg.log \) -prune -o -print | sort)
-}
 before=$(listing)
-
-# Shell functions every chroot step shares.
-common=$(cat <<'SH'
-set -euo pipefail
-fail() { echo "FAIL (in the chroot): $*" >&2; exit 1; }
-state=/var/lib/colorlabd
-socket=$state/colorlabd.sock
-cli() { setpriv --reuid=colorlab --regid=colorlab --init-groups colorlab --socket "$socket" --json "$@"; }
-json() { python3 -c "import json, sys; d = json.load(sys.stdin); print($1)"; }
-start_daemon() {
-  rm -f /tmp/colorlabd.log
-  setpriv --reuid=colorlab --regid=colorlab --init-groups colorlabd --config /etc/colorlab/colorlabd.toml \
-    >/tmp/colorlabd.log 2>&1 &
-  daemon=$!
-  for _ in $(seq 600); do
-    [[ -S $socket && -s $state/colorlabd.endpoint ]] && return 0
-    kill -0 "$daemon" 2>/dev/null || { cat /tmp/colorlabd.log; fail "colorlabd exited while starting"; }
-    sleep 0.1
-  done
-  cat /tmp/colorlabd.log
-  fail "colorlabd did not write its endpoint within 60 s"
-}
-stop_daemon() {
-  kill -TERM "$daemon"
-  for _ in $(seq 600); do
-    kill -0 "$daemon" 2>/dev/null || break
-    sleep 0.1
-  done
-  kill -0 "$daemon" 2>/dev/null && { cat /tmp/colorlabd.log; fail "colorlabd did not stop within 60 s of SIGTERM"; }
-  wait "$daemon" || { cat /tmp/colorlabd.log; fail "colorlabd exited with $? on SIGTERM"; }
-}
-daemons_running() { grep -lx -e colorlabd -e colorlab-sim /proc/[0-9]*/comm 2>/dev/null || true; }
-SH
-)
+cp "$(dirname "$0")/in_chroot.sh" "$root/tmp/colorlab-test.sh"
 
 # --- 6. Install: the user, the configuration, the data directory; nothing started or enabled. ---------------------
 step "install $(basename "$deb1") with apt in the chroot"
 t=$(now)
 in_chroot <<SH
-$common
+source /tmp/colorlab-test.sh
 apt-get install -y --no-install-recommends /tmp/debs/$(basename "$deb1")
 [[ \$(dpkg-query -W -f '\${Status} \${Version}' colorlab) == "install ok installed $v1" ]] || fail "colorlab $v1 not installed"
 getent passwd colorlab | grep -q ':/var/lib/colorlabd:/usr/sbin/nologin\$' || fail "user: \$(getent passwd colorlab)"
@@ -266,7 +217,7 @@ echo "install took $(elapsed "$t" "$(now)") s"
 # --- 7. The installed daemon on its embedded simulated lab, as the colorlab user; a campaign through the CLI. -------
 step "colorlabd and a luminance-spot campaign in the chroot"
 in_chroot <<SH
-$common
+source /tmp/colorlab-test.sh
 # The admin's own configuration: the simulated lab instead of the example's LS-110.
 cat >/etc/colorlab/colorlabd.toml <<'TOML'
 # this lab's configuration (written by tests/packaging/deb_package_test.sh)
@@ -293,7 +244,7 @@ rm -f "$root/var/tmp/colorlab-run-id"
 # --- 8. Upgrade to the second build: configuration and data kept, the run still there. -----------------------------
 step "upgrade to $(basename "$deb2")"
 in_chroot <<SH
-$common
+source /tmp/colorlab-test.sh
 apt-get install -y --no-install-recommends /tmp/debs/$(basename "$deb2")
 [[ \$(dpkg-query -W -f '\${Version}' colorlab) == "$v2" ]] || fail "not upgraded to $v2"
 sha256sum -c --quiet /var/tmp/colorlab-config.sha256 || fail "the upgrade changed the admin's configuration"
@@ -308,7 +259,7 @@ SH
 # --- 9. Remove keeps the configuration; purge removes it and keeps the data. --------------------------------------
 step "remove, then purge"
 in_chroot <<SH
-$common
+source /tmp/colorlab-test.sh
 apt-get remove -y colorlab
 [[ \$(dpkg-query -W -f '\${Status}' colorlab) == "deinstall ok config-files" ]] || fail "after remove: \$(dpkg-query -W -f '\${Status}' colorlab)"
 [[ ! -e /usr/sbin/colorlabd && -e /etc/colorlab/colorlabd.toml && -s \$state/colorlab.db ]] || fail "remove: wrong files left"
@@ -332,7 +283,7 @@ echo "after purge, only the data is left: $(grep -c . <<<"$left") paths under /v
 # --- 10. The adduser fallback (no systemd-sysusers), and purge with the flag file that drops the data. ------------
 step "reinstall without systemd-sysusers, purge with /etc/colorlab/purge-measured-data"
 in_chroot <<SH
-$common
+source /tmp/colorlab-test.sh
 userdel colorlab
 getent group colorlab >/dev/null && groupdel colorlab
 dpkg-divert --quiet --local --rename --add /usr/bin/systemd-sysusers
@@ -345,4 +296,4 @@ apt-get purge -y colorlab
 [[ ! -e \$state && ! -e /etc/colorlab ]] || fail "purge with the flag file kept \$state or /etc/colorlab"
 dpkg-divert --quiet --local --rename --remove /usr/bin/systemd-sysusers
 SH
-echo "PASS"
+step "PASS"
