@@ -28,6 +28,8 @@ packages=(
   python3-matplotlib chromium chromium-driver python3-selenium
   # clang only recommends its fuzzer and sanitizer runtimes, and this script installs without recommends
   libclang-rt-14-dev
+  # the Debian package (docs/packaging.md): cpack's dpkg-shlibdeps, lintian, and mmdebstrap's throwaway chroot
+  dpkg-dev binutils lintian mmdebstrap debian-archive-keyring iproute2
 )
 
 missing=()

@@ -34,7 +34,7 @@ class EmbeddedSim {
   nlohmann::json announcement_;
 };
 
-// colorlab-sim next to the running executable, or $COLORLAB_SIM.
+// $COLORLAB_SIM, else colorlab-sim next to the running executable, else in ../bin (installed: sbin/colorlabd).
 std::filesystem::path default_sim_binary();
 
 }  // namespace colorlab::daemon
