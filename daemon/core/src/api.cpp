@@ -78,9 +78,7 @@ HttpResponse get_root(ApiContext& ctx) {
 }
 
 HttpResponse get_instruments(ApiContext& ctx) {
-  json items = json::array();
-  for (const auto& i : ctx.instruments.all()) items.push_back(drivers::describe(*i));
-  return HttpResponse::json(200, {{"items", items}});
+  return HttpResponse::json(200, {{"items", ctx.instruments.describe_all()}});
 }
 
 HttpResponse get_campaigns(ApiContext& ctx) {
