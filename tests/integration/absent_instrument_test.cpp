@@ -37,8 +37,9 @@ class AbsentLab : public ::testing::Test {
                                        dir_ / "first-sim.log");
     auto line = first_->read_line(std::chrono::seconds(30));
     ASSERT_TRUE(line) << "the first colorlab-sim did not announce itself (" << (dir_ / "first-sim.log") << ")";
+    const json announcement = json::parse(*line);
     bool camera = false;
-    for (const auto& i : json::parse(*line)["instruments"]) camera = camera || i["kind"] == "genicam";
+    for (const auto& i : announcement["instruments"]) camera = camera || i["kind"] == "genicam";
     ASSERT_TRUE(camera) << "the first colorlab-sim must hold the GigE camera's address for this test: " << *line;
 
     // The daemon's own simulated lab asks for the same camera (and no DSLR, so nothing else serves the
