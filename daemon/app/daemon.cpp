@@ -123,9 +123,14 @@ Daemon::Daemon(DaemonConfig config) : impl_(std::make_unique<Impl>()) {
     try {
       d.instruments.add(drivers::make_instrument(d.io.get_executor(), c));
     } catch (const Error& e) {
-      // One unusable entry must not keep the others (and the stored data) offline.
+      // One unusable entry must not keep the others (and the stored data) offline; it is listed as absent.
       log::warning("colorlabd", std::string("instrument skipped: ") + e.what());
+      d.instruments.add_absent({c.id, c.kind, c.port, c.simulated,
+                                std::string(e.what()) + (e.hint().empty() ? "" : " (" + e.hint() + ")")});
     }
+  }
+  if (d.sim) {
+    for (auto& a : d.sim->absent_instruments()) d.instruments.add_absent(std::move(a));
   }
   std::vector<drivers::DiscoveryRule> rules;
   for (const auto& c : instrument_configs) {

@@ -123,4 +123,14 @@ std::vector<drivers::InstrumentConfig> EmbeddedSim::instruments() const {
   return out;
 }
 
+std::vector<campaigns::AbsentInstrument> EmbeddedSim::absent_instruments() const {
+  std::vector<campaigns::AbsentInstrument> out;
+  for (const auto& i : announcement_.value("absent", nlohmann::json::array())) {
+    out.push_back({i.value("id", std::string()), i.value("kind", std::string()),
+                   i.value("port", i.value("address", std::string())), true,
+                   "the simulated lab could not start it: " + i.value("reason", std::string("no reason given"))});
+  }
+  return out;
+}
+
 }  // namespace colorlab::daemon

@@ -57,6 +57,7 @@ struct Lab::Impl {
   std::shared_ptr<camera::CameraModel> camera_model;       // the GenICam camera's
   std::shared_ptr<camera::CameraModel> dslr_model;
   std::unique_ptr<aravis::GvFakeCamera> genicam;
+  std::string genicam_absent;  // why the GenICam camera asked for did not start, announced as "absent"
   std::unique_ptr<dslr::DslrServer> dslr;
   std::filesystem::path dslr_temp_dir;  // created here, removed with the lab
   std::shared_ptr<RelayBoard> relay_board;
@@ -259,6 +260,7 @@ Lab::Lab(boost::asio::io_context& io, LabConfig config) : impl_(std::make_unique
     } catch (const Error& e) {
       log::warning("sim", std::string("GenICam camera not started: ") + e.what());
       d.genicam.reset();
+      d.genicam_absent = std::string(e.what()) + (e.hint().empty() ? "" : " (" + e.hint() + ")");
     }
   }
 
@@ -392,11 +394,19 @@ json Lab::announcement() const {
                            {"simulated", true},
                            {"driver_options", {{"lamps", lamps}, {"board_id", d.config.relay.board_id}}}});
   }
-  return {{"colorlab_sim", 1},
-          {"pid", ::getpid()},
-          {"seed", d.config.seed},
-          {"time_scale", d.config.time_scale},
-          {"instruments", instruments}};
+  json announced{{"colorlab_sim", 1},
+                 {"pid", ::getpid()},
+                 {"seed", d.config.seed},
+                 {"time_scale", d.config.time_scale},
+                 {"instruments", instruments}};
+  // Asked for and not started: a client lists it as absent with this reason instead of losing it.
+  if (!d.genicam && !d.genicam_absent.empty()) {
+    announced["absent"] = json::array({{{"id", d.config.genicam.id},
+                                        {"kind", "genicam"},
+                                        {"address", d.config.genicam.address},
+                                        {"reason", d.genicam_absent}}});
+  }
+  return announced;
 }
 
 json Lab::control(const json& command) {

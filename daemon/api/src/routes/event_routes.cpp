@@ -57,8 +57,7 @@ json snapshot(ApiContext& ctx, std::int64_t last_seq) {
     }
     executions.push_back(j);
   }
-  json instruments = json::array();
-  for (const auto& i : ctx.instruments.all()) instruments.push_back(drivers::describe(*i));
+  json instruments = ctx.instruments.describe_all();
   json requests = json::array();
   if (ctx.desk) {
     for (const auto& r : ctx.desk->pending()) requests.push_back(r.to_json());

@@ -44,9 +44,7 @@ HttpResponse get_root(ApiContext& ctx, const HttpRequest&, const PathParams&) {
 }
 
 HttpResponse get_instruments(ApiContext& ctx, const HttpRequest&, const PathParams&) {
-  json items = json::array();
-  for (const auto& i : ctx.instruments.all()) items.push_back(drivers::describe(*i));
-  return HttpResponse::json(200, {{"items", items}});
+  return HttpResponse::json(200, {{"items", ctx.instruments.describe_all()}});
 }
 
 HttpResponse get_campaigns(ApiContext& ctx, const HttpRequest&, const PathParams&) {
