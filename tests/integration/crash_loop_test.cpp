@@ -94,11 +94,15 @@ std::filesystem::path control_socket(const DaemonProcess& daemon) {
 // The execution's events (topic execution), oldest first.
 std::vector<json> execution_events(const client::ApiClient& api, const std::string& id) {
   std::vector<json> out;
-  json events = api.get("/v1/events?topic=execution&limit=1000");
-  for (const auto& ev : events["items"]) {
-    if (ev["payload"].value("execution_id", "") == id) out.push_back(ev);
+  std::int64_t after = 0;
+  for (;;) {
+    json page = api.get("/v1/events?topic=execution&limit=300&after=" + std::to_string(after));
+    if (page["items"].empty()) return out;
+    for (const auto& ev : page["items"]) {
+      after = ev["seq"].get<std::int64_t>();
+      if (ev["payload"].value("execution_id", "") == id) out.push_back(ev);
+    }
   }
-  return out;
 }
 
 std::vector<json> crash_loop_suspensions(const client::ApiClient& api, const std::string& id) {
@@ -213,9 +217,10 @@ class WebhookReceiver {
   std::vector<std::pair<std::string, json>> bodies_;
 };
 
-// [notify] whose command appends each notification (its stdin) and COLORLAB_EVENT to `file`, one a line.
+// [notify] whose command appends COLORLAB_EVENT to `file`.events, then the notification (its stdin) to `file`,
+// one a line: once a document is in `file`, its event is in the other.
 std::string notify_toml(const std::filesystem::path& file, const std::string& webhook) {
-  return "[notify]\ncommand = [\"/bin/sh\", \"-c\", \"{ cat; echo; } >> \\\"$1\\\"; echo \\\"$COLORLAB_EVENT\\\" >> \\\"$1.events\\\"\", "
+  return "[notify]\ncommand = [\"/bin/sh\", \"-c\", \"echo \\\"$COLORLAB_EVENT\\\" >> \\\"$1.events\\\"; { cat; echo; } >> \\\"$1\\\"\", "
          "\"notify\", \"" + file.string() + "\"]\nwebhook = \"" + webhook + "\"\ntimeout_s = 10\n";
 }
 
@@ -291,7 +296,8 @@ TEST(CrashLoopGuard, ASuspensionShowsItsCauseAndTheOperatorResumesItWithTheCli) 
   WebhookReceiver hook;
   TempDir out;
   const auto file = out / "notifications.jsonl";
-  GuardLab lab("max_resume_attempts = 1\ncrash_loop_backoff_s = 3600\ncrash_loop_retries = 2\n", notify_toml(file, hook.url()));
+  GuardLab lab("max_resume_attempts = 1\ncrash_loop_backoff_s = 3600\ncrash_loop_backoff_max_s = 3600\ncrash_loop_retries = 2\n",
+               notify_toml(file, hook.url()));
   auto api = lab.api();
   auto e = api.post("/v1/executions", {{"campaign", "lit"}, {"params", json::object()}});
   std::string id = e["id"];
@@ -315,6 +321,26 @@ TEST(CrashLoopGuard, ASuspensionShowsItsCauseAndTheOperatorResumesItWithTheCli) 
   EXPECT_FALSE(s.contains("error")) << "a suspension is no failure";
   EXPECT_NE(s["reason"].get<std::string>().find("crash loop"), std::string::npos) << s.dump(2);
 
+  // The operator heard of the crash loop, by command and by webhook, with the same document (asked before
+  // colorlabd stops: a notification still queued then is dropped).
+  ASSERT_TRUE(eventually([&] { return !notifications(file).empty() && !hook.received().empty(); }))
+      << "no notification arrived";
+  json n = notifications(file).front();
+  EXPECT_EQ(n["event"], "crash-loop") << n.dump(2);
+  EXPECT_EQ(n["execution_id"], id);
+  EXPECT_EQ(n["campaign"], "lit");
+  EXPECT_EQ(n["category"], "crash-loop");
+  EXPECT_EQ(n["status"], "suspended");
+  EXPECT_EQ(n["suspension"]["retry_at"], why["retry_at"]);
+  EXPECT_TRUE(n.contains("time") && n.contains("host"));
+  std::ifstream events(file.string() + ".events");
+  std::string first_event;
+  std::getline(events, first_event);
+  EXPECT_EQ(first_event, "crash-loop") << "COLORLAB_EVENT names the event";
+  auto [request_line, posted] = hook.received().front();
+  EXPECT_EQ(request_line, "POST /hooks/secret-token HTTP/1.1");
+  EXPECT_EQ(posted["event"], "crash-loop");
+  EXPECT_EQ(posted["execution_id"], id);
   // Still suspended after a restart during the back-off: it neither resumes at once nor counts an attempt.
   EXPECT_EQ(lab.daemon->terminate(), 0);
   lab.daemon->start();
@@ -336,25 +362,6 @@ TEST(CrashLoopGuard, ASuspensionShowsItsCauseAndTheOperatorResumesItWithTheCli) 
   }
   EXPECT_TRUE(by_client) << "the resume is recorded as the operator's";
 
-  // The operator heard of the crash loop, by command and by webhook, with the same document.
-  ASSERT_TRUE(eventually([&] { return !notifications(file).empty() && !hook.received().empty(); }))
-      << "no notification arrived";
-  json n = notifications(file).front();
-  EXPECT_EQ(n["event"], "crash-loop") << n.dump(2);
-  EXPECT_EQ(n["execution_id"], id);
-  EXPECT_EQ(n["campaign"], "lit");
-  EXPECT_EQ(n["category"], "crash-loop");
-  EXPECT_EQ(n["status"], "suspended");
-  EXPECT_EQ(n["suspension"]["retry_at"], why["retry_at"]);
-  EXPECT_TRUE(n.contains("time") && n.contains("host"));
-  std::ifstream events(file.string() + ".events");
-  std::string first_event;
-  std::getline(events, first_event);
-  EXPECT_EQ(first_event, "crash-loop") << "COLORLAB_EVENT names the event";
-  auto [request_line, posted] = hook.received().front();
-  EXPECT_EQ(request_line, "POST /hooks/secret-token HTTP/1.1");
-  EXPECT_EQ(posted["event"], "crash-loop");
-  EXPECT_EQ(posted["execution_id"], id);
   lab.daemon->kill9();
 }
 
