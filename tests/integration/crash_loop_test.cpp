@@ -33,12 +33,13 @@ namespace {
 constexpr double kTimeScale = 40;
 constexpr int kReadings = 12;
 
-// Lights D65, waits for it, then readings: a resume relights the lamp and waits for its warm-up again.
+// Lights TL84, waits for it, then readings. The simulated lab starts with D65 lit and warm, so each fresh
+// simulator (it dies with colorlabd) has TL84 cold: a resume relights it and waits for its warm-up again.
 const char* kLit = R"lua(
 return {
   needs = { "lamps", "luminance_meter" },
   run = function(p)
-    lab.lamps.select("D65")
+    lab.lamps.select("TL84")
     lab.dimmer.set(100, { settle_s = 1 })
     lab.wait_stable({ window_s = 60 })
     for i = 1, 12 do
