@@ -76,21 +76,24 @@ std::filesystem::path control_socket(const DaemonProcess& daemon) {
 ::testing::AssertionResult kill_during_warmup(DaemonProcess& daemon) {
   auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
   const auto socket = control_socket(daemon);
+  std::string last;
   while (std::chrono::steady_clock::now() < deadline) {
     try {
       json truth = sim::send_control_command(socket, {{"cmd", "truth"}});
-      for (const auto& [lamp, factor] : truth.value("warmup", json::object()).items()) {
+      const json warmup = truth.value("warmup", json::object());  // held: items() of a temporary would dangle
+      last = warmup.dump();
+      for (const auto& [lamp, factor] : warmup.items()) {
         if (factor.get<double>() < 0.97) {
           daemon.kill9();
           return ::testing::AssertionSuccess();
         }
       }
-    } catch (const std::exception&) {
-      // The simulated lab is still starting.
+    } catch (const std::exception& e) {
+      last = e.what();  // the simulated lab is still starting
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
-  return ::testing::AssertionFailure() << "no lamp was warming up within 120 s";
+  return ::testing::AssertionFailure() << "no lamp was warming up within 120 s (last: " << last << ")";
 }
 
 // The execution's events (topic execution), oldest first.
