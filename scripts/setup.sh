@@ -18,6 +18,10 @@ packages=(
   # independent references and test tools
   argyll aravis-tools aravis-tools-cli libraw-bin dcraw python3-numpy hyperfine sqlite3 curl util-linux procps strace
   imagemagick
+  # third-party clients of the simulated lab (tests/clients): OLA, whose olad runs in a network namespace of
+  # its own (iproute2 brings its lo up); node-dmx comes from the npm registry with the machine's Node.js and
+  # npm (not Debian's: the machine's are newer), installed by its test with npm ci
+  ola iproute2
   # the data service: load benches against nginx, fuzzing with clang's libFuzzer, the Python client
   wrk nginx-light clang libfuzzer-14-dev python3-requests python3-pandas openssl
   # the daemon's webhook notifications ([notify] webhook)
@@ -26,6 +30,8 @@ packages=(
   python3-matplotlib chromium chromium-driver python3-selenium
   # clang only recommends its fuzzer and sanitizer runtimes, and this script installs without recommends
   libclang-rt-14-dev
+  # the Debian package (docs/packaging.md): cpack's dpkg-shlibdeps, lintian, and mmdebstrap's throwaway chroot
+  dpkg-dev binutils lintian mmdebstrap debian-archive-keyring
 )
 
 missing=()
@@ -34,6 +40,12 @@ for p in "${packages[@]}"; do
     missing+=("$p")
   fi
 done
+
+# node-dmx's test uses the machine's Node.js and npm where they exist (newer than Debian's); Debian's only
+# where the machine has none, so that test never lacks its runtime.
+if ! command -v npm >/dev/null 2>&1; then
+  missing+=(nodejs npm)
+fi
 
 if ((${#missing[@]})); then
   if [[ $(id -u) -ne 0 ]]; then

@@ -7,8 +7,9 @@
    machine, alternating, by wrk with 4 connections: throughput ratio;
 3. 500 idle connections held open: colorlabd's resident memory before and with them.
 
-Usage: python3 bench/service/api_load.py --build build [--seconds 10] [--rounds 3]
-Prints one JSON document; docs/PERFORMANCE.md records the figures and this command.
+Usage: python3 bench/service/api_load.py --build build [--seconds 10] [--rounds 3] [--parts small_gets,blob,idle]
+Prints one JSON document; docs/PERFORMANCE.md records the figures and this command. `--parts small_gets` alone,
+run alternately against two builds, compares two versions of the daemon (bench/service/api_ab.sh).
 """
 import argparse
 import json
@@ -204,15 +205,19 @@ def main():
     p.add_argument("--seconds", type=int, default=10)
     p.add_argument("--rounds", type=int, default=3)
     p.add_argument("--time-scale", type=float, default=1000)
+    p.add_argument("--parts", default="small_gets,blob,idle", help="which of small_gets, blob, idle to run")
     ARGS = p.parse_args()
+    parts = set(ARGS.parts.split(","))
     with tempfile.TemporaryDirectory() as tmp:
         proc, url = start_daemon(ARGS.build, os.path.join(tmp, "state"), ARGS.time_scale)
         try:
             result = {"cores": os.cpu_count(), "seconds_per_measurement": ARGS.seconds}
             result["small_gets"] = small_gets(url, ARGS.seconds, ARGS.rounds)
-            result["blob_50mb"] = blob_throughput(url, os.path.join(tmp, "state"), SMALL_RUN[0], ARGS.seconds,
-                                                  ARGS.rounds, tmp)
-            result["idle_500"] = idle_connections(url, proc.pid, 500)
+            if "blob" in parts:
+                result["blob_50mb"] = blob_throughput(url, os.path.join(tmp, "state"), SMALL_RUN[0], ARGS.seconds,
+                                                      ARGS.rounds, tmp)
+            if "idle" in parts:
+                result["idle_500"] = idle_connections(url, proc.pid, 500)
             print(json.dumps(result, indent=2))
         finally:
             proc.terminate()

@@ -212,14 +212,25 @@ json dry_run_campaign(const DryRunSetup& setup) {
   for (const auto& role : roles) {
     auto i = lab.instrument_for(role);
     if (!i) {
-      problems.push_back({"instrument", "the campaign needs " + role_words(role) + ", and none is configured"});
+      auto absent = absent_for(setup.instruments ? *setup.instruments : no_instruments, role);
+      problems.push_back({"instrument", "the campaign needs " + role_words(role) +
+                                            (absent.empty() ? ", and none is configured" : ", and it is not here: " + absent)});
       instruments.push_back({{"role", role}, {"instrument", nullptr}});
       continue;
     }
-    instruments.push_back({{"role", role},
-                           {"instrument", i->id()},
-                           {"state", std::string(drivers::to_string(i->state()))},
-                           {"simulated", i->identity().simulated}});
+    json entry{{"role", role},
+               {"instrument", i->id()},
+               {"state", std::string(drivers::to_string(i->state()))},
+               {"simulated", i->identity().simulated}};
+    if (auto reason = InstrumentSet::absence(*i)) {
+      entry["state"] = "absent";
+      entry["reason"] = *reason;
+      if (InstrumentSet::port_missing(*i)) {
+        problems.push_back({"instrument", "the campaign needs " + role_words(role) + ", and it is not here: '" +
+                                              i->id() + "' is configured but absent: " + *reason});
+      }
+    }
+    instruments.push_back(std::move(entry));
   }
 
   // Storage: what the run's journal and measurements take, against the free space where they go.

@@ -20,17 +20,6 @@ namespace cam = drivers::camera;
 
 namespace {
 
-// Whether the instrument is of the C++ kind that serves `role` (it may learn the capability only
-// once connected, as a Spectrolino learns whether it sits on a table).
-bool is_kind_for(const std::shared_ptr<drivers::Instrument>& i, const std::string& role) {
-  if (role == "luminance_meter") return std::dynamic_pointer_cast<drivers::LuminanceMeter>(i) != nullptr;
-  if (role == "spectrophotometer") return std::dynamic_pointer_cast<drivers::Spectrometer>(i) != nullptr;
-  if (role == "table") return std::dynamic_pointer_cast<drivers::XyTable>(i) != nullptr;
-  if (role == "lamps") return std::dynamic_pointer_cast<drivers::LampController>(i) != nullptr;
-  if (role == "dimmer") return std::dynamic_pointer_cast<drivers::Dimmer>(i) != nullptr;
-  return std::dynamic_pointer_cast<cam::CameraInstrument>(i) != nullptr;
-}
-
 // A CIE XYZ (Y of white = 100) as camera values: linear sRGB primaries (IEC 61966-2-1) scaled to
 // the format's code range. Only plausibility matters: the dry run fits the script's models to it.
 std::array<double, 3> camera_values(const json& xyz, const std::string& format) {
@@ -61,15 +50,20 @@ std::string DryLab::role_of(const std::string& call) {
 std::shared_ptr<drivers::Instrument> DryLab::instrument_for(const std::string& role) const {
   const Capability capability = capability_of(role);
   for (const auto& i : instruments_.all()) {
-    if (!is_kind_for(i, role)) continue;
+    if (!is_kind_for(i, role) || InstrumentSet::port_missing(*i)) continue;
     auto caps = i->capabilities();
     if (std::find(caps.begin(), caps.end(), capability) != caps.end()) return i;
   }
   for (const auto& i : instruments_.all()) {
     auto s = i->state();
-    if (is_kind_for(i, role) && (s == drivers::InstrumentState::disconnected || s == drivers::InstrumentState::initialising)) {
+    if (is_kind_for(i, role) && !InstrumentSet::port_missing(*i) &&
+        (s == drivers::InstrumentState::disconnected || s == drivers::InstrumentState::initialising)) {
       return i;
     }
+  }
+  // Only an absent one (its port not there): the report names it and why, as the start would refuse.
+  for (const auto& i : instruments_.all()) {
+    if (is_kind_for(i, role)) return i;
   }
   return nullptr;
 }

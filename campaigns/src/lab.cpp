@@ -84,10 +84,15 @@ Lab::Lab(asio::any_io_executor executor, const InstrumentSet& instruments, LabOp
 template <class T>
 std::shared_ptr<T> Lab::find_role(const std::string& name) const {
   auto capability = capability_of(name);
-  for (const auto& i : instruments_.all()) {
-    for (auto c : i->capabilities()) {
-      if (c == capability) {
-        if (auto t = std::dynamic_pointer_cast<T>(i)) return t;
+  // One whose port is not there last: another may serve the role; if none does, reaching for the absent
+  // one fails no_comms, which suspends a running campaign until it is plugged in again.
+  for (bool absent_too : {false, true}) {
+    for (const auto& i : instruments_.all()) {
+      if (!absent_too && InstrumentSet::port_missing(*i)) continue;
+      for (auto c : i->capabilities()) {
+        if (c == capability) {
+          if (auto t = std::dynamic_pointer_cast<T>(i)) return t;
+        }
       }
     }
   }
@@ -97,8 +102,7 @@ std::shared_ptr<T> Lab::find_role(const std::string& name) const {
 template <class T>
 std::shared_ptr<T> Lab::role(const std::string& name) const {
   if (auto t = find_role<T>(name)) return t;
-  throw Error(ErrorClass::not_found, "this campaign needs " + role_words(name) + ", and none is configured",
-              "add one to colorlabd's configuration, or run the simulated lab");
+  refuse_role(instruments_, name);
 }
 
 template <class T>
@@ -126,13 +130,14 @@ asio::awaitable<std::shared_ptr<T>> Lab::acquire(const std::string& name) {
 
 template <class T>
 bool Lab::may_offer(const std::string& name) const {
-  if (find_role<T>(name)) return true;
+  // One whose device path is not there cannot serve before someone plugs it in: refused now, with why.
+  const auto capability = capability_of(name);
   for (const auto& i : instruments_.all()) {
+    if (!std::dynamic_pointer_cast<T>(i) || InstrumentSet::port_missing(*i)) continue;
+    auto caps = i->capabilities();
+    if (std::find(caps.begin(), caps.end(), capability) != caps.end()) return true;
     auto s = i->state();
-    if (std::dynamic_pointer_cast<T>(i) &&
-        (s == drivers::InstrumentState::disconnected || s == drivers::InstrumentState::initialising)) {
-      return true;
-    }
+    if (s == drivers::InstrumentState::disconnected || s == drivers::InstrumentState::initialising) return true;
   }
   return false;
 }
@@ -146,7 +151,7 @@ void Lab::check_needs(const std::vector<std::string>& roles) const {
               : r == "lamps"             ? may_offer<drivers::LampController>(r)
               : r == "dimmer"            ? may_offer<drivers::Dimmer>(r)
                                          : may_offer<cam::CameraInstrument>(r);
-    if (!ok) role<drivers::Instrument>(r);  // throws the not_found with its hint
+    if (!ok) refuse_role(instruments_, r);
   }
 }
 

@@ -45,9 +45,12 @@ std::string format_instruments(const json& list) {
   std::ostringstream o;
   if (list["items"].empty()) return "no instruments configured\n";
   for (const auto& i : list["items"]) {
-    o << str(i, "id") << "  " << str(i, "model") << "  [" << str(i, "state") << "]"
+    const std::string model = i.value("model", std::string());
+    o << str(i, "id") << "  " << (model.empty() ? str(i, "kind") : model) << "  [" << str(i, "state") << "]"
       << (i.value("simulated", false) ? "  (simulated)" : "") << "\n    port " << str(i, "port");
-    if (i.contains("problem")) o << "\n    problem: " << i["problem"].get<std::string>();
+    // An absent instrument's reason says it all; its problem (the same failure) would repeat it.
+    if (i.contains("reason")) o << "\n    absent: " << i["reason"].get<std::string>();
+    else if (i.contains("problem")) o << "\n    problem: " << i["problem"].get<std::string>();
     o << "\n";
   }
   return o.str();

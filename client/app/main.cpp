@@ -13,6 +13,7 @@
 #include "blob_commands.hpp"
 #include "access_commands.hpp"
 #include "locate_commands.hpp"
+#include "doctor_command.hpp"
 #ifdef COLORLAB_HAVE_ANALYZE
 #include "colorlab/cli/analyze_command.hpp"
 #endif
@@ -36,6 +37,7 @@ int main(int argc, char** argv) {
   colorlab::cli::add_blob_commands(app, global);
   colorlab::cli::add_access_commands(app, global);
   colorlab::cli::add_locate_commands(app, global);
+  colorlab::cli::add_doctor_command(app, global);
 #ifdef COLORLAB_HAVE_ANALYZE
   colorlab::cli::add_analyze_command(app);
 #endif

@@ -6,7 +6,7 @@
 
 #include "colorlab/core/error.hpp"
 #include "colorlab/core/log.hpp"
-#include "colorlab/daemon/daemon.hpp"
+#include "daemon.hpp"
 
 int main(int argc, char** argv) {
   // libgphoto2 translates choice labels; the daemon must compare the untranslated ones.

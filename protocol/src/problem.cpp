@@ -36,6 +36,13 @@ Problem Problem::from_json(const nlohmann::json& j) {
   return p;
 }
 
+ProblemCategory category_for_status(int status) {
+  if (status < 500) return ProblemCategory::validation;
+  if (status == 500) return ProblemCategory::undefined_execution;
+  if (status == 502 || status == 504) return ProblemCategory::connection;
+  return ProblemCategory::framework;
+}
+
 Problem problem_from_error(const Error& e) {
   Problem p;
   p.detail = e.info().message;

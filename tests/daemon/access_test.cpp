@@ -11,9 +11,9 @@
 #include <gtest/gtest.h>
 
 #include "colorlab/core/error.hpp"
-#include "colorlab/daemon/access.hpp"
+#include "colorlab/api/access.hpp"
 #include "colorlab/daemon/config.hpp"
-#include "colorlab/daemon/control_lock.hpp"
+#include "colorlab/api/control_lock.hpp"
 #include "colorlab/store/api_keys.hpp"
 #include "colorlab/store/store.hpp"
 #include "colorlab/testing/process.hpp"

@@ -8,7 +8,7 @@
 
 #include <boost/asio/io_context.hpp>
 
-#include "colorlab/daemon/blob_api.hpp"
+#include "colorlab/api/conditional.hpp"
 #include "colorlab/core/error.hpp"
 #include "colorlab/daemon/blob_service.hpp"
 #include "colorlab/daemon/config.hpp"

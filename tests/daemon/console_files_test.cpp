@@ -3,7 +3,7 @@
 #include <fstream>
 #include <gtest/gtest.h>
 
-#include "colorlab/daemon/console_files.hpp"
+#include "colorlab/api/console_files.hpp"
 #include "colorlab/testing/temp_dir.hpp"
 
 using colorlab::daemon::serve_console;

@@ -7,8 +7,12 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <thread>
+#include <tuple>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -77,6 +81,11 @@ class DaemonHttp : public ::testing::Test {
  protected:
   void SetUp() override {
     std::ofstream(dir / "colorlabd.toml") << "state_dir = \"state\"\n";
+    // The web console's files from a directory of the test's own (console_files.hpp), so what the
+    // daemon serves at / does not depend on the build having copied client/web.
+    std::filesystem::create_directories(dir / "console");
+    std::ofstream(dir / "console" / "index.html") << "<!doctype html><title>console</title>\n";
+    ::setenv("COLORLAB_CONSOLE_DIR", (dir / "console").c_str(), 1);
     daemon = std::make_unique<Process>(
         std::vector<std::string>{colorlab::testing::bin_path("colorlabd"), "--config", (dir / "colorlabd.toml").string(),
                                  "--listen", "127.0.0.1:0"},
@@ -158,6 +167,51 @@ TEST_F(DaemonHttp, UnknownRoutesAndMethodsAre404And405) {
   auto r = send_raw_unix(socket_path, "DELETE /v1/runs HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n");
   expect_problem(r, 405, "method-not-allowed");
   EXPECT_NE(r.headers.find("Allow: GET"), std::string::npos) << r.headers;
+  expect_still_serving();
+}
+
+// docs/API.md's route list, written out: a method a path does not take is 405, and `Allow` lists
+// the path's methods (HEAD wherever GET is). Over the Unix socket, so no scope stands in the way.
+TEST_F(DaemonHttp, EveryWrongMethodIs405WithTheRoutesMethodsInAllow) {
+  const std::vector<std::tuple<std::string, std::string, std::string>> cases{
+      {"DELETE", "/v1/runs", "GET, HEAD"},
+      {"POST", "/v1/runs/r1/export", "GET, HEAD"},
+      {"GET", "/v1/executions", "POST"},
+      {"PUT", "/v1/queue", "GET, HEAD, POST"},
+      {"PATCH", "/v1/queue/q1", "GET, HEAD, DELETE"},
+      {"GET", "/v1/queue/start", "POST"},
+      {"GET", "/v1/blobs/retention", "POST"},
+      {"POST", "/v1/blobs/check", "GET, HEAD"},
+      {"GET", "/v1/blobs/abc/locate-chart", "POST"},
+      {"PUT", "/v1/keys", "GET, HEAD, POST"},
+      {"POST", "/v1/keys/k1", "GET, HEAD, DELETE"},
+      {"GET", "/v1/control/acquire", "POST"},
+      {"DELETE", "/v1/requests/x", "GET, HEAD, POST"},
+      {"POST", "/v1/events/stream", "GET, HEAD"},
+  };
+  for (const auto& [method, path, allow] : cases) {
+    auto r = send_raw_unix(socket_path, method + " " + path + " HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n");
+    expect_problem(r, 405, "method-not-allowed");
+    EXPECT_NE(r.headers.find("\r\nAllow: " + allow + "\r\n"), std::string::npos) << method << " " << path << "\n" << r.headers;
+  }
+  expect_still_serving();
+}
+
+// The order chosen (docs/API.md, "How a request is routed"): the console's files before the access
+// check — they are public and a browser loads them before it has a key — and every /v1 request after it.
+TEST_F(DaemonHttp, ConsoleFilesAreServedBeforeTheAccessCheckAndTheApiAfterIt) {
+  auto page = send_raw(port, "GET / HTTP/1.1\r\nHost: x\r\nAuthorization: Bearer clk_not-a-key\r\nConnection: close\r\n\r\n");
+  EXPECT_EQ(page.status, 200) << page.headers << "\n" << page.body;
+  EXPECT_NE(page.body.find("<title>console</title>"), std::string::npos) << page.body;
+  // Loopback without a key only reads; a write to a console file is the console's 405, not a 401.
+  auto write = send_raw(port, "POST /index.html HTTP/1.1\r\nHost: x\r\nContent-Length: 0\r\nConnection: close\r\n\r\n");
+  expect_problem(write, 405, "method-not-allowed");
+  EXPECT_NE(write.headers.find("\r\nAllow: GET, HEAD\r\n"), std::string::npos) << write.headers;
+  // The same wrong key on the API is refused.
+  expect_problem(send_raw(port, "GET /v1 HTTP/1.1\r\nHost: x\r\nAuthorization: Bearer clk_not-a-key\r\nConnection: close\r\n\r\n"),
+                 401, "key-unknown");
+  expect_problem(send_raw(port, "POST /v1/queue/start HTTP/1.1\r\nHost: x\r\nContent-Length: 0\r\nConnection: close\r\n\r\n"),
+                 401, "key-required");
   expect_still_serving();
 }
 

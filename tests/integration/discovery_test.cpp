@@ -58,7 +58,9 @@ TEST(Discovery, DaemonReportsInstrumentsThatComeAndGo) {
 
   std::this_thread::sleep_for(std::chrono::milliseconds(600));  // a couple of discovery ticks with nothing plugged in
   EXPECT_TRUE(get("/v1/ports")["items"].empty());
-  EXPECT_EQ(instrument_state(), "disconnected");
+  // Configured but not up: absent, with the missing path as its reason (issue 25).
+  EXPECT_EQ(instrument_state(), "absent");
+  EXPECT_NE(get("/v1/instruments")["items"][0].value("reason", "").find(link.string()), std::string::npos);
 
   std::filesystem::create_symlink(pty, link);  // plugged in
   ASSERT_TRUE(eventually([&] { return get("/v1/ports")["items"].size() == 1; }));
@@ -67,7 +69,7 @@ TEST(Discovery, DaemonReportsInstrumentsThatComeAndGo) {
 
   std::filesystem::remove(link);  // unplugged
   ASSERT_TRUE(eventually([&] { return get("/v1/ports")["items"].empty(); }));
-  EXPECT_TRUE(eventually([&] { return instrument_state() == "disconnected"; }));
+  EXPECT_TRUE(eventually([&] { return instrument_state() == "absent"; }));
 
   json events = get("/v1/events?topic=instrument");
   ASSERT_EQ(events["items"].size(), 2u) << events.dump();

@@ -29,6 +29,9 @@ return {
 '''
 
 TIME_SCALE = 200
+# A configured instrument that cannot come up (a DMX widget without its lamp map): the Lab page lists it as absent
+# with the daemon's reason, instead of leaving it out (issue 25). No driver is made, so no campaign reaches for it.
+ABSENT_WIDGET = '\n[[instrument]]\nid = "bench-widget"\nkind = "dmx"\nport = "/dev/colorlab/no-such-widget"\n'
 READINGS = 5
 
 
@@ -41,7 +44,7 @@ class ConsoleTest(unittest.TestCase):
         cleanup_artifacts()
         # Suspensions retried and settled quickly, as tests/integration/suspend_test.cpp has them.
         cls.daemon = Daemon(time_scale=TIME_SCALE, port=free_port(),
-                            extra="[campaigns]\nsuspend_retry_s = 20\nsuspend_settle_s = 20\n")
+                            extra="[campaigns]\nsuspend_retry_s = 20\nsuspend_settle_s = 20\n" + ABSENT_WIDGET)
         cls.addClassCleanup(cls.daemon.cleanup)
         campaigns = cls.daemon.state / "campaigns"
         campaigns.mkdir(exist_ok=True)
@@ -153,11 +156,16 @@ class ConsoleTest(unittest.TestCase):
             self.assertIn("SIMULATED" if i["simulated"] else "real", card.text)
             for c in i["calibration"]:
                 self.assertIn(("valid " if c["valid"] else "invalid ") + c["type"], card.text)
+            if i["state"] == "absent":
+                self.assertIn(f"absent: {i['reason']}", card.text, "an absent instrument's card says why")
             # The cabinet as it is: every lamp of a lamp controller, on or off.
             for lamp, lit in (i.get("lab") or {}).get("lamps", {}).items():
                 self.assertIn(f"{lamp}: {'on' if lit else 'off'}", card.text)
         self.assertTrue(any("lamps" in (i.get("lab") or {}) for i in instruments),
                         "no instrument reports the cabinet's lamps")
+        widget = [i for i in instruments if i["id"] == "bench-widget"]
+        self.assertEqual([i["state"] for i in widget], ["absent"], "the configured widget that did not come up")
+        self.assertIn("lamps", widget[0]["reason"], "the factory's own words: the lamp map it lacks")
         screenshot(self.d, "lab")
 
     def test_2_start_from_queue_and_follow_to_100_percent_on_now(self):

@@ -20,8 +20,12 @@ std::filesystem::path default_sim_binary() {
   if (const char* env = std::getenv("COLORLAB_SIM"); env && *env) return env;
   std::error_code ec;
   auto self = std::filesystem::read_symlink("/proc/self/exe", ec);
-  if (!ec) return self.parent_path() / "colorlab-sim";
-  return "colorlab-sim";
+  if (ec) return "colorlab-sim";
+  // The build tree puts both in bin/; an installed colorlabd is in <prefix>/sbin beside <prefix>/bin/colorlab-sim.
+  auto sibling = self.parent_path() / "colorlab-sim";
+  auto in_bin = self.parent_path().parent_path() / "bin" / "colorlab-sim";
+  if (!std::filesystem::exists(sibling, ec) && std::filesystem::exists(in_bin, ec)) return in_bin;
+  return sibling;
 }
 
 EmbeddedSim::EmbeddedSim(const std::filesystem::path& sim_binary, const SimulatorConfig& config,
@@ -115,6 +119,16 @@ std::vector<drivers::InstrumentConfig> EmbeddedSim::instruments() const {
     c.simulated = true;
     if (i.contains("driver_options")) c.options = i["driver_options"];
     if (!c.port.empty()) out.push_back(std::move(c));
+  }
+  return out;
+}
+
+std::vector<campaigns::AbsentInstrument> EmbeddedSim::absent_instruments() const {
+  std::vector<campaigns::AbsentInstrument> out;
+  for (const auto& i : announcement_.value("absent", nlohmann::json::array())) {
+    out.push_back({i.value("id", std::string()), i.value("kind", std::string()),
+                   i.value("port", i.value("address", std::string())), true,
+                   "the simulated lab could not start it: " + i.value("reason", std::string("no reason given"))});
   }
   return out;
 }

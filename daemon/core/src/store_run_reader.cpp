@@ -1,4 +1,4 @@
-#include "store_run_reader.hpp"
+#include "colorlab/daemon/store_run_reader.hpp"
 
 namespace colorlab::daemon {
 

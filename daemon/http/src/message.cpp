@@ -81,7 +81,7 @@ HttpResponse HttpResponse::problem(int status, const std::string& code, const st
   p.title = title;
   p.detail = detail;
   p.hint = hint;
-  p.category = status < 500 ? protocol::ProblemCategory::validation : protocol::ProblemCategory::framework;
+  p.category = protocol::category_for_status(status);
   HttpResponse r;
   r.status = status;
   r.content_type = std::string(protocol::kContentProblem);

@@ -36,6 +36,12 @@ std::string transport_code(const error_code& ec) {
 
 }  // namespace
 
+std::string describe(const SerialSettings& s) {
+  const char parity = s.parity == Parity::even ? 'E' : s.parity == Parity::odd ? 'O' : 'N';
+  const char* flow = s.flow == FlowControl::hardware ? "rts/cts" : s.flow == FlowControl::software ? "xon/xoff" : "none";
+  return std::to_string(s.baud) + " " + std::to_string(s.data_bits) + parity + std::to_string(s.stop_bits) + " " + flow;
+}
+
 SerialLink::SerialLink(asio::any_io_executor executor, std::string path)
     : executor_(executor), path_(std::move(path)), timer_(executor) {}
 
@@ -104,6 +110,7 @@ void SerialLink::reconfigure(const SerialSettings& settings) {
                      "the adapter may not support this speed or framing", {}, transport_code(ec));
   }
   settings_ = settings;
+  transcript_.settings(describe(settings) + (is_pty_ ? " (pty)" : ""));
 }
 
 void SerialLink::close() {

@@ -57,6 +57,7 @@ struct Lab::Impl {
   std::shared_ptr<camera::CameraModel> camera_model;       // the GenICam camera's
   std::shared_ptr<camera::CameraModel> dslr_model;
   std::unique_ptr<aravis::GvFakeCamera> genicam;
+  std::string genicam_absent;  // why the GenICam camera asked for did not start, announced as "absent"
   std::unique_ptr<dslr::DslrServer> dslr;
   std::filesystem::path dslr_temp_dir;  // created here, removed with the lab
   std::shared_ptr<RelayBoard> relay_board;
@@ -259,6 +260,7 @@ Lab::Lab(boost::asio::io_context& io, LabConfig config) : impl_(std::make_unique
     } catch (const Error& e) {
       log::warning("sim", std::string("GenICam camera not started: ") + e.what());
       d.genicam.reset();
+      d.genicam_absent = std::string(e.what()) + (e.hint().empty() ? "" : " (" + e.hint() + ")");
     }
   }
 
@@ -392,11 +394,19 @@ json Lab::announcement() const {
                            {"simulated", true},
                            {"driver_options", {{"lamps", lamps}, {"board_id", d.config.relay.board_id}}}});
   }
-  return {{"colorlab_sim", 1},
-          {"pid", ::getpid()},
-          {"seed", d.config.seed},
-          {"time_scale", d.config.time_scale},
-          {"instruments", instruments}};
+  json announced{{"colorlab_sim", 1},
+                 {"pid", ::getpid()},
+                 {"seed", d.config.seed},
+                 {"time_scale", d.config.time_scale},
+                 {"instruments", instruments}};
+  // Asked for and not started: a client lists it as absent with this reason instead of losing it.
+  if (!d.genicam && !d.genicam_absent.empty()) {
+    announced["absent"] = json::array({{{"id", d.config.genicam.id},
+                                        {"kind", "genicam"},
+                                        {"address", d.config.genicam.address},
+                                        {"reason", d.genicam_absent}}});
+  }
+  return announced;
 }
 
 json Lab::control(const json& command) {
@@ -429,13 +439,30 @@ json Lab::control(const json& command) {
         t["ls110"] = {{"luminance", lt.luminance}, {"noise_sigma", lt.noise_sigma},
                       {"aim", {d.aim_row, d.aim_col}}, {"readings_served", d.ls110->readings_served()}};
       }
-      if (d.spectrolino) t["spectrolino"] = d.spectrolino_truth();
+      if (d.spectrolino) {
+        t["spectrolino"] = d.spectrolino_truth();
+        t["spectrolino"]["serial"] = std::to_string(d.config.spectrolino.device.serial);
+        if (d.config.spectrolino.device.table) t["spectrolino"]["table_serial"] = std::to_string(d.config.spectrolino.device.table_serial);
+      }
+      if (d.genicam) {
+        // what a GigE Vision client should find and how many frames the camera has filled for it
+        t["genicam"] = {{"address", d.genicam->address()}, {"serial", d.genicam->serial()},
+                        {"plugged_in", d.genicam->plugged_in()}, {"frames_filled", d.genicam->frames_filled()},
+                        {"sensor", {d.camera_model->width(), d.camera_model->height()}}};
+      }
       if (d.dmx) {
         const auto& u = d.dmx->universe();
-        t["dmx"] = {{"packets", d.dmx->packets()},
+        // The serial as printed on the widget's label: what an operator confirms (colorlab doctor).
+        t["dmx"] = {{"serial", std::to_string(d.config.dmx.device.serial_decimal)},
+                    {"packets", d.dmx->packets()},
                     {"slots", std::vector<int>(u.begin(), u.begin() + static_cast<long>(std::min<std::size_t>(u.size(), 16)))},
+                    {"slot_count", u.size()},  // of the last label 6 packet
                     {"bad_frames", d.dmx->bad_frames()},
-                    {"rejected_requests", d.dmx->rejected_requests()}};
+                    {"rejected_requests", d.dmx->rejected_requests()},
+                    // as the last label 4 set them, so a client's parameter writes are checked at the widget
+                    {"parameters", {{"break_time", d.dmx->parameters().break_time},
+                                    {"mab_time", d.dmx->parameters().mab_time},
+                                    {"output_rate", d.dmx->parameters().output_rate}}}};
       }
       return t;
     }

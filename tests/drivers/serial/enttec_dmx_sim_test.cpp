@@ -58,6 +58,8 @@ TEST_F(EnttecDmxSimTest, DiscoversWidgetBySerialAndParameters) {
   EXPECT_EQ(d.widget_serial(), 0x12345678u) << "serial 12345678 is stored as BCD";
   EXPECT_EQ(d.identity().serial, "12345678");
   EXPECT_EQ(d.firmware() >> 8, 1) << "DMX firmware";
+  // What `colorlab instruments` shows; OLA prints the same bytes as "firmware 1.44" (issue 25: it was 1.68).
+  EXPECT_EQ(d.identity().firmware, "1.44");
   EXPECT_EQ(sim_->packets(), 0u) << "discovery must not change the light";
 }
 

@@ -45,7 +45,8 @@ class RawWidget : public std::enable_shared_from_this<RawWidget> {
       answered_ += len + 5;
       Bytes reply;
       if (label == 10) reply = {0x7E, 0x0A, 0x04, 0x00, 0x78, 0x56, 0x34, 0x12, 0xE7};         // serial 12345678 (BCD, LE)
-      if (label == 3) reply = {0x7E, 0x03, 0x05, 0x00, 0x2C, 0x01, 0x09, 0x01, 0x28, 0xE7};  // fw 1.44, break 9, MAB 1, 40/s
+      // fw 1.44 (minor 44 = 0x2C, then major 1, as OLA's UsbProWidgetDetector reads them), break 9, MAB 1, 40/s
+      if (label == 3) reply = {0x7E, 0x03, 0x05, 0x00, 0x2C, 0x01, 0x09, 0x01, 0x28, 0xE7};
       if (reply.empty()) continue;
       auto r = std::make_shared<Bytes>(std::move(reply));
       boost::asio::async_write(master_, boost::asio::buffer(*r), [r](boost::system::error_code, std::size_t) {});

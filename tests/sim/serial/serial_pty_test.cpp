@@ -172,10 +172,10 @@ TEST(SimSerialPty, DmxWidgetDrivesTheScene) {
   c.write(bytes(en::get_serial_request()));
   EXPECT_EQ(c.read_n(9, 2.0), bytes(en::encode_frame(10, std::vector<std::uint8_t>{0x78, 0x56, 0x34, 0x12})));
   c.write(bytes(en::get_parameters_request()));
-  EXPECT_EQ(c.read_n(10, 2.0), bytes({0x7E, 0x03, 0x05, 0x00, 0x44, 0x01, 0x09, 0x01, 0x28, 0xE7}));
+  EXPECT_EQ(c.read_n(10, 2.0), bytes({0x7E, 0x03, 0x05, 0x00, 0x2C, 0x01, 0x09, 0x01, 0x28, 0xE7}));
   c.write(bytes(en::set_parameters_request({0, 20, 4, 30, {}})));
   c.write(bytes(en::get_parameters_request()));
-  EXPECT_EQ(c.read_n(10, 2.0), bytes({0x7E, 0x03, 0x05, 0x00, 0x44, 0x01, 20, 4, 30, 0xE7}));
+  EXPECT_EQ(c.read_n(10, 2.0), bytes({0x7E, 0x03, 0x05, 0x00, 0x2C, 0x01, 20, 4, 30, 0xE7}));
   c.write(bytes(en::encode_frame(77, {})));  // OLA extension: a genuine widget stays silent
   EXPECT_EQ(c.read_n(1, 0.2), "");
   std::vector<std::uint8_t> slots(512, 0);

@@ -32,9 +32,10 @@ TEST(SimWireEnttec, ShortFrameAndOtherLabels) {
   EXPECT_EQ(en::to_hex(en::get_parameters_request()), "7E 03 02 00 00 00 E7");
   EXPECT_EQ(en::to_hex(en::get_serial_request()), "7E 0A 00 00 E7");
   en::WidgetParameters wp;
-  EXPECT_EQ(en::to_hex(en::get_parameters_reply(wp)), "7E 03 05 00 44 01 09 01 28 E7");
+  EXPECT_EQ(en::to_hex(en::get_parameters_reply(wp)), "7E 03 05 00 2C 01 09 01 28 E7");
   auto back = en::decode_parameters_reply(en::decode_frame(en::get_parameters_reply(wp)));
   EXPECT_EQ(back.firmware >> 8, 1);
+  EXPECT_EQ(back.firmware & 0xFF, 44);
   EXPECT_EQ(back.output_rate, 40);
   EXPECT_EQ(en::to_hex(en::serial_reply(en::bcd_serial(12345678))), "7E 0A 04 00 78 56 34 12 E7");
   EXPECT_EQ(en::decode_serial_reply(en::decode_frame(en::serial_reply(0x12345678))), 0x12345678u);

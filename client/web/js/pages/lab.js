@@ -31,7 +31,9 @@ function card(i) {
       h("dt", {}, "can"), h("dd", {}, (i.capabilities || []).join(", ") || "—"),
       h("dt", {}, "calibration"), h("dd", {}, calibration(i.calibration)),
       lampish ? [h("dt", {}, "lamps, dimmer"), h("dd", {}, lampState(i))] : null),
-    i.problem ? h("p", { class: "error" }, typeof i.problem === "string" ? i.problem : (i.problem.detail || JSON.stringify(i.problem))) : null);
+    // An absent instrument (configured, not up) carries its reason; its problem would repeat it.
+    i.reason ? h("p", { class: "error reason" }, `absent: ${i.reason}`)
+      : i.problem ? h("p", { class: "error" }, typeof i.problem === "string" ? i.problem : (i.problem.detail || JSON.stringify(i.problem))) : null);
 }
 
 // GET /v1/instruments' `lab`: {lamps: {name: lit}, levels: {name: percent}, dimmer: percent of the lit lamp}.

@@ -28,4 +28,10 @@ struct Problem {
 // The HTTP status and category a colorlab::Error maps to.
 Problem problem_from_error(const Error& e);
 
+// The category of a problem answered by status alone (no colorlab::Error in hand), agreeing with
+// problem_from_error: 4xx validation (the request), 500 undefined_execution (the server failed),
+// 502 and 504 connection (something behind the server), any other 5xx framework (the server cannot
+// take the request now: 503 busy, too many connections).
+ProblemCategory category_for_status(int status);
+
 }  // namespace colorlab::protocol

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "colorlab/campaigns/instrument_set.hpp"
 #include "colorlab/daemon/config.hpp"
 
 namespace colorlab::daemon {
@@ -26,6 +27,8 @@ class EmbeddedSim {
   const nlohmann::json& announcement() const { return announcement_; }
   // The announced serial instruments as driver configurations (simulated = true).
   std::vector<drivers::InstrumentConfig> instruments() const;
+  // The instruments the simulated lab was asked for but could not start (its announcement's "absent").
+  std::vector<campaigns::AbsentInstrument> absent_instruments() const;
   pid_t pid() const { return pid_; }
 
  private:
@@ -34,7 +37,7 @@ class EmbeddedSim {
   nlohmann::json announcement_;
 };
 
-// colorlab-sim next to the running executable, or $COLORLAB_SIM.
+// $COLORLAB_SIM, else colorlab-sim next to the running executable, else in ../bin (installed: sbin/colorlabd).
 std::filesystem::path default_sim_binary();
 
 }  // namespace colorlab::daemon

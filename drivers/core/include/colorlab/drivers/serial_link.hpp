@@ -35,6 +35,9 @@ struct SerialSettings {
   std::chrono::nanoseconds byte_time() const;
 };
 
+// "4800 7E2 none", "57600 8N1 rts/cts".
+std::string describe(const SerialSettings& settings);
+
 class SerialLink {
  public:
   using Duration = std::chrono::steady_clock::duration;

@@ -55,9 +55,16 @@ class FrameParser {
   std::string last_problem_;
 };
 
+// A widget's firmware version as its label 3 reply carries it: LSB the minor, MSB the major number
+// (1 = DMX, 2 = RDM, 3 = sniffer firmware), each a plain binary number that OLA and our driver print
+// in decimal, so spec 1.44 firmware is minor 44 (0x2C), major 1 — not the BCD-looking 0x0144 (1.68).
+constexpr std::uint16_t firmware_version(std::uint8_t major, std::uint8_t minor) {
+  return static_cast<std::uint16_t>(major << 8 | minor);
+}
+
 // Label 3 reply / label 4 request body.
 struct WidgetParameters {
-  std::uint16_t firmware = 0x0144;  // LSB = minor, MSB = 1 (DMX firmware)
+  std::uint16_t firmware = firmware_version(1, 44);
   std::uint8_t break_time = 9;      // units of 10.67 us, 9..127
   std::uint8_t mab_time = 1;        // units of 10.67 us, 1..127
   std::uint8_t output_rate = 40;    // packets/s, 0..40 (0 = as fast as possible)

@@ -1,0 +1,44 @@
+#include "colorlab/api/problem.hpp"
+
+#include "colorlab/protocol/api.hpp"
+#include "colorlab/protocol/problem.hpp"
+#include "colorlab/store/queue.hpp"
+
+namespace colorlab::daemon {
+
+namespace {
+
+http::HttpResponse respond(const protocol::Problem& p, const nlohmann::json& extra) {
+  nlohmann::json body = p.to_json();
+  if (!extra.empty()) body.update(extra);
+  http::HttpResponse r;
+  r.status = p.status;
+  r.content_type = std::string(protocol::kContentProblem);
+  // A detail may quote the client's bytes (a path that is not UTF-8): replaced, never a throw.
+  r.body = body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  return r;
+}
+
+}  // namespace
+
+http::HttpResponse problem_response(int status, const std::string& code, const std::string& title,
+                                    const std::string& detail, const std::string& hint, const nlohmann::json& extra) {
+  protocol::Problem p;
+  p.status = status;
+  p.code = code;
+  p.title = title;
+  p.detail = detail;
+  p.hint = hint;
+  p.category = protocol::category_for_status(status);
+  return respond(p, extra);
+}
+
+http::HttpResponse error_response(const Error& e, const std::string& instance) {
+  auto p = protocol::problem_from_error(e);
+  // A refusal about a queue item's references: its own code, so a client can tell it from another conflict.
+  if (const auto* q = dynamic_cast<const store::QueueConflict*>(&e)) p.code = q->code();
+  p.instance = instance;
+  return respond(p, nlohmann::json::object());
+}
+
+}  // namespace colorlab::daemon

@@ -1,0 +1,180 @@
+#include "colorlab/api/conditional.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include "colorlab/campaigns/frame_keeper.hpp"
+#include "colorlab/core/error.hpp"
+#include "colorlab/daemon/blob_service.hpp"
+#include "colorlab/api/problem.hpp"
+#include "colorlab/protocol/api.hpp"
+#include "colorlab/store/blob_index.hpp"
+#include "handlers.hpp"
+
+// The blob routes of the v1 API (docs/API.md, "Blobs"): a stored frame by its SHA-256 with ETag,
+// If-None-Match, a single Range and the array's dtype/shape/CFA in headers; its PNG preview; a
+// run's blobs; the start-up check's report; retention on request.
+namespace colorlab::daemon::routes {
+
+namespace fs = std::filesystem;
+using http::HttpRequest;
+using http::HttpResponse;
+using nlohmann::json;
+
+namespace {
+
+// Served on the HTTP pool: the calling thread's own read connection, never the writer.
+store::Store& reads(ApiContext& ctx) { return ctx.reads(); }
+
+BlobService& service(ApiContext& ctx) {
+  if (!ctx.blobs) throw Error(ErrorClass::unsupported, "this daemon keeps no blob store");
+  return *ctx.blobs;
+}
+
+store::BlobRecord require_blob(ApiContext& ctx, const std::string& sha256) {
+  if (!store::BlobStore::is_sha256(sha256)) {
+    throw Error(ErrorClass::not_found, "no blob named '" + sha256.substr(0, 80) + "'",
+                "a blob is named by the 64 lower-case hex digits of its SHA-256 (GET /v1/runs/{id}/blobs lists a run's)");
+  }
+  auto row = store::BlobIndex(reads(ctx)).blob(sha256);
+  if (!row) throw Error(ErrorClass::not_found, "no blob " + sha256, "GET /v1/runs/{id}/blobs lists a run's blobs");
+  return *row;
+}
+
+std::string join_shape(const json& shape) {
+  std::string out;
+  for (const auto& d : shape) out += (out.empty() ? "" : ",") + std::to_string(d.get<long long>());
+  return out;
+}
+
+// Everything a GET and a HEAD of the blob share, before the body: identity, type and caching. The
+// bytes of a name never change, so a client may keep them for good.
+void describe(HttpResponse& r, const store::BlobRecord& blob, const std::string& etag) {
+  r.headers["ETag"] = etag;
+  r.headers["Accept-Ranges"] = "bytes";
+  r.headers["Cache-Control"] = "public, max-age=31536000, immutable";
+  if (blob.media_type == campaigns::kArrayMediaType) {
+    const json& m = blob.meta;
+    if (m.contains("dtype") && m["dtype"].is_string()) r.headers["X-Colorlab-Dtype"] = m["dtype"].get<std::string>();
+    if (m.contains("shape") && m["shape"].is_array()) r.headers["X-Colorlab-Shape"] = join_shape(m["shape"]);
+    if (m.contains("cfa") && m["cfa"].is_string()) r.headers["X-Colorlab-Cfa"] = m["cfa"].get<std::string>();
+  }
+}
+
+HttpResponse serve_blob(ApiContext& ctx, const HttpRequest& req, const std::string& sha256) {
+  const store::BlobRecord blob = require_blob(ctx, sha256);
+  const fs::path path = service(ctx).files().path_of(sha256);
+  std::error_code ec;
+  const auto size = fs::file_size(path, ec);
+  if (ec) {
+    throw Error(ErrorClass::not_found, "the file of blob " + sha256 + " is missing from the blob store",
+                "GET /v1/blobs/check lists what the store lacks");
+  }
+  const std::string etag = "\"" + sha256 + "\"";
+  HttpResponse r;
+  r.content_type = blob.media_type;
+  describe(r, blob, etag);
+  if (auto inm = req.header("if-none-match"); inm && none_match_hits(*inm, etag)) {
+    r.status = 304;
+    return r;
+  }
+  ByteRange range;
+  if (auto h = req.header("range")) {
+    range = parse_byte_range(*h, size);
+    // If-Range compares strongly: a weak or another tag (or a date: ours never changes, yet we
+    // have no Last-Modified to compare with) means "send it whole".
+    if (auto ir = req.header("if-range"); ir && trim_ows(*ir) != etag) range.kind = ByteRange::Kind::whole;
+  }
+  if (range.kind == ByteRange::Kind::unsatisfiable) {
+    auto p = problem_response(416, "range-not-satisfiable", "Range not satisfiable",
+                                   "blob " + sha256 + " has " + std::to_string(size) + " bytes; the range asked for starts beyond them");
+    describe(p, blob, etag);
+    p.headers["Content-Range"] = "bytes */" + std::to_string(size);
+    return p;
+  }
+  r.status = 200;
+  std::uint64_t offset = 0, length = size;
+  if (range.kind == ByteRange::Kind::partial) {
+    r.status = 206;
+    offset = range.first;
+    length = range.last - range.first + 1;
+    r.headers["Content-Range"] = "bytes " + std::to_string(range.first) + "-" + std::to_string(range.last) + "/" + std::to_string(size);
+  }
+  r.file = http::FileSpan{path, offset, length};
+  return r;
+}
+
+HttpResponse serve_preview(ApiContext& ctx, const HttpRequest& req, const std::string& sha256) {
+  const store::BlobRecord blob = require_blob(ctx, sha256);
+  const fs::path png = service(ctx).preview_path(reads(ctx), blob);
+  std::error_code ec;
+  const auto size = fs::file_size(png, ec);
+  if (ec) throw Error(ErrorClass::not_found, "the preview of blob " + sha256 + " is gone");
+  // Weak: the same frame's preview may be rendered anew by a later version, with other bytes.
+  const std::string etag = "W/\"preview-" + sha256 + "\"";
+  HttpResponse r;
+  r.content_type = "image/png";
+  r.headers["ETag"] = etag;
+  r.headers["Cache-Control"] = "public, max-age=86400";
+  if (auto inm = req.header("if-none-match"); inm && none_match_hits(*inm, etag)) {
+    r.status = 304;
+    return r;
+  }
+  r.file = http::FileSpan{png, 0, size};
+  return r;
+}
+
+json blob_links(const std::string& sha256) {
+  const std::string self = std::string(protocol::kPrefix) + "/blobs/" + sha256;
+  return json{{"self", self}, {"preview", self + "/preview.png"}};
+}
+
+HttpResponse run_blobs(ApiContext& ctx, const std::string& run_id) {
+  store::Store& db = reads(ctx);
+  if (!db.run(run_id)) throw Error(ErrorClass::not_found, "no run with id '" + run_id + "'");
+  json items = json::array();
+  for (const auto& b : store::BlobIndex(db).of_run(run_id)) {
+    items.push_back({{"name", b.name},
+                     {"sha256", b.blob.sha256},
+                     {"kind", b.kind},
+                     {"step", b.step},
+                     {"media_type", b.blob.media_type},
+                     {"size", b.blob.size},
+                     {"meta", b.blob.meta},
+                     {"created_at", b.created_at},
+                     {"links", blob_links(b.blob.sha256)}});
+  }
+  return HttpResponse::json(200, {{"run_id", run_id}, {"items", items}});
+}
+
+HttpResponse retention(ApiContext& ctx, const HttpRequest& req) {
+  bool dry_run = false;
+  if (auto it = req.query.find("dry_run"); it != req.query.end()) {
+    if (it->second != "true" && it->second != "false" && it->second != "1" && it->second != "0") {
+      throw Error(ErrorClass::bad_parameter, "dry_run must be true or false");
+    }
+    dry_run = it->second == "true" || it->second == "1";
+  }
+  return HttpResponse::json(200, service(ctx).apply_retention(dry_run));
+}
+
+}  // namespace
+
+HttpResponse get_run_blobs(ApiContext& ctx, const HttpRequest&, const PathParams& params) {
+  return run_blobs(ctx, params["id"]);
+}
+
+HttpResponse get_blob(ApiContext& ctx, const HttpRequest& req, const PathParams& params) {
+  return serve_blob(ctx, req, params["sha256"]);
+}
+
+HttpResponse get_blob_preview(ApiContext& ctx, const HttpRequest& req, const PathParams& params) {
+  return serve_preview(ctx, req, params["sha256"]);
+}
+
+HttpResponse get_blob_check(ApiContext& ctx, const HttpRequest&, const PathParams&) {
+  return HttpResponse::json(200, service(ctx).check_report());
+}
+
+HttpResponse post_blob_retention(ApiContext& ctx, const HttpRequest& req, const PathParams&) { return retention(ctx, req); }
+
+}  // namespace colorlab::daemon::routes
