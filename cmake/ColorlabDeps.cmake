@@ -62,6 +62,8 @@ colorlab_require_pkg(LCMS2 lcms2 liblcms2-dev)
 colorlab_require_pkg(LUA lua5.4 liblua5.4-dev)
 colorlab_require_pkg(LIBTIFF libtiff-4 libtiff-dev)
 colorlab_require_pkg(SYSTEMD libsystemd libsystemd-dev)
+# colorlabd's webhook notifications ([notify]).
+colorlab_require_pkg(CURL libcurl libcurl4-openssl-dev)
 
 # Asio on Boost 1.74 + GCC 12 in C++20 uses std::exchange without including <utility>.
 add_library(colorlab_asio INTERFACE)

@@ -24,6 +24,8 @@ packages=(
   ola iproute2
   # the data service: load benches against nginx, fuzzing with clang's libFuzzer, the Python client
   wrk nginx-light clang libfuzzer-14-dev python3-requests python3-pandas openssl
+  # the daemon's webhook notifications ([notify] webhook)
+  libcurl4-openssl-dev
   # reports (plots by matplotlib) and the web console, both tested in headless Chromium
   python3-matplotlib chromium chromium-driver python3-selenium
   # clang only recommends its fuzzer and sanitizer runtimes, and this script installs without recommends

@@ -131,6 +131,14 @@ std::string format_execution(const json& e) {
     << number(100.0 * e.value("progress", 0.0), 0) << "%  " << str(e, "step");
   if (!e.value("reason", std::string()).empty()) o << "  (" << e["reason"].get<std::string>() << ")";
   o << "\n";
+  // Why a suspended execution waits; the crash-loop guard also says when it retries by itself.
+  if (e.contains("suspension") && e["suspension"].is_object()) {
+    const json& s = e["suspension"];
+    o << "  suspended  " << str(s, "category");
+    if (s.contains("retry_at")) o << ", retried by colorlabd at " << str(s, "retry_at") << " (retry " << str(s, "retry") << " of " << str(s, "retries") << ")";
+    o << "\n";
+    if (s.contains("problem") && s["problem"].contains("hint")) o << "  hint       " << str(s["problem"], "hint") << "\n";
+  }
   return o.str();
 }
 

@@ -30,6 +30,7 @@
 #include "colorlab/daemon/executions.hpp"
 #include "colorlab/daemon/simulator_hands.hpp"
 #include "colorlab/daemon/night_queue.hpp"
+#include "colorlab/daemon/notifier.hpp"
 #include "colorlab/daemon/store_run_reader.hpp"
 #include "colorlab/daemon/systemd_notify.hpp"
 #include "colorlab/drivers/discovery_monitor.hpp"
@@ -52,6 +53,7 @@ struct Daemon::Impl {
   campaigns::OperatorDesk desk;
   std::unique_ptr<SimulatorHands> hands;
   std::unique_ptr<StoreRunReader> run_reader;  // lab.runs.* (characterize-camera's reference)
+  std::unique_ptr<Notifier> notices;  // [notify]: tells the operator (notifier.hpp); outlives executions
   std::unique_ptr<Executions> executions;
   std::unique_ptr<NightQueue> queue;
   std::unique_ptr<ReadConnections> readers;
@@ -177,8 +179,15 @@ Daemon::Daemon(DaemonConfig config) : impl_(std::make_unique<Impl>()) {
       log::warning("operator", std::string("cannot record the request: ") + e.what());
     }
   });
-  d.executions = std::make_unique<Executions>(d.io, *d.store, *d.catalogue, d.instruments, *d.lab,
-                                              ExecutionOptions{cc.max_resume_attempts, d.config.state_dir},
+  ExecutionOptions execution_options;
+  execution_options.crash_loop = {cc.max_resume_attempts, cc.crash_loop_backoff_s, cc.crash_loop_backoff_max_s,
+                                  cc.crash_loop_retries};
+  execution_options.state_dir = d.config.state_dir;
+  if (d.config.notify.enabled()) {
+    d.notices = std::make_unique<Notifier>(d.config.notify);
+    execution_options.notifier = d.notices.get();
+  }
+  d.executions = std::make_unique<Executions>(d.io, *d.store, *d.catalogue, d.instruments, *d.lab, execution_options,
                                               [&d](const std::string& text) { d.notifier.status(text); });
   d.queue = std::make_unique<NightQueue>(d.io, *d.store, *d.executions, *d.catalogue, *d.lab,
                                          QueueOptions{d.config.queue.autostart});

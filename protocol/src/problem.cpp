@@ -1,5 +1,7 @@
 #include "colorlab/protocol/problem.hpp"
 
+#include <utility>
+
 namespace colorlab::protocol {
 
 std::string_view to_string(ProblemCategory c) {
@@ -41,6 +43,17 @@ ProblemCategory category_for_status(int status) {
   if (status == 500) return ProblemCategory::undefined_execution;
   if (status == 502 || status == 504) return ProblemCategory::connection;
   return ProblemCategory::framework;
+}
+
+Problem problem_for_status(int status, std::string code, std::string title, std::string detail, std::string hint) {
+  Problem p;
+  p.status = status;
+  p.code = std::move(code);
+  p.title = std::move(title);
+  p.detail = std::move(detail);
+  p.hint = std::move(hint);
+  p.category = category_for_status(status);
+  return p;
 }
 
 Problem problem_from_error(const Error& e) {

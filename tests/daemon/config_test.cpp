@@ -86,3 +86,49 @@ TEST(DaemonConfig, QueueAutostartIsOffUnlessSaidAndOtherQueueKeysAreRefused) {
     EXPECT_NE(std::string(e.what()).find("queue.retries"), std::string::npos) << e.what();
   }
 }
+
+// The crash-loop guard's back-off and [notify] (docs/configuration.md): defaults, and every bad value
+// refused with the file and line.
+TEST(DaemonConfig, CrashLoopBackOffAndNotifyHaveDefaultsAndRefuseNonsense) {
+  using colorlab::daemon::parse_config;
+  auto d = parse_config("", "d.toml");
+  EXPECT_EQ(d.campaigns.max_resume_attempts, 3);
+  EXPECT_EQ(d.campaigns.crash_loop_backoff_s, 60);
+  EXPECT_EQ(d.campaigns.crash_loop_backoff_max_s, 1800);
+  EXPECT_EQ(d.campaigns.crash_loop_retries, 6);
+  EXPECT_FALSE(d.notify.enabled());
+  EXPECT_EQ(d.notify.events, (std::vector<std::string>{"suspended", "crash-loop", "failed"}));
+
+  auto c = parse_config(R"([campaigns]
+crash_loop_backoff_s = 0.5
+crash_loop_backoff_max_s = 2
+crash_loop_retries = 0
+[notify]
+command = ["/usr/local/bin/page-me", "--lab", "north"]
+webhook = "https://hooks.example.invalid/T0/secret"
+timeout_s = 3
+events = ["crash-loop"]
+)", "c.toml");
+  EXPECT_EQ(c.campaigns.crash_loop_backoff_s, 0.5);
+  EXPECT_EQ(c.campaigns.crash_loop_backoff_max_s, 2);
+  EXPECT_EQ(c.campaigns.crash_loop_retries, 0);
+  EXPECT_EQ(c.notify.command, (std::vector<std::string>{"/usr/local/bin/page-me", "--lab", "north"}));
+  EXPECT_EQ(c.notify.webhook, "https://hooks.example.invalid/T0/secret");
+  EXPECT_EQ(c.notify.timeout_s, 3);
+  EXPECT_EQ(c.notify.events, std::vector<std::string>{"crash-loop"});
+  EXPECT_TRUE(c.notify.enabled());
+
+  for (const char* bad : {"[campaigns]\ncrash_loop_backoff_s = 0\n", "[campaigns]\ncrash_loop_retries = -1\n",
+                          "[campaigns]\ncrash_loop_backoff_s = 600\ncrash_loop_backoff_max_s = 60\n",
+                          "[notify]\ncommand = \"page-me --now\"\n", "[notify]\ncommand = []\n",
+                          "[notify]\nwebhook = \"ftp://x/\"\n", "[notify]\ntimeout_s = 0\n",
+                          "[notify]\nevents = [\"finished\"]\n", "[notify]\nshell = true\n"}) {
+    try {
+      parse_config(bad, "bad.toml");
+      ADD_FAILURE() << "accepted: " << bad;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("bad.toml:"), std::string::npos) << e.what();
+      EXPECT_EQ(e.cls(), colorlab::ErrorClass::bad_parameter);
+    }
+  }
+}

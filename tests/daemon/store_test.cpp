@@ -321,3 +321,38 @@ TEST(Store, CallTimingsAccumulateWithTheirStepAndAreReadAtTheNearestTimeScale) {
   EXPECT_DOUBLE_EQ(at_800["meter.measure"].mean_s, 20.0);
   EXPECT_DOUBLE_EQ(at_800["wait_stable cold D65"].mean_s, 400.0);  // only ever timed at ×100
 }
+
+// Schema 7: a suspended execution keeps why it waits (the crash-loop guard's back-off among it); running
+// again or ended, it waits for nothing. A version-6 file gains the column with its executions intact.
+TEST(Store, ASuspensionIsStoredWhileSuspendedAndClearedAfter) {
+  TempDir dir;
+  auto path = dir / "colorlab.db";
+  std::string id;
+  {
+    Store store(path);
+    auto e = scripted_execution(store);
+    id = e.id;
+    nlohmann::json why{{"category", "crash-loop"}, {"retry", 1}, {"retry_at", "2026-11-28T02:15:07.311Z"}};
+    store.set_execution_status(e, ExecutionStatus::suspended, "crash loop: …", nullptr, why);
+    EXPECT_EQ(store.execution(id)->suspension, why);
+    EXPECT_EQ(store.execution(id)->to_json()["suspension"], why);
+    auto events = store.events(0, 100, std::string("execution"));
+    EXPECT_EQ(events.back().payload["suspension"], why);
+    store.set_execution_status(e, ExecutionStatus::running, "resumed");
+    EXPECT_TRUE(store.execution(id)->suspension.is_null());
+    EXPECT_FALSE(store.execution(id)->to_json().contains("suspension"));
+    store.set_execution_status(e, ExecutionStatus::suspended, "again", nullptr, why);
+    store.finish_execution(e, ExecutionStatus::finished_error, "s", nullptr, {{"code", "crash-loop"}}, "gave up");
+    EXPECT_TRUE(store.execution(id)->suspension.is_null());
+    EXPECT_EQ(store.events(0, 100, std::string("execution")).back().payload["error"]["code"], "crash-loop");
+  }
+  sqlite3* h = nullptr;
+  ASSERT_EQ(sqlite3_open(path.c_str(), &h), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(h, "ALTER TABLE executions DROP COLUMN suspension; PRAGMA user_version = 6;", nullptr, nullptr, nullptr),
+            SQLITE_OK);
+  sqlite3_close(h);
+  Store migrated(path);
+  ASSERT_TRUE(migrated.execution(id).has_value());
+  EXPECT_EQ(migrated.execution(id)->status, ExecutionStatus::finished_error);
+  EXPECT_TRUE(migrated.execution(id)->suspension.is_null());
+}

@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include "colorlab/daemon/config.hpp"
+#include "colorlab/daemon/crash_loop.hpp"
 #include "colorlab/testing/process.hpp"
 #include "colorlab/testing/temp_dir.hpp"
 
@@ -31,6 +33,33 @@ TEST(SystemdUnit, KeepsTheDirectivesColorlabdReliesOn) {
   }
   EXPECT_FALSE(std::regex_search(unit, std::regex("^PrivateDevices=", std::regex::multiline)))
       << "PrivateDevices would hide /dev/ttyUSB*, /dev/bus/usb and /dev/hidraw*";
+}
+
+double unit_seconds(const std::string& unit, const std::string& key) {
+  std::smatch m;
+  if (!std::regex_search(unit, m, std::regex("^" + key + "=([0-9]+)s?$", std::regex::multiline))) return -1;
+  return std::stod(m[1]);
+}
+
+// systemd must keep restarting colorlabd while the crash-loop guard handles a step that kills it every
+// time, with the default back-off, and the next queued run doing the same: otherwise the unit fails
+// before the guard's first back-off has ended (issue 27: StartLimitBurst=5 per 300 s did).
+TEST(SystemdUnit, StartLimitLetsTheCrashLoopGuardDoItsWork) {
+  std::string unit = read_unit();
+  const double interval = unit_seconds(unit, "StartLimitIntervalSec");
+  const double burst = unit_seconds(unit, "StartLimitBurst");
+  const double restart = unit_seconds(unit, "RestartSec");
+  ASSERT_GT(interval, 0) << "StartLimitIntervalSec=N (seconds) expected";
+  ASSERT_GT(burst, 0);
+  ASSERT_GT(restart, 0);
+  const colorlab::daemon::CampaignConfig defaults;
+  const colorlab::daemon::CrashLoopPolicy policy{defaults.max_resume_attempts, defaults.crash_loop_backoff_s,
+                                                 defaults.crash_loop_backoff_max_s, defaults.crash_loop_retries};
+  const int needed = colorlab::daemon::max_starts_within(policy, interval, restart);
+  EXPECT_LE(needed, burst) << "StartLimitBurst=" << burst << " per " << interval << " s stops systemd restarting "
+                           << "colorlabd while the guard still needs " << needed << " starts";
+  // The old limit would not have done: the guard's first back-off retry alone is the 6th start.
+  EXPECT_GT(colorlab::daemon::max_starts_within(policy, 300, 5), 5);
 }
 
 TEST(SystemdUnit, SystemdAcceptsIt) {

@@ -18,7 +18,8 @@ void one_input(const std::uint8_t* data, std::size_t size) {
     const auto& k = c.campaigns;
     for (double v : {k.lamp_warmup_s, k.stable_tolerance_pct, k.stable_window_s, k.stable_interval_s, k.stable_timeout_s,
                      k.suspend_retry_s, k.suspend_settle_s, k.suspend_max_s, k.time_scale, c.access.control_lease_s,
-                     c.api.stream_write_timeout_s, c.blobs.retention_days}) {
+                     c.api.stream_write_timeout_s, c.blobs.retention_days, k.crash_loop_backoff_s,
+                     k.crash_loop_backoff_max_s, c.notify.timeout_s}) {
       if (!std::isfinite(v)) {
         std::fprintf(stderr, "fuzz: a range-checked setting came out %f\n", v);
         std::abort();

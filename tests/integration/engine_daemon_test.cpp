@@ -216,10 +216,12 @@ TEST(EngineInDaemon, SigtermSuspendsTheRunningStepAndTheNextStartResumesIt) {
   for (int i = 0; i < 20; ++i) EXPECT_EQ(run["measurements"][i]["step"], "reading/" + std::to_string(i));
 }
 
+// Without back-off retries (crash_loop_retries = 0) the crash-loop guard ends the run as soon as it trips;
+// crash_loop_test.cpp has the suspension and back-off that the default retries give.
 TEST(EngineInDaemon, AStepThatKillsTheDaemonEveryTimeEndsAfterTheBoundedAttempts) {
   TempDir dir;
-  DaemonProcess daemon(dir / "state",
-                       write_daemon_config(dir.path(), 1, 1, "[campaigns]\nmax_resume_attempts = 2\n"));
+  DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), 1, 1,
+                                                          "[campaigns]\nmax_resume_attempts = 2\ncrash_loop_retries = 0\n"));
   auto api = api_for(daemon);
   auto e = start(api, "luminance-spot", {{"readings", 100}});
   std::string id = e["id"];
@@ -237,6 +239,8 @@ TEST(EngineInDaemon, AStepThatKillsTheDaemonEveryTimeEndsAfterTheBoundedAttempts
   ASSERT_EQ(done["status"], "finished_error") << done.dump();
   EXPECT_NE(done["reason"].get<std::string>().find("3 times in a row"), std::string::npos) << done.dump();
   EXPECT_EQ(done["resume_attempts"], 3);
+  EXPECT_EQ(done["error"]["code"], "crash-loop") << "colorlabd's own trouble, not an instrument error: " << done.dump();
+  EXPECT_EQ(done["error"]["title"], "Crash loop");
   // What was measured before stays.
   EXPECT_GE(measurement_count(api, e), 2u);
 }

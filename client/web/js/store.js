@@ -58,6 +58,8 @@ export class Store {
       if ("reason" in p) e.reason = p.reason;
       // A suspension carries the failure it waits out (problem+json): the operator needs its hint.
       if (p.status) e.problem = p.problem || p.error || null;
+      // Why a suspended run waits (the crash-loop guard adds when it retries); gone once it runs again.
+      if (p.status) e.suspension = p.suspension || null;
       if (p.requested) e.requested = p.requested;
       if (p.status && isTerminal(p.status)) {
         e.finished_at = Date.now();

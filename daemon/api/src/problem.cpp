@@ -23,14 +23,7 @@ http::HttpResponse respond(const protocol::Problem& p, const nlohmann::json& ext
 
 http::HttpResponse problem_response(int status, const std::string& code, const std::string& title,
                                     const std::string& detail, const std::string& hint, const nlohmann::json& extra) {
-  protocol::Problem p;
-  p.status = status;
-  p.code = code;
-  p.title = title;
-  p.detail = detail;
-  p.hint = hint;
-  p.category = protocol::category_for_status(status);
-  return respond(p, extra);
+  return respond(protocol::problem_for_status(status, code, title, detail, hint), extra);
 }
 
 http::HttpResponse error_response(const Error& e, const std::string& instance) {

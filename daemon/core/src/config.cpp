@@ -90,6 +90,51 @@ void parse_blobs(const toml::node& node, BlobConfig& b, const std::filesystem::p
 }
 
 
+// [notify]: a command (argv) and/or a webhook, each optional (docs/configuration.md, "Notifications").
+void parse_notify(const toml::node& node, NotifyConfig& n, const std::filesystem::path& file) {
+  auto t = node.as_table();
+  if (!t) bad(file, node.source(), "[notify] must be a table");
+  auto strings = [&](const toml::node& v, const std::string& key, const std::string& example) {
+    auto arr = v.as_array();
+    if (!arr) bad(file, v.source(), "notify." + key + " must be a list of strings, e.g. " + example);
+    std::vector<std::string> out;
+    for (const auto& item : *arr) {
+      auto s = item.value<std::string>();
+      if (!s) bad(file, item.source(), "notify." + key + " must be a list of strings, e.g. " + example);
+      out.push_back(*s);
+    }
+    return out;
+  };
+  for (const auto& [nkey, nnode] : *t) {
+    std::string nk(nkey.str());
+    if (nk == "command") {
+      n.command = strings(nnode, nk, "[\"/usr/local/bin/page-me\", \"--lab\"]");
+      if (n.command.empty() || n.command.front().empty()) {
+        bad(file, nnode.source(), "notify.command needs the program to run as its first element (no shell is involved)");
+      }
+    } else if (nk == "webhook") {
+      auto v = nnode.value<std::string>();
+      if (!v || !(v->starts_with("http://") || v->starts_with("https://")) || v->find_first_of(" \t\r\n") != std::string::npos) {
+        bad(file, nnode.source(), "notify.webhook must be an http:// or https:// URL");
+      }
+      n.webhook = *v;
+    } else if (nk == "timeout_s") {
+      auto v = nnode.value<double>();
+      if (!v || !(*v >= 0.1 && *v <= 300)) bad(file, nnode.source(), "notify.timeout_s must be a number from 0.1 to 300");
+      n.timeout_s = *v;
+    } else if (nk == "events") {
+      n.events = strings(nnode, nk, "[\"crash-loop\", \"failed\"]");
+      for (const auto& e : n.events) {
+        if (e != "suspended" && e != "crash-loop" && e != "failed") {
+          bad(file, nnode.source(), "notify.events names suspended, crash-loop or failed, not '" + e + "'");
+        }
+      }
+    } else {
+      bad(file, nnode.source(), "unknown key 'notify." + nk + "'");
+    }
+  }
+}
+
 }  // namespace
 
 // The file, or text read from it, as a TOML table; a syntax error names the file and line.
@@ -159,6 +204,14 @@ static DaemonConfig from_toml(const toml::table& root, const std::filesystem::pa
           double v = 0;
           number(v, 1, 100);
           c.campaigns.max_resume_attempts = static_cast<int>(v);
+        } else if (ck == "crash_loop_backoff_s") {
+          number(c.campaigns.crash_loop_backoff_s, 0.1, 86400);
+        } else if (ck == "crash_loop_backoff_max_s") {
+          number(c.campaigns.crash_loop_backoff_max_s, 0.1, 7 * 86400);
+        } else if (ck == "crash_loop_retries") {
+          double v = 0;
+          number(v, 0, 100);
+          c.campaigns.crash_loop_retries = static_cast<int>(v);
         } else if (ck == "lamps_off_at_shutdown") {
           auto v = cnode.value<bool>();
           if (!v) bad(file, cnode.source(), "campaigns.lamps_off_at_shutdown must be true or false");
@@ -184,6 +237,9 @@ static DaemonConfig from_toml(const toml::table& root, const std::filesystem::pa
         } else {
           bad(file, cnode.source(), "unknown key 'campaigns." + ck + "'");
         }
+      }
+      if (c.campaigns.crash_loop_backoff_max_s < c.campaigns.crash_loop_backoff_s) {
+        bad(file, node.source(), "campaigns.crash_loop_backoff_max_s must not be below campaigns.crash_loop_backoff_s");
       }
     } else if (k == "api") {
       auto t = node.as_table();
@@ -221,6 +277,8 @@ static DaemonConfig from_toml(const toml::table& root, const std::filesystem::pa
           bad(file, qnode.source(), "unknown key 'queue." + qk + "'");
         }
       }
+    } else if (k == "notify") {
+      parse_notify(node, c.notify, file);
     } else if (k == "access") {
       auto t = node.as_table();
       if (!t) bad(file, node.source(), "[access] must be a table");

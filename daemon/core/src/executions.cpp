@@ -1,5 +1,6 @@
 #include "colorlab/daemon/executions.hpp"
 
+#include <chrono>
 #include <cmath>
 #include <random>
 
@@ -10,9 +11,11 @@
 #include "colorlab/campaigns/dry_run.hpp"
 #include "colorlab/campaigns/engine.hpp"
 #include "colorlab/core/error.hpp"
+#include "colorlab/core/ids.hpp"
 #include "colorlab/core/log.hpp"
 #include "colorlab/daemon/blob_service.hpp"
 #include "colorlab/daemon/campaign_request.hpp"
+#include "colorlab/daemon/notifier.hpp"
 #include "colorlab/protocol/problem.hpp"
 
 namespace colorlab::daemon {
@@ -35,10 +38,13 @@ namespace {
 // The engine's persistence, over the store: one step, one transaction.
 class StoreSink final : public campaigns::ExecutionSink {
  public:
+  // `on_suspended` hears of each suspension (reason, problem, suspension document) to tell the operator.
+  using SuspendedListener = std::function<void(const std::string&, const json&, const json&)>;
   StoreSink(store::Store& store, const store::ExecutionRecord& record, const campaigns::InstrumentSet& instruments,
             std::function<void(const std::string&)> status, json snapshot, bool replace_serials,
-            std::optional<std::string>& suspension, double time_scale)
+            std::optional<std::string>& suspension, double time_scale, SuspendedListener on_suspended)
       : suspension_(suspension),
+        on_suspended_(std::move(on_suspended)),
         time_scale_(time_scale),
         store_(store),
         record_(record),
@@ -75,13 +81,17 @@ class StoreSink final : public campaigns::ExecutionSink {
   void suspended(const std::string& reason, const Error& cause) override {
     suspension_ = reason;
     status_text("suspended: " + reason);
+    const json problem = protocol::problem_from_error(cause).to_json();
+    // The reason starts with the engine's cause: instrument, lamp or storage.
+    const json document{{"category", reason.substr(0, reason.find(':'))}, {"problem", problem}};
     try {
-      store_.set_execution_status(record_, ExecutionStatus::suspended, reason,
-                                  json{{"suspended", true}, {"problem", protocol::problem_from_error(cause).to_json()}});
+      store_.set_execution_status(record_, ExecutionStatus::suspended, reason, json{{"suspended", true}, {"problem", problem}},
+                                  document);
     } catch (const Error& e) {
       // A full disk refuses this too; the API still reports the suspension from memory.
       log::warning("executions", record_.id + ": cannot store the suspension: " + e.what());
     }
+    if (on_suspended_) on_suspended_(reason, problem, document);
   }
   void resumed(const json& how) override {
     suspension_.reset();
@@ -117,6 +127,7 @@ class StoreSink final : public campaigns::ExecutionSink {
   }
 
   std::optional<std::string>& suspension_;
+  SuspendedListener on_suspended_;
   double time_scale_ = 1;
   store::Store& store_;
   const store::ExecutionRecord& record_;
@@ -202,17 +213,21 @@ void Executions::resume_unfinished() {
       continue;
     }
     try {
+      if (record.status == ExecutionStatus::suspended && is_crash_loop(record.suspension)) {
+        // Stopped (or killed) during the guard's back-off: the back-off goes on where it was.
+        const double backoff = record.suspension.value("backoff_s", options_.crash_loop.backoff_s);
+        const double left = seconds_until(record.suspension.value("retry_at", std::string()), backoff,
+                                          std::chrono::system_clock::now());
+        log::info("executions", record.id + " stays suspended by the crash-loop guard; retrying in " +
+                                    std::to_string(static_cast<long>(std::ceil(left))) + " s (or `colorlab resume`)");
+        arm_backoff(record.id, left);
+        continue;
+      }
       // A clean shutdown suspended it; anything else means the process died during a step.
       if (record.status != ExecutionStatus::suspended) {
         int attempts = store_.begin_resume(record.id);
-        if (attempts > options_.max_resume_attempts) {
-          std::string why = "colorlabd stopped " + std::to_string(attempts) + " times in a row during step '" +
-                            record.step + "' without committing it; not resuming again";
-          Error e(ErrorClass::hardware_fail, why,
-                  "look at the daemon's log (journalctl -u colorlabd) for what killed it; start a new run when fixed");
-          store_.finish_execution(record, ExecutionStatus::finished_error, record.step, nullptr,
-                                  problem_json(e, json{{"step", record.step}}), why);
-          log::error("executions", record.id + ": " + why);
+        if (judge_crash_loop(options_.crash_loop, attempts).kind != CrashLoopVerdict::Kind::resume) {
+          crash_loop(record, attempts);
           continue;
         }
       }
@@ -220,36 +235,134 @@ void Executions::resume_unfinished() {
       relaunch(record, false);
     } catch (const Error& e) {
       log::error("executions", record.id + ": cannot resume: " + e.what());
-      store_.finish_execution(record, ExecutionStatus::finished_error, record.step, nullptr, problem_json(e, nullptr),
-                              std::string("cannot resume: ") + e.what());
+      json problem = problem_json(e, nullptr);
+      std::string why = std::string("cannot resume: ") + e.what();
+      store_.finish_execution(record, ExecutionStatus::finished_error, record.step, nullptr, problem, why);
+      notify("failed", record, why, problem);
     }
   }
 }
 
+// Not an instrument's failure: colorlabd itself kept dying in this step. Suspended with a back-off the
+// daemon waits out by itself; once the retries are spent the run ends and its queue item's on_failure
+// decides the rest of the night.
+void Executions::crash_loop(const store::ExecutionRecord& record, int attempts) {
+  const auto& policy = options_.crash_loop;
+  const auto verdict = judge_crash_loop(policy, attempts);
+  const std::string what = "colorlabd stopped " + std::to_string(attempts) + " times in a row during step '" + record.step +
+                           "' without committing it";
+  const std::string look = "look at the daemon's log (journalctl -u colorlabd) for what killed it";
+  if (verdict.kind == CrashLoopVerdict::Kind::give_up) {
+    std::string why = what + (policy.retries == 0 ? std::string(" (crash_loop_retries = 0)")
+                                                  : ", also after " + std::to_string(policy.retries) + " retr" +
+                                                        (policy.retries == 1 ? "y" : "ies") + " after a back-off") +
+                      "; not resuming again";
+    json problem = crash_loop_problem(why, look + "; start a new run when fixed");
+    problem["step"] = record.step;
+    json summary{{"measurements", store_.measurement_summary(record.run_id)}};
+    store_.finish_execution(record, ExecutionStatus::finished_error, record.step, summary, problem, why);
+    log::error("executions", record.id + ": " + why);
+    notify("failed", record, why, problem);
+    return;
+  }
+  const auto retry_at = std::chrono::system_clock::now() +
+                        std::chrono::duration_cast<std::chrono::system_clock::duration>(
+                            std::chrono::duration<double>(verdict.backoff_s));
+  std::string why = "crash loop: " + what + "; colorlabd retries it by itself after " +
+                    std::to_string(static_cast<long>(std::ceil(verdict.backoff_s))) + " s (retry " +
+                    std::to_string(verdict.round) + " of " + std::to_string(policy.retries) + ")";
+  json problem = crash_loop_problem(why, look + "; `colorlab resume` retries at once, `colorlab abort` gives the run up");
+  problem["step"] = record.step;
+  json suspension{{"category", kCrashLoopCategory},
+                  {"problem", problem},
+                  {"step", record.step},
+                  {"restarts", attempts},
+                  {"retry", verdict.round},
+                  {"retries", policy.retries},
+                  {"backoff_s", verdict.backoff_s},
+                  {"retry_at", iso8601_utc(retry_at)}};
+  store_.set_execution_status(record, ExecutionStatus::suspended, why, json{{"suspended", true}, {"problem", problem}},
+                              suspension);
+  log::error("executions", record.id + ": " + why);
+  notify("crash-loop", record, why, problem, suspension);
+  arm_backoff(record.id, verdict.backoff_s);
+}
+
+void Executions::arm_backoff(const std::string& id, double seconds) {
+  cancel_backoff(id);
+  auto timer = std::make_shared<asio::steady_timer>(io_);
+  timer->expires_after(std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(seconds)));
+  backoffs_[id] = timer;
+  timer->async_wait([this, id, timer](boost::system::error_code ec) {
+    if (ec) return;  // cancelled: resumed, aborted or shutting down
+    if (auto it = backoffs_.find(id); it != backoffs_.end() && it->second == timer) backoffs_.erase(it);
+    if (shutting_down_ || active_.count(id)) return;
+    auto record = store_.execution(id);
+    // Only what the guard itself suspended: an operator may have resumed or aborted it meanwhile.
+    if (!record || record->status != ExecutionStatus::suspended || !is_crash_loop(record->suspension)) return;
+    const int retry = record->suspension.value("retry", 0);
+    log::info("executions", id + ": the crash-loop back-off is over; retrying step '" + record->step + "'");
+    try {
+      relaunch(*record, false, json{{"by", "back-off"}, {"retry", retry}});
+    } catch (const Error& e) {
+      log::error("executions", id + ": cannot resume: " + e.what());
+      json problem = problem_json(e, nullptr);
+      std::string why = std::string("cannot resume: ") + e.what();
+      store_.finish_execution(*record, ExecutionStatus::finished_error, record->step, nullptr, problem, why);
+      notify("failed", *record, why, problem);
+    }
+  });
+}
+
+void Executions::cancel_backoff(const std::string& id) {
+  if (auto it = backoffs_.find(id); it != backoffs_.end()) {
+    it->second->cancel();
+    backoffs_.erase(it);
+  }
+}
+
+void Executions::notify(const std::string& event, const store::ExecutionRecord& record, const std::string& reason,
+                        const json& problem, const json& suspension) {
+  if (!options_.notifier) return;
+  json details{{"execution_id", record.id}, {"run_id", record.run_id}, {"campaign", record.campaign},
+               {"step", record.step},       {"reason", reason},        {"problem", problem}};
+  if (event == "failed") details["status"] = protocol::to_string(ExecutionStatus::finished_error);
+  else details["status"] = protocol::to_string(ExecutionStatus::suspended);
+  if (problem.is_object() && problem.contains("code")) details["category"] = problem["code"];
+  if (suspension.is_object()) {
+    details["suspension"] = suspension;
+    details["category"] = suspension.value("category", std::string());
+  }
+  options_.notifier->notify(event, details);
+}
+
 // A run continues with the exact text and parameters it started with, never an edited file.
-void Executions::relaunch(const store::ExecutionRecord& record, bool accept_units) {
+void Executions::relaunch(const store::ExecutionRecord& record, bool accept_units, json resumed_by) {
   auto source = store_.script_source(record.script_sha256);
   if (!source) throw Error(ErrorClass::not_found, "the run's script " + record.script_sha256 + " is missing from the store");
   auto script = std::make_shared<campaigns::CampaignScript>(campaigns::parse_campaign_script(record.campaign, *source));
   script->origin = "stored";
   auto run = store_.run(record.run_id);
-  launch(record, script, run ? run->params : json::object(), true, accept_units);
+  launch(record, script, run ? run->params : json::object(), true, accept_units, std::move(resumed_by));
 }
 
 void Executions::launch(store::ExecutionRecord record, std::shared_ptr<const campaigns::CampaignScript> script,
-                        json params, bool resumed, bool accept_units) {
+                        json params, bool resumed, bool accept_units, json resumed_by) {
   auto active = std::make_shared<Active>();
   active->record = record;
   active->control.execution_id = record.id;
   active_[record.id] = active;
   asio::co_spawn(
       io_,
-      [this, active, script, params, resumed, accept_units]() -> asio::awaitable<void> {
+      [this, active, script, params, resumed, accept_units, resumed_by]() -> asio::awaitable<void> {
         auto& record = active->record;
         campaigns::RunOutcome outcome;
+        bool storage_suspended = false;
         try {
+          json how = resumed ? json{{"resumed", true}} : json(nullptr);
+          if (resumed && resumed_by.is_object()) how["resumed_by"] = resumed_by;
           store_.set_execution_status(record, ExecutionStatus::running, resumed ? "resumed from step '" + record.step + "'" : "",
-                                      resumed ? json{{"resumed", true}} : json(nullptr));
+                                      how);
           campaigns::ScriptRunSetup setup;
           setup.script = script;
           setup.params = params;
@@ -270,7 +383,9 @@ void Executions::launch(store::ExecutionRecord record, std::shared_ptr<const cam
             setup.verify_serials = !accept_units;
           }
           StoreSink sink(store_, record, instruments_, status_text_, snapshot, resumed && accept_units, active->suspension,
-                         lab_.time_scale());
+                         lab_.time_scale(), [this, &record](const std::string& reason, const json& problem, const json& doc) {
+                           notify("suspended", record, reason, problem, doc);
+                         });
           outcome = co_await campaigns::run_campaign_script(std::move(setup), lab_, sink, active->control);
         } catch (const Error& e) {
           outcome.kind = campaigns::RunOutcome::Kind::failed;
@@ -278,6 +393,7 @@ void Executions::launch(store::ExecutionRecord record, std::shared_ptr<const cam
           if (e.cls() == ErrorClass::io_error) {
             outcome.kind = campaigns::RunOutcome::Kind::suspended;
             outcome.reason = std::string("storage: ") + e.what();
+            storage_suspended = true;
           }
         } catch (const std::exception& e) {
           outcome.kind = campaigns::RunOutcome::Kind::failed;
@@ -299,9 +415,11 @@ void Executions::launch(store::ExecutionRecord record, std::shared_ptr<const cam
             case Kind::failed: {
               json summary{{"measurements", store_.measurement_summary(record.run_id)}};
               Error e = outcome.error ? *outcome.error : Error(ErrorClass::internal, "unknown failure");
-              store_.finish_execution(record, ExecutionStatus::finished_error, step, summary,
-                                      problem_json(e, outcome.script_location), e.what());
+              json problem = problem_json(e, outcome.script_location);
+              store_.finish_execution(record, ExecutionStatus::finished_error, step, summary, problem, e.what());
               log::warning("executions", record.id + " failed: " + e.what());
+              record.step = step;
+              notify("failed", record, e.what(), problem);
               break;
             }
             case Kind::aborted: {
@@ -312,9 +430,15 @@ void Executions::launch(store::ExecutionRecord record, std::shared_ptr<const cam
             case Kind::paused:
               store_.set_execution_status(record, ExecutionStatus::paused, outcome.reason);
               break;
-            case Kind::suspended:
-              store_.set_execution_status(record, ExecutionStatus::suspended, outcome.reason);
+            case Kind::suspended: {
+              // A shutdown's suspension ends with the next start; the disk's is the operator's business.
+              json problem = storage_suspended && outcome.error ? protocol::problem_from_error(*outcome.error).to_json() : json(nullptr);
+              json document{{"category", storage_suspended ? "storage" : "shutdown"}};
+              if (!problem.is_null()) document["problem"] = problem;
+              store_.set_execution_status(record, ExecutionStatus::suspended, outcome.reason, nullptr, document);
+              if (storage_suspended) notify("suspended", record, outcome.reason, problem, document);
               break;
+            }
           }
         } catch (const Error& e) {
           // The disk failed at the very end: what was committed stays committed; a restart resumes it.
@@ -368,7 +492,10 @@ store::ExecutionRecord Executions::resume(const std::string& id) {
                                           ", not paused", "only a paused or suspended execution can be resumed");
   }
   if (shutting_down_) throw Error(ErrorClass::conflict, "colorlabd is shutting down");
-  relaunch(record, record.status == ExecutionStatus::paused);
+  const bool crash_loop = is_crash_loop(record.suspension);
+  cancel_backoff(id);
+  relaunch(record, record.status == ExecutionStatus::paused,
+           crash_loop ? json{{"by", "a client"}, {"retry", record.suspension.value("retry", 0)}} : json(nullptr));
   return require(id);
 }
 
@@ -385,6 +512,7 @@ store::ExecutionRecord Executions::abort(const std::string& id) {
     throw Error(ErrorClass::conflict, "execution " + id + " has already ended (" +
                                           std::string(protocol::to_string(record.status)) + ")");
   }
+  cancel_backoff(id);
   json summary{{"measurements", store_.measurement_summary(record.run_id)}};
   store_.finish_execution(record, ExecutionStatus::aborted, record.step, summary, nullptr, "aborted by a client");
   return require(id);
@@ -393,6 +521,9 @@ store::ExecutionRecord Executions::abort(const std::string& id) {
 void Executions::shutdown(std::function<void()> done) {
   shutting_down_ = true;
   on_all_stopped_ = std::move(done);
+  // A back-off under way stays in the store (retry_at): the next daemon waits out what is left of it.
+  for (auto& [id, timer] : backoffs_) timer->cancel();
+  backoffs_.clear();
   for (auto& [id, active] : active_) {
     if (active->control.request != Request::abort) {
       active->control.request = Request::shutdown;

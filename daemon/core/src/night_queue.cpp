@@ -353,6 +353,9 @@ json NightQueue::describe(unsigned history_limit) {
     if (item.state == QueueItemState::running && current.is_null()) {
       auto execution = item.execution_id ? store_.execution(*item.execution_id) : std::nullopt;
       j["execution_status"] = execution ? json(protocol::to_string(execution->status)) : json(nullptr);
+      // What holds the queue: a suspended run says why and, from the crash-loop guard, until when.
+      if (execution && !execution->reason.empty()) j["execution_reason"] = execution->reason;
+      if (execution && !execution->suspension.is_null()) j["execution_suspension"] = execution->suspension;
       current = j;
     }
     items.push_back(j);

@@ -75,13 +75,7 @@ HttpResponse HttpResponse::json(int status, const nlohmann::json& body) {
 
 HttpResponse HttpResponse::problem(int status, const std::string& code, const std::string& title,
                                    const std::string& detail, const std::string& hint) {
-  protocol::Problem p;
-  p.status = status;
-  p.code = code;
-  p.title = title;
-  p.detail = detail;
-  p.hint = hint;
-  p.category = protocol::category_for_status(status);
+  const auto p = protocol::problem_for_status(status, code, title, detail, hint);
   HttpResponse r;
   r.status = status;
   r.content_type = std::string(protocol::kContentProblem);

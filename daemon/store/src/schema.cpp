@@ -176,6 +176,12 @@ CREATE TABLE queue_groups (
   created_at  TEXT NOT NULL
 );
 )sql",
+    // 6 -> 7: why a suspended execution waits, as JSON ({category, problem, ...}; the crash-loop guard adds its
+    // back-off: attempt, retries, backoff_s, retry_at), so a restarted daemon keeps the guard's schedule and
+    // every client sees the cause. NULL whenever the execution is not suspended.
+    R"sql(
+ALTER TABLE executions ADD COLUMN suspension TEXT;
+)sql",
 };
 
 int read_pragma_int(Database& db, const char* pragma) {

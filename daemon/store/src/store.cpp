@@ -24,7 +24,7 @@ std::string dump_or_empty(const nlohmann::json& j) { return j.is_null() ? std::s
 
 constexpr const char* kExecutionColumns =
     "id, run_id, campaign, status, progress, step, created_at, updated_at, error, reason, resume_attempts, "
-    "steps_committed, script_sha256, random_seed";
+    "steps_committed, script_sha256, random_seed, suspension";
 
 }  // namespace
 
@@ -34,6 +34,7 @@ nlohmann::json ExecutionRecord::to_json() const {
                    {"step", step},     {"created_at", created_at}, {"updated_at", updated_at}};
   if (!error.is_null()) j["error"] = error;
   j["reason"] = reason;
+  if (!suspension.is_null()) j["suspension"] = suspension;
   j["resume_attempts"] = resume_attempts;
   j["steps_committed"] = steps_committed;
   if (!script_sha256.empty()) j["script_sha256"] = script_sha256;
@@ -218,26 +219,31 @@ void Store::finish_execution(const ExecutionRecord& execution, ExecutionStatus s
   double progress = execution.progress;
   if (auto current = this->execution(execution.id)) progress = current->progress;
   update_execution(execution.id, status, status == ExecutionStatus::finished_ok ? 1.0 : progress, step, error);
-  db_.prepare("UPDATE executions SET reason = ?2 WHERE id = ?1")
+  db_.prepare("UPDATE executions SET reason = ?2, suspension = NULL WHERE id = ?1")
       .bind(1, std::string_view(execution.id))
       .bind(2, std::string_view(reason))
       .run();
-  append_event("execution", {{"execution_id", execution.id},
-                             {"run_id", execution.run_id},
-                             {"status", protocol::to_string(status)},
-                             {"reason", reason}});
+  nlohmann::json event{{"execution_id", execution.id},
+                       {"run_id", execution.run_id},
+                       {"status", protocol::to_string(status)},
+                       {"reason", reason}};
+  // The console shows why a run ended as it happens, not only after reading it again.
+  if (!error.is_null()) event["error"] = error;
+  append_event("execution", event);
   tx.commit();
 }
 
 void Store::set_execution_status(const ExecutionRecord& execution, ExecutionStatus status, const std::string& reason,
-                                 const nlohmann::json& event_extra) {
+                                 const nlohmann::json& event_extra, const nlohmann::json& suspension) {
   Transaction tx(db_);
   std::string now = now_iso8601();
-  db_.prepare("UPDATE executions SET status = ?2, reason = ?3, updated_at = ?4 WHERE id = ?1")
+  const bool suspended = status == ExecutionStatus::suspended && !suspension.is_null();
+  db_.prepare("UPDATE executions SET status = ?2, reason = ?3, updated_at = ?4, suspension = ?5 WHERE id = ?1")
       .bind(1, std::string_view(execution.id))
       .bind(2, protocol::to_string(status))
       .bind(3, std::string_view(reason))
       .bind(4, std::string_view(now))
+      .bind(5, suspended ? std::optional<std::string>(suspension.dump()) : std::optional<std::string>())
       .run();
   db_.prepare("UPDATE runs SET status = ?2, started_at = COALESCE(started_at, ?3) WHERE id = ?1")
       .bind(1, std::string_view(execution.run_id))
@@ -248,6 +254,7 @@ void Store::set_execution_status(const ExecutionRecord& execution, ExecutionStat
                        {"run_id", execution.run_id},
                        {"status", protocol::to_string(status)},
                        {"reason", reason}};
+  if (suspended) event["suspension"] = suspension;
   if (event_extra.is_object()) event.update(event_extra);
   append_event("execution", event);
   tx.commit();
@@ -407,6 +414,7 @@ ExecutionRecord Store::read_execution(Statement& st) {
   e.steps_committed = st.int64(11);
   if (!st.is_null(12)) e.script_sha256 = st.text(12);
   e.random_seed = static_cast<std::uint64_t>(st.int64(13));
+  if (!st.is_null(14)) e.suspension = parse_json_column(st.text(14));
   return e;
 }
 

@@ -4,6 +4,7 @@ import { get, post } from "../api.js";
 import { h, replace, badge, fmtDuration, fmtNumber, short, errorBox } from "../dom.js";
 import { lineChart } from "../chart.js";
 import { isTerminal, LIMITS } from "../store.js";
+import { suspensionSummary } from "../suspension.js";
 
 export function mount(section, ctx) {
   const requestsBox = h("div", { id: "requests" });
@@ -80,10 +81,20 @@ export function mount(section, ctx) {
         h("dt", {}, "step"), h("dd", { class: "step" }, e.step || "—"),
         h("dt", {}, "ETA"), h("dd", {}, isTerminal(e.status) ? "ended" : e.status === "paused" || e.status === "suspended"
           ? `on hold (${e.status})` : eta === null ? "estimating…" : fmtDuration(eta)),
+        e.status === "suspended" && e.suspension
+          ? [h("dt", {}, "waiting out"), h("dd", { class: "suspension-line" }, suspensionSummary(e.suspension, ctx.store.serverNow()))] : null,
         e.reason ? [h("dt", {}, e.status === "suspended" ? "suspended because" : "reason"), h("dd", { class: "reason" }, e.reason)] : null,
         e.problem ? [h("dt", {}, "problem"), h("dd", {}, e.problem.detail || e.problem.title || "",
           e.problem.hint ? h("span", { class: "hint" }, ` — ${e.problem.hint}`) : null)] : null),
+      e.status === "suspended" || e.status === "paused" ? h("div", { class: "buttons" },
+        h("button", { type: "button", class: "control resume", dataset: { focus: `now-resume-${e.id}` }, disabled: !ctx.access.control,
+                      onclick: () => resume(e) }, "Resume now")) : null,
       e.run_id ? h("a", { href: `#runs/${e.run_id}` }, "open run") : null);
+  }
+
+  async function resume(e) {
+    try { await post(`/v1/executions/${e.id}/resume`); ctx.toast("resume: sent"); }
+    catch (err) { ctx.toast(`resume: ${err.message}`, true); ctx.accessChanged(err); }
   }
 
   function renderRunning() {

@@ -5,6 +5,7 @@ import { get, post, del } from "../api.js";
 import { h, replace, badge, errorBox, fmtDuration, fmtBytes, short } from "../dom.js";
 import { paramForm, readParams } from "../params.js";
 import { isTerminal } from "../store.js";
+import { suspensionSummary } from "../suspension.js";
 
 function dryRunReport(r) {
   const est = r.estimate || {};
@@ -119,10 +120,11 @@ export function mount(section, ctx) {
       h("span", { class: "progress-text" }, `${Math.round((e.progress || 0) * 100)} %`),
       e.step ? h("span", { class: "muted" }, e.step) : null,
       e.reason ? h("span", { class: "reason" }, e.reason) : null,
+      e.status === "suspended" && e.suspension ? suspensionSummary(e.suspension, ctx.store.serverNow()) : null,
       running ? h("span", { class: "buttons" },
         h("button", { type: "button", class: "control", dataset: { focus: `pause-${e.id}` }, disabled: !can || e.status === "paused",
                       onclick: () => control(`/v1/executions/${e.id}/pause`, "pause") }, "Pause"),
-        h("button", { type: "button", class: "control", dataset: { focus: `resume-${e.id}` }, disabled: !can || e.status !== "paused",
+        h("button", { type: "button", class: "control", dataset: { focus: `resume-${e.id}` }, disabled: !can || (e.status !== "paused" && e.status !== "suspended"),
                       onclick: () => control(`/v1/executions/${e.id}/resume`, "resume") }, "Resume"),
         h("button", { type: "button", class: "control danger", dataset: { focus: `abort-${e.id}` }, disabled: !can,
                       onclick: () => { if (confirm(`Abort ${e.campaign || e.id}?`)) control(`/v1/executions/${e.id}/abort`, "abort"); } }, "Abort"))
@@ -146,6 +148,9 @@ export function mount(section, ctx) {
     replace(queueBox,
       h("p", {}, "state ", badge(q.state), q.halted ? [" ", badge("halted")] : null, q.reason ? ` — ${q.reason}` : "",
         q.waiting_for ? ` — waiting for execution ${short(q.waiting_for.id || q.waiting_for)}` : ""),
+      // The running item's execution on hold: the queue waits for it (or for its on_failure once it ends).
+      q.current && q.current.execution_suspension ? h("p", { class: "held" }, `item ${q.current.campaign} is suspended: `,
+        suspensionSummary(q.current.execution_suspension, ctx.store.serverNow())) : null,
       h("div", { class: "buttons" },
         h("button", { type: "button", class: "control", id: "queue-start", disabled: !can || q.state === "running",
                       onclick: async () => { await control("/v1/queue/start", "start queue"); refreshQueue(); } }, "Start queue"),

@@ -34,4 +34,8 @@ Problem problem_from_error(const Error& e);
 // take the request now: 503 busy, too many connections).
 ProblemCategory category_for_status(int status);
 
+// A problem answered by status alone, its category from category_for_status: the one way the HTTP
+// server and the API build such an answer.
+Problem problem_for_status(int status, std::string code, std::string title, std::string detail, std::string hint);
+
 }  // namespace colorlab::protocol

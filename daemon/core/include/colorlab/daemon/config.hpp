@@ -21,7 +21,13 @@ struct SimulatorConfig {
 // [campaigns]: where the lab's own scripts live, and how executions survive restarts.
 struct CampaignConfig {
   std::optional<std::filesystem::path> directory;  // default: <state_dir>/campaigns
-  int max_resume_attempts = 3;       // restarts in a row without a committed step before giving up
+  int max_resume_attempts = 3;       // restarts in a row without a committed step before the crash-loop guard trips
+  // The guard suspends the execution and retries it itself after a back-off that doubles from
+  // crash_loop_backoff_s up to crash_loop_backoff_max_s (the daemon's own seconds, not lab seconds), at
+  // most crash_loop_retries times; a crash after the last retry ends the run (its queue item's on_failure).
+  double crash_loop_backoff_s = 60;
+  double crash_loop_backoff_max_s = 1800;
+  int crash_loop_retries = 6;
   bool lamps_off_at_shutdown = false;
   double lamp_warmup_s = 900;        // after relighting on resume, when there is no luminance meter
   double stable_tolerance_pct = 0.5; // lamp stability on resume: drift over the window (LS-110)
@@ -39,6 +45,15 @@ struct CampaignConfig {
 // [queue]: the night's queue (docs/campaigns.md, "A night's queue").
 struct QueueConfig {
   bool autostart = false;  // start the queue with the daemon (unless a failed item halted it)
+};
+
+// [notify]: who hears of a suspension, a crash loop or a failed run (docs/configuration.md, "Notifications").
+struct NotifyConfig {
+  std::vector<std::string> command;  // argv, run without a shell; the notification's JSON on its stdin
+  std::string webhook;               // http:// or https:// URL the JSON is POSTed to
+  double timeout_s = 10;             // per delivery: a command still running then is killed
+  std::vector<std::string> events = {"suspended", "crash-loop", "failed"};
+  bool enabled() const { return !command.empty() || !webhook.empty(); }
 };
 
 // [access]: who may do what over the API (docs/API.md, "Access"), TLS for a listener beyond
@@ -74,6 +89,7 @@ struct DaemonConfig {
   SimulatorConfig simulator;
   CampaignConfig campaigns;
   QueueConfig queue;
+  NotifyConfig notify;
   ApiConfig api;
   BlobConfig blobs;
   AccessConfig access;

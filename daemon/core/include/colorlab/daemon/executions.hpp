@@ -2,9 +2,9 @@
 // Campaign executions (SiLA's observable commands): a POST validates the parameters against the
 // script's declaration, stores the run with the script's exact text, and returns at once; the
 // script runs as a coroutine on the daemon's executor through the campaign engine. Executions
-// left unfinished by a crash, a power cut or a shutdown are resumed at start-up by replay, up to
-// a bounded number of attempts in a row without progress. Pause, resume and abort land at the
-// engine's next safe point.
+// left unfinished by a crash, a power cut or a shutdown are resumed at start-up by replay; one whose
+// step keeps killing the daemon is suspended by the crash-loop guard (crash_loop.hpp) and retried
+// after a bounded back-off. Pause, resume and abort land at the engine's next safe point.
 #include <filesystem>
 #include <functional>
 #include <map>
@@ -13,18 +13,23 @@
 #include <string>
 
 #include <boost/asio/io_context.hpp>
+#include <boost/asio/steady_timer.hpp>
 #include <nlohmann/json.hpp>
 
 #include "colorlab/campaigns/catalogue.hpp"
 #include "colorlab/campaigns/control.hpp"
 #include "colorlab/campaigns/lab.hpp"
+#include "colorlab/daemon/crash_loop.hpp"
 #include "colorlab/store/store.hpp"
 
 namespace colorlab::daemon {
 
+class Notifier;
+
 struct ExecutionOptions {
-  int max_resume_attempts = 3;
+  CrashLoopPolicy crash_loop;       // includes max_resume_attempts
   std::filesystem::path state_dir;  // where runs are stored (a dry run checks its free space)
+  Notifier* notifier = nullptr;     // told of suspensions, crash loops and failures; none: nobody is
 };
 
 class Executions {
@@ -41,7 +46,8 @@ class Executions {
   // disk, operator actions and the estimated duration from this lab's learned call timings.
   // Throws Error{bad_parameter|not_found} for an unknown campaign or invalid parameters.
   nlohmann::json dry_run(const std::string& campaign, const nlohmann::json& params);
-  // At start-up: every execution a previous process left running or suspended continues.
+  // At start-up: every execution a previous process left running or suspended continues, except one
+  // the crash-loop guard suspends (or, its retries spent, ends) and one waiting out the guard's back-off.
   void resume_unfinished();
   store::ExecutionRecord pause(const std::string& id);
   store::ExecutionRecord resume(const std::string& id);
@@ -57,8 +63,15 @@ class Executions {
  private:
   struct Active;
   void launch(store::ExecutionRecord record, std::shared_ptr<const campaigns::CampaignScript> script,
-              nlohmann::json params, bool resumed, bool accept_units = false);
-  void relaunch(const store::ExecutionRecord& record, bool accept_units);
+              nlohmann::json params, bool resumed, bool accept_units = false, nlohmann::json resumed_by = nullptr);
+  void relaunch(const store::ExecutionRecord& record, bool accept_units, nlohmann::json resumed_by = nullptr);
+  // The guard has tripped for this execution after `attempts` resumes in a row without a commit.
+  void crash_loop(const store::ExecutionRecord& record, int attempts);
+  // Retries a crash-loop suspension by itself once `seconds` have passed (unless resumed or aborted first).
+  void arm_backoff(const std::string& id, double seconds);
+  void cancel_backoff(const std::string& id);
+  void notify(const std::string& event, const store::ExecutionRecord& record, const std::string& reason,
+              const nlohmann::json& problem, const nlohmann::json& suspension = nullptr);
   store::ExecutionRecord require(const std::string& id);
   void maybe_done();
 
@@ -70,6 +83,7 @@ class Executions {
   ExecutionOptions options_;
   std::function<void(const std::string&)> status_text_;
   std::map<std::string, std::shared_ptr<Active>> active_;
+  std::map<std::string, std::shared_ptr<boost::asio::steady_timer>> backoffs_;  // crash-loop suspensions waiting
   std::function<void()> on_all_stopped_;
   bool shutting_down_ = false;
 };

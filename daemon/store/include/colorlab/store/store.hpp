@@ -41,6 +41,8 @@ struct ExecutionRecord {
   std::string updated_at;
   nlohmann::json error;  // problem, or null
   std::string reason;    // why it is paused, suspended, aborted or ended
+  // While suspended: {category, problem, ...} (the crash-loop guard adds its back-off); null otherwise.
+  nlohmann::json suspension;
   int resume_attempts = 0;
   std::int64_t steps_committed = 0;
   std::string script_sha256;
@@ -184,8 +186,10 @@ class Store {
   void finish_execution(const ExecutionRecord& execution, protocol::ExecutionStatus status, const std::string& step,
                         const nlohmann::json& summary, const nlohmann::json& error, const std::string& reason = {});
   // paused / suspended / running again, with the run's status and an event, in one transaction.
+  // `suspension` (why it waits, see ExecutionRecord) is stored with a suspended status, cleared otherwise,
+  // and given in the event.
   void set_execution_status(const ExecutionRecord& execution, protocol::ExecutionStatus status, const std::string& reason,
-                            const nlohmann::json& event_extra = nullptr);
+                            const nlohmann::json& event_extra = nullptr, const nlohmann::json& suspension = nullptr);
   // A restart is about to resume this execution: counts the attempt (reset by the next committed
   // step) and returns how many resumes in a row have not committed a step.
   int begin_resume(const std::string& execution_id);
