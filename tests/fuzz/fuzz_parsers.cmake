@@ -15,8 +15,7 @@ function(colorlab_fuzz_parser target name)
   if(name STREQUAL "spectrolino_wire" OR name STREQUAL "dmx_wire")
     list(APPEND libs colorlab::wire_protocols)
   elseif(name STREQUAL "ls110_reply")
-    list(APPEND sources ${s}/drivers/ls110/src/ls110_protocol.cpp)
-    list(APPEND includes ${s}/drivers/ls110/include)
+    list(APPEND libs colorlab::wire_protocols)
   elseif(name STREQUAL "cgats" OR name STREQUAL "csv")
     list(APPEND sources ${s}/analysis/src/cgats.cpp ${s}/analysis/src/csv.cpp ${s}/analysis/src/csv_write.cpp)
     list(APPEND includes ${s}/analysis/include)
@@ -46,10 +45,10 @@ function(colorlab_fuzz_parser target name)
     list(APPEND includes ${s}/campaigns/include ${s}/drivers/core/include ${s}/analysis/include)
     list(APPEND libs colorlab::analysis PkgConfig::LUA OpenSSL::Crypto nlohmann_json::nlohmann_json)
   elseif(name STREQUAL "hid_socket")
-    list(APPEND sources ${s}/drivers/lamps/src/socket_hid_transport.cpp ${s}/drivers/lamps/src/hid_relay_protocol.cpp
+    list(APPEND sources ${s}/drivers/lamps/src/socket_hid_transport.cpp
          ${s}/drivers/core/src/unix_line_client.cpp)
     list(APPEND includes ${s}/drivers/lamps/include ${s}/drivers/core/include)
-    list(APPEND libs nlohmann_json::nlohmann_json Threads::Threads)
+    list(APPEND libs colorlab::wire_protocols nlohmann_json::nlohmann_json Threads::Threads)
   elseif(name STREQUAL "simdslr_socket")
     # The driver with the Camera base class it derives from (worker thread, the capture pipeline's
     # LibRaw decoder, the gphoto2 driver's shutter labels and raw file names).

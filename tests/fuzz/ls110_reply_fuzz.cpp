@@ -3,7 +3,7 @@
 // averaged as a reading — and an error reply's code must have a meaning in the table.
 #include <cmath>
 
-#include "colorlab/drivers/ls110_protocol.hpp"
+#include "colorlab/wire/ls110_protocol.hpp"
 #include "fuzz_support.hpp"
 
 namespace {
@@ -11,10 +11,10 @@ namespace {
 using colorlab::fuzz::typed;
 
 void one_input(const std::uint8_t* data, std::size_t size) {
-  colorlab::ls110::Reply reply;
-  if (!typed("parse_reply", [&] { reply = colorlab::ls110::parse_reply(colorlab::fuzz::as_text(data, size)); })) return;
+  colorlab::wire::ls110::Reply reply;
+  if (!typed("parse_reply", [&] { reply = colorlab::wire::ls110::parse_reply(colorlab::fuzz::as_text(data, size)); })) return;
   if (!reply.ok) {
-    auto code = colorlab::ls110::lookup_error(reply.error_code);
+    auto code = colorlab::wire::ls110::lookup_error(reply.error_code);
     if (code.meaning.empty()) {
       std::fprintf(stderr, "fuzz: LS-110 error code '%s' has no meaning\n", reply.error_code.c_str());
       std::abort();

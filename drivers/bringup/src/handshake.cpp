@@ -4,7 +4,7 @@
 
 #include "colorlab/core/error.hpp"
 #include "colorlab/drivers/ls110.hpp"
-#include "colorlab/drivers/ls110_protocol.hpp"
+#include "colorlab/wire/ls110_protocol.hpp"
 #include "colorlab/drivers/serial_link.hpp"
 #include "colorlab/drivers/spectrolino_link.hpp"
 #include "colorlab/wire/enttec_dmx_protocol.hpp"
@@ -41,7 +41,7 @@ std::vector<Step> steps_for(const std::string& kind) {
     return {{kind, s, std::string(f.begin(), f.end()), 400ms, "dmx @115200 8N1 (label 10)"}};
   }
   if (kind == "ls110") {
-    return {{kind, drivers::Ls110::serial_settings(), ls110::command_set_mode(4), 1500ms, "ls110 @4800 7E2 (MDS,04)"}};
+    return {{kind, drivers::Ls110::serial_settings(), wire::ls110::command_set_mode(4), 1500ms, "ls110 @4800 7E2 (MDS,04)"}};
   }
   if (kind == "spectrolino") {
     std::vector<Step> out;
@@ -91,7 +91,7 @@ Heard recognise_ls110(std::string_view b) {
     auto at = std::min(line.find("OK"), line.find("ER"));
     if (at == std::string::npos || line.size() < at + 6 || line.substr(line.size() - 2) != "\r\n") continue;
     try {
-      auto reply = ls110::parse_reply(std::string_view(line).substr(at));
+      auto reply = wire::ls110::parse_reply(std::string_view(line).substr(at));
       return {"ls110", reply.ok ? "OK" + reply.status : reply.error_code, 0};
     } catch (const Error&) {
     }

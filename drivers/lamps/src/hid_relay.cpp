@@ -1,7 +1,7 @@
 #include "colorlab/drivers/hid_relay.hpp"
 
 #include "colorlab/core/log.hpp"
-#include "colorlab/drivers/hid_relay_protocol.hpp"
+#include "colorlab/wire/hid_relay_protocol.hpp"
 
 namespace colorlab::drivers {
 
@@ -25,7 +25,7 @@ void HidRelay::fail(const Error& e) {
 }
 
 std::uint8_t HidRelay::read_mask() {
-  auto s = hidrelay::parse_state(transport_->get_feature_report(0, hidrelay::kReportDataBytes));
+  auto s = wire::hidrelay::parse_state(transport_->get_feature_report(0, wire::hidrelay::kReportDataBytes));
   mask_ = s.mask;
   return mask_;
 }
@@ -35,9 +35,9 @@ asio::awaitable<void> HidRelay::connect() {
   try {
     transport_->open();
     auto info = transport_->info();
-    relay_count_ = hidrelay::relay_count_from_product(info.product);
+    relay_count_ = wire::hidrelay::relay_count_from_product(info.product);
     product_ = info.product;
-    auto s = hidrelay::parse_state(transport_->get_feature_report(0, hidrelay::kReportDataBytes));
+    auto s = wire::hidrelay::parse_state(transport_->get_feature_report(0, wire::hidrelay::kReportDataBytes));
     if (!options_.expected_board_id.empty() && s.id != options_.expected_board_id) {
       throw Error(ErrorClass::protocol_error,
                   "relay board id is '" + s.id + "', configured '" + options_.expected_board_id + "'",
@@ -68,7 +68,7 @@ void HidRelay::disconnect() {
 void HidRelay::switch_verified(int relay, bool on) {
   const std::uint8_t bit = static_cast<std::uint8_t>(1u << (relay - 1));
   for (int attempt = 1; attempt <= options_.switch_attempts; ++attempt) {
-    transport_->send_feature_report(hidrelay::switch_one(relay, on));
+    transport_->send_feature_report(wire::hidrelay::switch_one(relay, on));
     if (((read_mask() & bit) != 0) == on) return;
     log::warning("hidrelay", options_.id + ": relay " + std::to_string(relay) + " did not switch " + (on ? "on" : "off") +
                                  " (attempt " + std::to_string(attempt) + ")");

@@ -5,7 +5,7 @@
 #include <boost/asio/use_awaitable.hpp>
 
 #include "colorlab/core/log.hpp"
-#include "colorlab/drivers/ls110_protocol.hpp"
+#include "colorlab/wire/ls110_protocol.hpp"
 
 namespace colorlab::drivers {
 
@@ -48,7 +48,7 @@ asio::awaitable<std::string> Ls110::transact(const std::string& command) {
     link_.discard_input();
     try {
       co_await link_.write(command, options_.reply_timeout);
-      std::string line = co_await link_.read_until(ls110::kTerminator, options_.reply_timeout);
+      std::string line = co_await link_.read_until(wire::ls110::kTerminator, options_.reply_timeout);
       co_return line;
     } catch (const Error& e) {
       if (e.cls() != ErrorClass::timeout) throw;
@@ -68,15 +68,15 @@ asio::awaitable<std::string> Ls110::transact(const std::string& command) {
 asio::awaitable<std::string> Ls110::transact_expecting(const std::string& command, bool with_value) {
   std::string line = co_await transact(command);
   for (int late = 0; late < 2; ++late) {
-    ls110::Reply reply;
+    wire::ls110::Reply reply;
     try {
-      reply = ls110::parse_reply(line);
+      reply = wire::ls110::parse_reply(line);
     } catch (const Error&) {
       co_return line;  // garbled: the caller decides
     }
     if (!reply.ok || reply.value.has_value() == with_value) co_return line;
     log::debug("ls110", "discarding a late reply to an earlier command: " + line.substr(0, line.size() - 2));
-    line = co_await link_.read_until(ls110::kTerminator, options_.reply_timeout);
+    line = co_await link_.read_until(wire::ls110::kTerminator, options_.reply_timeout);
   }
   co_return line;
 }
@@ -86,10 +86,10 @@ asio::awaitable<void> Ls110::connect() {
   try {
     link_.open(serial_settings());
     // Absolute mode; any OK proves the meter is there and in remote mode.
-    std::string line = co_await transact_expecting(ls110::command_set_mode(4), false);
-    auto reply = ls110::parse_reply(line);
+    std::string line = co_await transact_expecting(wire::ls110::command_set_mode(4), false);
+    auto reply = wire::ls110::parse_reply(line);
     if (!reply.ok) {
-      auto code = ls110::lookup_error(reply.error_code);
+      auto code = wire::ls110::lookup_error(reply.error_code);
       throw link_.make_error(code.cls, "LS-110 refused MDS,04: " + code.meaning, code.hint, code.code);
     }
     state_ = InstrumentState::ready;
@@ -119,16 +119,16 @@ asio::awaitable<LuminanceReading> Ls110::measure_luminance() {
   state_ = InstrumentState::busy;
   try {
     for (int attempt = 1;; ++attempt) {
-      std::string line = co_await transact_expecting(ls110::command_measure(), true);
-      ls110::Reply reply;
+      std::string line = co_await transact_expecting(wire::ls110::command_measure(), true);
+      wire::ls110::Reply reply;
       try {
-        reply = ls110::parse_reply(line);
+        reply = wire::ls110::parse_reply(line);
       } catch (const Error& e) {
         if (attempt < options_.attempts) continue;  // garbled line: measure again
         throw link_.make_error(e.cls(), e.info().message, e.hint());
       }
       if (!reply.ok) {
-        auto code = ls110::lookup_error(reply.error_code);
+        auto code = wire::ls110::lookup_error(reply.error_code);
         throw link_.make_error(code.cls, "LS-110 " + code.code + ": " + code.meaning, code.hint, code.code);
       }
       if (!reply.value) throw link_.make_error(ErrorClass::protocol_error, "LS-110 answered MES without a value");

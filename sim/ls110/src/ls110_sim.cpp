@@ -2,7 +2,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "colorlab/drivers/ls110_protocol.hpp"
+#include "colorlab/wire/ls110_protocol.hpp"
 
 namespace colorlab::sim {
 
@@ -81,23 +81,23 @@ void Ls110Sim::handle_line(const std::string& line, std::size_t wire_bytes) {
         std::lock_guard lock(mutex_);
         faults_.error_code.clear();
       }
-      answer(ls110::format_error(f.error_code), kMeasureSeconds, wire_bytes);
+      answer(wire::ls110::format_error(f.error_code), kMeasureSeconds, wire_bytes);
       return;
     }
     Ls110Truth t = truth_();
     std::normal_distribution<double> noise(0.0, t.noise_sigma);
     double value = std::max(0.0, t.luminance + noise(rng_));
     ++readings_;
-    answer(ls110::format_ok(value, 0), kMeasureSeconds, wire_bytes);
+    answer(wire::ls110::format_ok(value, 0), kMeasureSeconds, wire_bytes);
   } else if (line.rfind("MDS", 0) == 0) {
     std::string mode = line.substr(3);
     if (!mode.empty() && mode[0] == ',') mode.erase(0, 1);
     bool valid = mode == "04" || mode == "08" || mode == "09";
-    answer(valid ? "OK00\r\n" : ls110::format_error("ER01"), kCommandSeconds, wire_bytes);
+    answer(valid ? "OK00\r\n" : wire::ls110::format_error("ER01"), kCommandSeconds, wire_bytes);
   } else if (line == "CLE") {
     answer("OK00\r\n", kCommandSeconds, wire_bytes);
   } else {
-    answer(ls110::format_error("ER00"), kCommandSeconds, wire_bytes);
+    answer(wire::ls110::format_error("ER00"), kCommandSeconds, wire_bytes);
   }
 }
 

@@ -1,7 +1,7 @@
 #include "colorlab/sim/relay_board.hpp"
 
 #include "colorlab/core/error.hpp"
-#include "colorlab/drivers/hid_relay_protocol.hpp"
+#include "colorlab/wire/hid_relay_protocol.hpp"
 
 namespace colorlab::sim {
 
@@ -75,7 +75,7 @@ class RelayBoardTransport final : public drivers::HidTransport {
     std::lock_guard lock(s_->mutex);
     check_link();
     ++s_->reads;
-    auto d = hidrelay::encode_state(hidrelay::BoardState{s_->id, s_->mask});
+    auto d = wire::hidrelay::encode_state(wire::hidrelay::BoardState{s_->id, s_->mask});
     d.resize(data_length, 0);
     return d;
   }

@@ -7,7 +7,7 @@
 
 #include "colorlab/core/error.hpp"
 #include "colorlab/drivers/hid_relay.hpp"
-#include "colorlab/drivers/hid_relay_protocol.hpp"
+#include "colorlab/wire/hid_relay_protocol.hpp"
 #include "colorlab/sim/relay_board.hpp"
 #include "run_support.hpp"
 
@@ -38,19 +38,19 @@ class HidRelayTest : public ::testing::Test {
 };
 
 TEST(HidRelayProtocol, ReportsMatchTheBoardsDocumentedBytes) {
-  EXPECT_EQ(hidrelay::switch_one(3, true), on(3));
-  EXPECT_EQ(hidrelay::switch_one(8, false), off(8));
-  EXPECT_EQ(hidrelay::switch_all(true), (Report{0, 0xFE, 0, 0, 0, 0, 0, 0, 0}));
-  EXPECT_EQ(hidrelay::switch_all(false), (Report{0, 0xFC, 0, 0, 0, 0, 0, 0, 0}));
-  EXPECT_EQ(hidrelay::set_board_id("ABCDE"), (Report{0, 0xFA, 'A', 'B', 'C', 'D', 'E', 0, 0}));
-  auto s = hidrelay::parse_state({'Q', 'W', 'E', 'R', 'T', 0, 0, 0x05});
+  EXPECT_EQ(wire::hidrelay::switch_one(3, true), on(3));
+  EXPECT_EQ(wire::hidrelay::switch_one(8, false), off(8));
+  EXPECT_EQ(wire::hidrelay::switch_all(true), (Report{0, 0xFE, 0, 0, 0, 0, 0, 0, 0}));
+  EXPECT_EQ(wire::hidrelay::switch_all(false), (Report{0, 0xFC, 0, 0, 0, 0, 0, 0, 0}));
+  EXPECT_EQ(wire::hidrelay::set_board_id("ABCDE"), (Report{0, 0xFA, 'A', 'B', 'C', 'D', 'E', 0, 0}));
+  auto s = wire::hidrelay::parse_state({'Q', 'W', 'E', 'R', 'T', 0, 0, 0x05});
   EXPECT_EQ(s.id, "QWERT");
   EXPECT_EQ(s.mask, 0x05);
-  EXPECT_THROW(hidrelay::parse_state({'Q', 'W', 'E', 'R', 'T', 'Y', 0, 0}), Error);
-  EXPECT_THROW(hidrelay::parse_state({'Q', 'W'}), Error);
-  EXPECT_THROW(hidrelay::switch_one(9, true), Error);
-  EXPECT_EQ(hidrelay::relay_count_from_product("USBRelay2"), 2);
-  EXPECT_THROW(hidrelay::relay_count_from_product("HIDRelay"), Error);
+  EXPECT_THROW(wire::hidrelay::parse_state({'Q', 'W', 'E', 'R', 'T', 'Y', 0, 0}), Error);
+  EXPECT_THROW(wire::hidrelay::parse_state({'Q', 'W'}), Error);
+  EXPECT_THROW(wire::hidrelay::switch_one(9, true), Error);
+  EXPECT_EQ(wire::hidrelay::relay_count_from_product("USBRelay2"), 2);
+  EXPECT_THROW(wire::hidrelay::relay_count_from_product("HIDRelay"), Error);
 }
 
 TEST_F(HidRelayTest, ConnectReadsIdAndState) {

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "colorlab/drivers/hid_transport.hpp"
+#include "colorlab/wire/hid_transport.hpp"
 #include "colorlab/drivers/port_enumeration.hpp"
 
 namespace colorlab::drivers {

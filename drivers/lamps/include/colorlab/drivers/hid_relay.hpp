@@ -9,7 +9,7 @@
 
 #include <boost/asio/any_io_executor.hpp>
 
-#include "colorlab/drivers/hid_transport.hpp"
+#include "colorlab/wire/hid_transport.hpp"
 #include "colorlab/drivers/lab_capabilities.hpp"
 #include "colorlab/drivers/lamp_map.hpp"
 #include "colorlab/drivers/reconnect.hpp"

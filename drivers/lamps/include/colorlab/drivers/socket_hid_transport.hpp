@@ -10,7 +10,7 @@
 
 #include <nlohmann/json_fwd.hpp>
 
-#include "colorlab/drivers/hid_transport.hpp"
+#include "colorlab/wire/hid_transport.hpp"
 
 namespace colorlab::drivers {
 

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "colorlab/drivers/hid_transport.hpp"
+#include "colorlab/wire/hid_transport.hpp"
 
 namespace colorlab::sim {
 

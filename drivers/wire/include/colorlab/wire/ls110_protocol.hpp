@@ -7,7 +7,7 @@
 
 #include "colorlab/core/error.hpp"
 
-namespace colorlab::ls110 {
+namespace colorlab::wire::ls110 {
 
 inline constexpr std::string_view kTerminator = "\r\n";
 
@@ -36,4 +36,4 @@ Reply parse_reply(std::string_view line);
 std::string format_ok(double value, int status = 0);
 std::string format_error(std::string_view code);
 
-}  // namespace colorlab::ls110
+}  // namespace colorlab::wire::ls110

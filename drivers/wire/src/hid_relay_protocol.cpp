@@ -1,8 +1,8 @@
-#include "colorlab/drivers/hid_relay_protocol.hpp"
+#include "colorlab/wire/hid_relay_protocol.hpp"
 
 #include "colorlab/core/error.hpp"
 
-namespace colorlab::hidrelay {
+namespace colorlab::wire::hidrelay {
 
 std::vector<std::uint8_t> switch_one(int relay, bool on) {
   if (relay < 1 || relay > 8) throw Error(ErrorClass::bad_parameter, "relay number " + std::to_string(relay) + " is outside 1..8");
@@ -59,4 +59,4 @@ int relay_count_from_product(std::string_view product) {
   return product.back() - '0';
 }
 
-}  // namespace colorlab::hidrelay
+}  // namespace colorlab::wire::hidrelay

@@ -1,7 +1,8 @@
 #pragma once
 // The few HID operations the relay board needs, behind an interface: the production side is
 // hidapi (hidapi_transport.hpp); tests use the scripted board in sim/relay, because no virtual HID
-// device can be created on the build machines.
+// device can be created on the build machines. It lives in drivers/wire/ so that board can implement it
+// without sim/ depending on the lamps driver; it stays in colorlab::drivers, the namespace its users speak.
 #include <cstdint>
 #include <string>
 #include <vector>

@@ -7,7 +7,7 @@
 #include <string_view>
 #include <vector>
 
-namespace colorlab::hidrelay {
+namespace colorlab::wire::hidrelay {
 
 inline constexpr std::size_t kReportDataBytes = 8;
 
@@ -26,4 +26,4 @@ std::vector<std::uint8_t> encode_state(const BoardState& state);
 // "USBRelay2" → 2; throws Error{unsupported} for other products.
 int relay_count_from_product(std::string_view product);
 
-}  // namespace colorlab::hidrelay
+}  // namespace colorlab::wire::hidrelay

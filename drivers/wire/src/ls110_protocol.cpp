@@ -1,4 +1,4 @@
-#include "colorlab/drivers/ls110_protocol.hpp"
+#include "colorlab/wire/ls110_protocol.hpp"
 
 #include <cctype>
 #include <charconv>
@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 
-namespace colorlab::ls110 {
+namespace colorlab::wire::ls110 {
 
 std::string command_measure() { return "MES\r\n"; }
 
@@ -87,4 +87,4 @@ std::string format_ok(double value, int status) {
 
 std::string format_error(std::string_view code) { return std::string(code) + "\r\n"; }
 
-}  // namespace colorlab::ls110
+}  // namespace colorlab::wire::ls110
