@@ -1,5 +1,6 @@
 #include "commands.hpp"
 
+#include <cctype>
 #include <chrono>
 #include <set>
 #include <iostream>
@@ -19,6 +20,23 @@ namespace colorlab::cli {
 using nlohmann::json;
 
 namespace {
+
+// A query parameter's value, percent-encoded except RFC 3986's unreserved characters and the comma
+// that separates a list of statuses.
+std::string query_value(const std::string& v) {
+  static const char* hex = "0123456789ABCDEF";
+  std::string out;
+  for (unsigned char c : v) {
+    if (std::isalnum(c) || c == '-' || c == '_' || c == '.' || c == '~' || c == ',') {
+      out += static_cast<char>(c);
+    } else {
+      out += '%';
+      out += hex[c >> 4];
+      out += hex[c & 15];
+    }
+  }
+  return out;
+}
 
 struct RunOptions {
   std::string campaign;
@@ -120,6 +138,23 @@ void add_daemon_commands(CLI::App& app, GlobalOptions& global) {
     std::string target = "/v1/runs?limit=" + std::to_string(*limit);
     if (!cursor->empty()) target += "&cursor=" + *cursor;
     print(global, make_client(global).get(target), format_runs);
+  });
+
+  auto exec_limit = std::make_shared<unsigned>(20);
+  auto exec_cursor = std::make_shared<std::string>();
+  auto exec_status = std::make_shared<std::string>();
+  auto exec_campaign = std::make_shared<std::string>();
+  auto* executions = app.add_subcommand("executions", "List executions, newest first (what ran, and how it ended)");
+  executions->add_option("--status", *exec_status, "only these statuses, comma-separated (e.g. running,suspended)");
+  executions->add_option("--campaign", *exec_campaign, "only this campaign");
+  executions->add_option("--limit", *exec_limit, "executions per page (1..300)");
+  executions->add_option("--cursor", *exec_cursor, "continue from a previous page");
+  executions->callback([&global, exec_limit, exec_cursor, exec_status, exec_campaign] {
+    std::string target = "/v1/executions?limit=" + std::to_string(*exec_limit);
+    if (!exec_cursor->empty()) target += "&cursor=" + query_value(*exec_cursor);
+    if (!exec_status->empty()) target += "&status=" + query_value(*exec_status);
+    if (!exec_campaign->empty()) target += "&campaign=" + query_value(*exec_campaign);
+    print(global, make_client(global).get(target), format_executions);
   });
 
   // Pause, resume and abort land at the campaign's next safe point (the step before is committed).

@@ -99,6 +99,22 @@ std::string format_runs(const json& page) {
   return o.str();
 }
 
+std::string format_executions(const json& page) {
+  std::ostringstream o;
+  if (page["items"].empty()) return "no executions\n";
+  for (const auto& e : page["items"]) {
+    o << str(e, "id") << "  " << str(e, "campaign") << "  " << str(e, "status") << "  " << str(e, "created_at")
+      << "  run " << str(e, "run_id");
+    if (!str(e, "reason").empty()) o << "  (" << str(e, "reason") << ")";
+    o << "\n";
+  }
+  // The filters are the caller's to repeat: the cursor alone continues the same listing only with them.
+  if (page.contains("next_cursor") && !page["next_cursor"].is_null()) {
+    o << "more: --cursor " << page["next_cursor"].get<std::string>() << " (with the same filters)\n";
+  }
+  return o.str();
+}
+
 std::string format_run(const json& r) {
   std::ostringstream o;
   o << "run " << str(r, "id") << "\n"

@@ -10,6 +10,7 @@ std::string format_status(const nlohmann::json& root);
 std::string format_instruments(const nlohmann::json& list);
 std::string format_campaigns(const nlohmann::json& list);
 std::string format_runs(const nlohmann::json& page);
+std::string format_executions(const nlohmann::json& page);
 std::string format_run(const nlohmann::json& run);
 std::string format_execution(const nlohmann::json& execution);
 std::string format_dry_run(const nlohmann::json& report);

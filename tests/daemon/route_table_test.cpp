@@ -165,7 +165,7 @@ TEST(RouteTable, HeadIsServedByTheGetRowAndTheEventStreamByAccept) {
 TEST(RouteTable, StoredDataIsServedOnThePoolAndLiveStateOnTheMainThread) {
   for (const char* target : {"/v1/runs", "/v1/runs/r1", "/v1/runs/r1/measurements", "/v1/runs/r1/export",
                              "/v1/runs/r1/blobs", "/v1/runs/r1/script", "/v1/blobs/abc", "/v1/blobs/abc/preview.png",
-                             "/v1/events", "/index.html"}) {
+                             "/v1/events", "/v1/executions", "/index.html"}) {
     EXPECT_EQ(route_request(request("GET", target)).placement(), Placement::pool) << target;
   }
   EXPECT_EQ(route_request(request("POST", "/v1/blobs/abc/locate-chart")).placement(), Placement::pool);

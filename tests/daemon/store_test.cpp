@@ -1,5 +1,6 @@
 // The store's promises: forward-only migrations, refusal of newer or foreign files, durable
 // measurements, unfinished scripted runs kept for resume (legacy ones finalised) at open, whole steps, idempotent execution creation, keyset paging.
+#include <algorithm>
 #include <cmath>
 #include <gtest/gtest.h>
 #include <sqlite3.h>
@@ -355,4 +356,61 @@ TEST(Store, ASuspensionIsStoredWhileSuspendedAndClearedAfter) {
   ASSERT_TRUE(migrated.execution(id).has_value());
   EXPECT_EQ(migrated.execution(id)->status, ExecutionStatus::finished_error);
   EXPECT_TRUE(migrated.execution(id)->suspension.is_null());
+}
+
+// GET /v1/executions: newest first, keyset pages, filtered by any of several statuses and by campaign.
+TEST(Store, ExecutionsPageNewestFirstFilteredByStatusesAndCampaign) {
+  using colorlab::protocol::ExecutionStatus;
+  TempDir dir;
+  Store store(dir / "colorlab.db");
+  std::vector<std::string> all, spot_ended;
+  for (int i = 0; i < 8; ++i) {
+    auto run = luminance_run();
+    if (i % 4 == 0) run.campaign = "frame-average";
+    auto id = store.create_execution(run).execution.id;
+    all.push_back(id);
+    if (i % 4 != 0 && i % 2 == 1) {
+      store.update_execution(id, ExecutionStatus::aborted, 0.5, "reading 2");
+      spot_ended.push_back(id);
+    } else if (i % 4 != 0) {
+      store.update_execution(id, ExecutionStatus::finished_ok, 1, "done");
+      spot_ended.push_back(id);
+    }
+  }
+  auto collect = [&](const colorlab::store::ExecutionFilter& f, unsigned limit) {
+    std::vector<std::string> ids;
+    std::optional<std::string> cursor;
+    int pages = 0;
+    do {
+      auto page = store.executions(limit, cursor, f);
+      EXPECT_LE(page.items.size(), limit);
+      for (const auto& e : page.items) {
+        if (!f.campaign.empty()) {
+          EXPECT_EQ(e.campaign, f.campaign);
+        }
+        if (!f.statuses.empty()) {
+          EXPECT_NE(std::find(f.statuses.begin(), f.statuses.end(), e.status), f.statuses.end());
+        }
+        ids.push_back(e.id);
+      }
+      cursor = page.next_cursor;
+      if (++pages > 20) break;  // a cursor that never ends the listing
+    } while (cursor);
+    return ids;
+  };
+  std::reverse(all.begin(), all.end());
+  std::reverse(spot_ended.begin(), spot_ended.end());
+  EXPECT_EQ(collect({}, 3), all);  // 3 pages of 3, 3, 2: each once, newest first
+  EXPECT_EQ(collect({}, 8), all);  // exactly one page: no cursor to an empty page
+  EXPECT_EQ(collect({{}, "frame-average"}, 1).size(), 2u);
+  EXPECT_EQ(collect({{ExecutionStatus::aborted, ExecutionStatus::finished_ok}, "luminance-spot"}, 2), spot_ended);
+  EXPECT_EQ(collect({{ExecutionStatus::aborted}, ""}, 2).size(), 4u);
+  EXPECT_EQ(collect({{ExecutionStatus::waiting}, ""}, 5).size(), 2u);  // the frame-average ones, never started
+  EXPECT_TRUE(collect({{ExecutionStatus::running}, ""}, 5).empty());
+  EXPECT_TRUE(collect({{}, "no-such-campaign"}, 5).empty());
+  auto exact = store.executions(8, std::nullopt);
+  EXPECT_FALSE(exact.next_cursor);
+  ASSERT_EQ(exact.items.size(), 8u);
+  EXPECT_EQ(exact.items.front().to_json(), store.execution(all.front())->to_json());
+  EXPECT_THROW(store.executions(3, std::string("abc")), Error);
 }

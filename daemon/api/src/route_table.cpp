@@ -24,6 +24,7 @@ constexpr Route kRoutes[] = {
     {"GET",    "/v1/events",                           read,    pool,    r::get_events},
     {"GET",    "/v1/events/stream",                    read,    main,    r::get_event_stream},
     {"POST",   "/v1/executions",                       control, main,    r::post_execution},
+    {"GET",    "/v1/executions",                       read,    pool,    r::get_executions},
     {"GET",    "/v1/executions/{id}",                  read,    main,    r::get_execution},
     {"POST",   "/v1/executions/{id}/pause",            control, main,    r::post_execution_pause},
     {"POST",   "/v1/executions/{id}/resume",           control, main,    r::post_execution_resume},

@@ -595,18 +595,26 @@ std::int64_t Store::last_event_seq() {
   return st.step() ? st.int64(0) : 0;
 }
 
-RunPage Store::runs(unsigned limit, const std::optional<std::string>& cursor, const RunFilter& filter) {
-  std::int64_t before = INT64_MAX;
-  if (cursor) {
-    try {
-      std::size_t used = 0;
-      before = std::stoll(*cursor, &used);
-      if (used != cursor->size() || before <= 0) throw std::invalid_argument("cursor");
-    } catch (const std::exception&) {
-      throw Error(ErrorClass::bad_parameter, "cursor '" + *cursor + "' is not a cursor this server issued",
-                  "use links.next from the previous page");
-    }
+namespace {
+
+// A list's cursor: the seq (or rowid) the next page continues below.
+std::int64_t cursor_before(const std::optional<std::string>& cursor) {
+  if (!cursor) return INT64_MAX;
+  try {
+    std::size_t used = 0;
+    std::int64_t before = std::stoll(*cursor, &used);
+    if (used != cursor->size() || before <= 0) throw std::invalid_argument("cursor");
+    return before;
+  } catch (const std::exception&) {
+    throw Error(ErrorClass::bad_parameter, "cursor '" + *cursor + "' is not a cursor this server issued",
+                "use links.next from the previous page");
   }
+}
+
+}  // namespace
+
+RunPage Store::runs(unsigned limit, const std::optional<std::string>& cursor, const RunFilter& filter) {
+  std::int64_t before = cursor_before(cursor);
   // Keyset paging: the cost of a page does not grow with how far back it is.
   auto st = db_.prepare(std::string("SELECT ") + kRunColumns +
                         " FROM runs WHERE seq < ?1 AND (?3 = '' OR campaign = ?3) AND (?4 = '' OR status = ?4)"
@@ -620,6 +628,35 @@ RunPage Store::runs(unsigned limit, const std::optional<std::string>& cursor, co
   if (page.runs.size() > limit) {
     page.runs.pop_back();
     page.next_cursor = std::to_string(page.runs.back().seq);
+  }
+  return page;
+}
+
+ExecutionPage Store::executions(unsigned limit, const std::optional<std::string>& cursor, const ExecutionFilter& filter) {
+  std::int64_t before = cursor_before(cursor);
+  // The rowid is the table's insertion order (nothing here ever VACUUMs or reuses it): keyset paging
+  // on the table's own b-tree, so a page costs the same however far back it is.
+  std::string sql = std::string("SELECT ") + kExecutionColumns +
+                    ", rowid FROM executions WHERE rowid < ?1 AND (?3 = '' OR campaign = ?3)";
+  if (!filter.statuses.empty()) {
+    sql += " AND status IN (";
+    for (std::size_t i = 0; i < filter.statuses.size(); ++i) sql += (i ? ", ?" : "?") + std::to_string(4 + i);
+    sql += ")";
+  }
+  sql += " ORDER BY rowid DESC LIMIT ?2";
+  auto st = db_.prepare(sql);
+  st.bind(1, before).bind(2, static_cast<std::int64_t>(limit) + 1).bind(3, std::string_view(filter.campaign));
+  for (std::size_t i = 0; i < filter.statuses.size(); ++i)
+    st.bind(static_cast<int>(4 + i), protocol::to_string(filter.statuses[i]));
+  ExecutionPage page;
+  std::vector<std::int64_t> rowids;
+  while (st.step()) {
+    page.items.push_back(read_execution(st));
+    rowids.push_back(st.int64(15));
+  }
+  if (page.items.size() > limit) {
+    page.items.pop_back();
+    page.next_cursor = std::to_string(rowids[limit - 1]);
   }
   return page;
 }

@@ -2,7 +2,7 @@
 // first, and steer what is running. Every control button is a real <button>, disabled while the key lacks
 // the control scope.
 import { get, post, del } from "../api.js";
-import { h, replace, badge, errorBox, fmtDuration, fmtBytes, short } from "../dom.js";
+import { h, replace, badge, errorBox, fmtDuration, fmtBytes, fmtTime, short } from "../dom.js";
 import { paramForm, readParams } from "../params.js";
 import { isTerminal } from "../store.js";
 import { suspensionSummary } from "../suspension.js";
@@ -41,10 +41,12 @@ export function mount(section, ctx) {
     h("div", { class: "buttons" }, btnDry, btnStart, btnEnqueue), result);
   const executions = h("div", { id: "executions" });
   const queueBox = h("div", { id: "queue" });
+  const recentBox = h("div", { id: "recent-executions" });
   section.append(h("h2", {}, "Queue"),
     h("section", { class: "panel" }, h("h3", {}, "Start a campaign"), form),
     h("section", { class: "panel" }, h("h3", {}, "Executions"), executions),
-    h("section", { class: "panel" }, h("h3", {}, "The night's queue"), queueBox));
+    h("section", { class: "panel" }, h("h3", {}, "The night's queue"), queueBox),
+    h("section", { class: "panel" }, h("h3", {}, "Recent executions"), recentBox));
 
   let campaigns = [];
   const current = () => campaigns.find(c => c.name === select.value);
@@ -181,6 +183,22 @@ export function mount(section, ctx) {
     refreshQueue();
   }
 
+  // From the store (GET /v1/executions), so what ran before this page opened is listed too. "ended" is the
+  // last change of a terminal execution.
+  const RECENT = 20;
+  async function refreshRecent() {
+    try {
+      const r = await get(`/v1/executions?limit=${RECENT}`);
+      replace(recentBox, r.items.length ? h("table", { class: "executions" },
+        h("thead", {}, h("tr", {}, ["campaign", "status", "started", "ended", "run"].map(c => h("th", { scope: "col" }, c)))),
+        h("tbody", {}, r.items.map(e => h("tr", { dataset: { execution: e.id } },
+          h("td", {}, e.campaign), h("td", {}, badge(e.status)), h("td", {}, fmtTime(e.created_at)),
+          h("td", {}, isTerminal(e.status) ? fmtTime(e.updated_at) : "—"),
+          h("td", {}, h("a", { href: `#runs/${e.run_id}`, class: "mono" }, short(e.run_id)))))))
+        : h("p", { class: "muted" }, "No executions stored yet."));
+    } catch (e) { replace(recentBox, errorBox(e)); }
+  }
+
   async function refreshQueue() {
     try { ctx.store.queue = await get("/v1/queue"); ctx.store.queueDirty = false; renderQueue(); }
     catch (e) { replace(queueBox, errorBox(e)); }
@@ -190,12 +208,14 @@ export function mount(section, ctx) {
   // A hidden page does not redraw on every event of a busy night: show() draws it whole.
   let visible = false;
   return {
-    show() { visible = true; loadCampaigns(); refreshQueue(); render(); },
+    show() { visible = true; loadCampaigns(); refreshQueue(); refreshRecent(); render(); },
     hide() { visible = false; },
     update(what) {
       if (!visible) return;
       const t = what.event && what.event.topic;
       if (what.kind === "snapshot" || what.kind === "access" || t === "execution" || t === "progress" || t === "queue") render();
+      // Progress events are many: the stored list is read again only when an execution changes state.
+      if (what.kind === "snapshot" || t === "execution") refreshRecent();
     },
   };
 }

@@ -1,4 +1,5 @@
-// Executions: POST /v1/executions (start or dry run), GET /v1/executions/{id}, and pause, resume, abort.
+// Executions: POST /v1/executions (start or dry run), GET /v1/executions (the list, on the pool),
+// GET /v1/executions/{id}, and pause, resume, abort.
 #include <nlohmann/json.hpp>
 
 #include "colorlab/api/problem.hpp"
@@ -6,6 +7,7 @@
 #include "colorlab/daemon/executions.hpp"
 #include "colorlab/protocol/api.hpp"
 #include "handlers.hpp"
+#include "query.hpp"
 
 namespace colorlab::daemon::routes {
 
@@ -56,6 +58,57 @@ HttpResponse post_execution(ApiContext& ctx, const HttpRequest& req, const PathP
   auto r = HttpResponse::json(202, record.to_json());
   r.headers["Location"] = std::string(protocol::kPrefix) + "/executions/" + record.id;
   return r;
+}
+
+namespace {
+
+// ?status=running,paused: one or several execution statuses, comma-separated.
+std::vector<protocol::ExecutionStatus> status_filter(const std::string& text) {
+  std::vector<protocol::ExecutionStatus> out;
+  std::size_t from = 0;
+  while (from <= text.size()) {
+    std::size_t comma = text.find(',', from);
+    if (comma == std::string::npos) comma = text.size();
+    std::string name = text.substr(from, comma - from);
+    auto s = protocol::execution_status_from_string(name);
+    if (!s)
+      throw Error(ErrorClass::bad_parameter, "status '" + name + "' is not an execution status",
+                  "one or several of waiting, running, paused, suspended, finished_ok, finished_error, aborted, "
+                  "interrupted, comma-separated");
+    out.push_back(*s);
+    from = comma + 1;
+  }
+  return out;
+}
+
+}  // namespace
+
+// Read from the store on the pool: a live suspension the main thread holds but has not stored yet is not
+// shown here (GET /v1/executions/{id} shows it).
+HttpResponse get_executions(ApiContext& ctx, const HttpRequest& req, const PathParams&) {
+  unsigned limit = page_limit(req);
+  std::optional<std::string> cursor;
+  if (auto it = req.query.find("cursor"); it != req.query.end()) cursor = it->second;
+  store::ExecutionFilter filter;
+  std::string status_text;
+  if (auto it = req.query.find("campaign"); it != req.query.end()) filter.campaign = it->second;
+  if (auto it = req.query.find("status"); it != req.query.end()) {
+    status_text = it->second;
+    filter.statuses = status_filter(status_text);
+  }
+  auto page = ctx.reads().executions(limit, cursor, filter);
+  json items = json::array();
+  for (const auto& e : page.items) items.push_back(e.to_json());
+  json next = nullptr;
+  if (page.next_cursor) {
+    std::string link = std::string(protocol::kPrefix) + "/executions?limit=" + std::to_string(limit) + "&cursor=" +
+                       *page.next_cursor;
+    if (!filter.campaign.empty()) link += "&campaign=" + http::percent_encode(filter.campaign);
+    if (!status_text.empty()) link += "&status=" + http::percent_encode(status_text);
+    next = link;
+  }
+  return HttpResponse::json(
+      200, {{"items", items}, {"links", {{"next", next}}}, {"next_cursor", page.next_cursor ? json(*page.next_cursor) : json(nullptr)}});
 }
 
 HttpResponse get_execution(ApiContext& ctx, const HttpRequest&, const PathParams& params) {

@@ -23,6 +23,7 @@ HttpResponse get_event_stream(ApiContext& ctx, const HttpRequest& req, const Pat
 
 // execution_routes.cpp
 HttpResponse post_execution(ApiContext& ctx, const HttpRequest& req, const PathParams& params);
+HttpResponse get_executions(ApiContext& ctx, const HttpRequest& req, const PathParams& params);
 HttpResponse get_execution(ApiContext& ctx, const HttpRequest& req, const PathParams& params);
 HttpResponse post_execution_pause(ApiContext& ctx, const HttpRequest& req, const PathParams& params);
 HttpResponse post_execution_resume(ApiContext& ctx, const HttpRequest& req, const PathParams& params);

@@ -143,6 +143,17 @@ struct RunPage {
   std::optional<std::string> next_cursor;
 };
 
+// Which executions a page of GET /v1/executions holds; empty fields match everything.
+struct ExecutionFilter {
+  std::vector<protocol::ExecutionStatus> statuses;  // any of these
+  std::string campaign;                             // exact name
+};
+
+struct ExecutionPage {
+  std::vector<ExecutionRecord> items;
+  std::optional<std::string> next_cursor;
+};
+
 // Which of a run's measurements a page holds; empty fields match everything.
 struct MeasurementFilter {
   std::string step_prefix;
@@ -222,6 +233,8 @@ class Store {
   std::int64_t last_event_seq();
   // Newest first; `cursor` is the opaque next_cursor of the previous page.
   RunPage runs(unsigned limit, const std::optional<std::string>& cursor, const RunFilter& filter = {});
+  // Newest first (in the order they were created); `cursor` as for runs().
+  ExecutionPage executions(unsigned limit, const std::optional<std::string>& cursor, const ExecutionFilter& filter = {});
 
   std::int64_t append_event(const std::string& topic, const nlohmann::json& payload);
   // Events with seq > after, oldest first (a client resumes from the last seq it saw).
