@@ -196,6 +196,28 @@ json write_record(const fs::path& dir, const bu::Examination& x, const bu::Recor
   return path.string();
 }
 
+// A relay board's transcript: "transport": "hid" tells the replay to play it as a HID device, and
+// "hid" keeps what the transport said of it (the product string sets the relay count).
+json write_relay_record(const fs::path& dir, const json& r, const bu::Recording& rec) {
+  bu::TranscriptFile f;
+  f.header = {{"port", r["where"]},
+              {"transport", "hid"},
+              {"kind", "hidrelay"},
+              {"recorded_utc", utc_stamp("%Y-%m-%dT%H:%M:%SZ")},
+              {"recorded_by", "colorlab doctor " COLORLAB_DOCTOR_VERSION},
+              {"plan", {{"measure", false}}},
+              {"verdict", r["verdict"]},
+              {"hid", r.value("hid", json::object())}};
+  f.events = rec.events();
+  if (r["verdict"] == "identified") f.decoded = {{"board_id", r["board_id"]}, {"relays", r["relays"]}, {"relays_on", r["relays_on"]}};
+  f.expected_note = "unconfirmed: fill \"expected\" (e.g. board_id from the board's own listing) before committing this as a test";
+  fs::create_directories(dir);
+  std::string base = fs::path(r["where"].get<std::string>()).filename().string();
+  auto path = dir / ("hidrelay-" + base + "-identify.jsonl");
+  bu::write_transcript(path, f);
+  return path.string();
+}
+
 int run_doctor(const GlobalOptions& g, const DoctorOptions& o) {
   const auto start = std::chrono::steady_clock::now();
   json report = json::object();
@@ -225,7 +247,13 @@ int run_doctor(const GlobalOptions& g, const DoctorOptions& o) {
   for (const auto& b : drivers::enumerate_relay_boards()) {
     if (std::find(relay_paths.begin(), relay_paths.end(), b.path) == relay_paths.end()) relay_paths.push_back(b.path);
   }
-  for (const auto& r : relay_paths) relays.push_back(bu::identify_relay(r));
+  // Relay boards have no display to confirm and nothing is switched here: their transcripts are
+  // recorded unconfirmed (docs/bring-up.md says how to make one a test).
+  std::vector<std::unique_ptr<bu::Recording>> relay_recordings;
+  for (const auto& r : relay_paths) {
+    relay_recordings.push_back(std::make_unique<bu::Recording>());
+    relays.push_back(bu::identify_relay(r, relay_recordings.back().get()));
+  }
 
   if (!consent && interactive && !g.json) {
     int n = 0;
@@ -278,6 +306,9 @@ int run_doctor(const GlobalOptions& g, const DoctorOptions& o) {
     ports.push_back(j);
   }
   report["ports"] = ports;
+  if (!o.no_record) {
+    for (std::size_t i = 0; i < relays.size(); ++i) relays[i]["transcript"] = write_relay_record(dir, relays[i], *relay_recordings[i]);
+  }
   report["cameras"] = cameras;
   report["relays"] = relays;
   bool all_ok = !disagreement;

@@ -208,6 +208,57 @@ TEST_F(DoctorSimLab, EveryInstrumentAnswersItsOwnHandshakeAndNothingIsMeasuredUn
   EXPECT_NE(d.report["readings"].get<std::string>().find("--measure"), std::string::npos);
 }
 
+// Rewrites a transcript's expected line (the last) with `expected`, as a person committing it would.
+void set_expected(const fs::path& file, const json& expected, const std::string& source) {
+  auto lines = read_lines(file);
+  ASSERT_FALSE(lines.empty());
+  ASSERT_TRUE(lines.back().contains("expected")) << lines.back().dump();
+  lines.back() = {{"expected", expected}, {"source", source}};
+  std::ofstream out(file, std::ios::trunc);
+  for (const auto& l : lines) out << l.dump() << "\n";
+}
+
+// The relay board's HID feature reports land in the transcript like a serial port's bytes: the board
+// id the simulator holds is in the device's answer, and with the simulator's ground truth filled in
+// as its expected value the replay (a HID device played from the file) decodes it, and a wrong
+// expected value fails it.
+TEST_F(DoctorSimLab, TheRelayBoardsFeatureReportsAreRecordedAndReplay) {
+  auto d = doctor({"--relay", ports["hidrelay"], "--record", (dir / "relay").string()});
+  EXPECT_EQ(d.exit_code, 0) << d.report.dump(2) << d.err;
+  ASSERT_EQ(d.report["relays"].size(), 1u);
+  const auto& r = d.report["relays"][0];
+  ASSERT_TRUE(r.contains("transcript")) << r.dump(2);
+  const fs::path file = r["transcript"].get<std::string>();
+  auto lines = read_lines(file);
+  ASSERT_GE(lines.size(), 3u);
+  EXPECT_EQ(lines[0]["transport"], "hid");
+  const auto truth_id = truth()["relay"]["board_id"].get<std::string>();
+  std::string id_hex;
+  for (unsigned char c : truth_id) {
+    static const char* digits = "0123456789abcdef";
+    id_hex += digits[c >> 4];
+    id_hex += digits[c & 15];
+  }
+  bool host = false, id_answered = false;
+  for (const auto& l : lines) {
+    host = host || l.contains("host");
+    if (l.contains("device") && l["device"].get<std::string>().find(id_hex) != std::string::npos) id_answered = true;
+  }
+  EXPECT_TRUE(host) << "no GET_REPORT request recorded";
+  EXPECT_TRUE(id_answered) << "the board id " << truth_id << " (" << id_hex << ") is in no recorded device answer";
+
+  const auto replay = bin_path("../tests/transcript_replay");
+  auto unconfirmed = run_command({replay, file.string()}, std::chrono::seconds(60));
+  EXPECT_EQ(unconfirmed.exit_code, 1) << "an unconfirmed transcript is no test yet";
+  set_expected(file, {{"board_id", {{"value", truth_id}}}}, "simulator ground truth (control channel truth.relay.board_id)");
+  auto ok = run_command({replay, file.string()}, std::chrono::seconds(60));
+  EXPECT_EQ(ok.exit_code, 0) << ok.out << ok.err;
+  set_expected(file, {{"board_id", {{"value", "XXXXX"}}}}, "a wrong value");
+  auto wrong = run_command({replay, file.string()}, std::chrono::seconds(60));
+  EXPECT_EQ(wrong.exit_code, 1) << wrong.out << wrong.err;
+  EXPECT_NE(wrong.err.find("board_id"), std::string::npos) << wrong.err;
+}
+
 TEST_F(DoctorSimLab, APortThatAnswersInAnotherInstrumentsProtocolIsNamedForWhatItIs) {
   auto d = doctor({"--port", ports["ls110"] + "=spectrolino", "--port", ports["dmx"] + "=ls110", "--no-record"});
   EXPECT_EQ(d.exit_code, 3);

@@ -7,6 +7,7 @@
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/use_future.hpp>
 
+#include "colorlab/bringup/hid_recording.hpp"
 #include "colorlab/core/error.hpp"
 #include "colorlab/drivers/hid_relay.hpp"
 #include "colorlab/drivers/hidapi_transport.hpp"
@@ -16,16 +17,22 @@ namespace colorlab::bringup {
 
 using nlohmann::json;
 
-json identify_relay(const std::string& where) {
+json identify_relay(const std::string& where, Recording* recording) {
+  std::unique_ptr<drivers::HidTransport> transport;
+  if (where.rfind("unix:", 0) == 0) {
+    transport = std::make_unique<drivers::SocketHidTransport>(where.substr(5));
+  } else {
+    transport = std::make_unique<drivers::HidapiTransport>(where);
+  }
+  if (recording) transport = std::make_unique<RecordingHidTransport>(std::move(transport), *recording);
+  return identify_relay(std::move(transport), where);
+}
+
+json identify_relay(std::unique_ptr<drivers::HidTransport> transport, const std::string& where) {
   const auto start = std::chrono::steady_clock::now();
   json j{{"where", where}};
+  auto* t = transport.get();
   try {
-    std::unique_ptr<drivers::HidTransport> transport;
-    if (where.rfind("unix:", 0) == 0) {
-      transport = std::make_unique<drivers::SocketHidTransport>(where.substr(5));
-    } else {
-      transport = std::make_unique<drivers::HidapiTransport>(where);
-    }
     boost::asio::io_context io;
     drivers::HidRelayOptions o;
     o.reconnect.max_attempts = 0;
@@ -34,6 +41,9 @@ json identify_relay(const std::string& where) {
     io.run();
     fut.get();
     auto id = relay.identity();
+    const auto info = t->info();
+    j["hid"] = {{"product", info.product}, {"manufacturer", info.manufacturer}, {"serial", info.serial},
+                {"vendor_id", info.vendor_id}, {"product_id", info.product_id}};
     j["verdict"] = "identified";
     j["model"] = id.model;
     j["board_id"] = id.serial;

@@ -3,6 +3,7 @@
 // serial links' transcript taps (the links' own ring buffer keeps only the last lines).
 #include <chrono>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "colorlab/drivers/transcript.hpp"
@@ -28,6 +29,9 @@ class Recording {
   static void detach(drivers::Transcript& transcript) { transcript.set_tap({}); }
   // A phase of the session ("probe ls110", "reading"), for people reading the file.
   void mark(std::string text);
+  // Bytes exchanged by a link that has no Transcript tap (the relay board's HID reports).
+  void host(std::string_view bytes) { add(ByteEvent::Kind::host, bytes); }
+  void device(std::string_view bytes) { add(ByteEvent::Kind::device, bytes); }
 
   const std::vector<ByteEvent>& events() const { return events_; }
   std::size_t bytes_received() const;
