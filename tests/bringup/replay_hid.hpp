@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "colorlab/bringup/recording.hpp"
-#include "colorlab/drivers/hid_transport.hpp"
+#include "colorlab/wire/hid_transport.hpp"
 
 namespace colorlab::test {
 

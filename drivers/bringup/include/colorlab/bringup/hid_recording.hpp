@@ -7,7 +7,7 @@
 #include <memory>
 
 #include "colorlab/bringup/recording.hpp"
-#include "colorlab/drivers/hid_transport.hpp"
+#include "colorlab/wire/hid_transport.hpp"
 
 namespace colorlab::bringup {
 
