@@ -176,7 +176,7 @@ TEST_F(DaemonHttp, EveryWrongMethodIs405WithTheRoutesMethodsInAllow) {
   const std::vector<std::tuple<std::string, std::string, std::string>> cases{
       {"DELETE", "/v1/runs", "GET, HEAD"},
       {"POST", "/v1/runs/r1/export", "GET, HEAD"},
-      {"GET", "/v1/executions", "POST"},
+      {"DELETE", "/v1/executions", "GET, HEAD, POST"},
       {"PUT", "/v1/queue", "GET, HEAD, POST"},
       {"PATCH", "/v1/queue/q1", "GET, HEAD, DELETE"},
       {"GET", "/v1/queue/start", "POST"},
