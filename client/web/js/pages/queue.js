@@ -41,7 +41,7 @@ export function mount(section, ctx) {
     h("div", { class: "buttons" }, btnDry, btnStart, btnEnqueue), result);
   const executions = h("div", { id: "executions" });
   const queueBox = h("div", { id: "queue" });
-  const recentBox = h("div", { id: "recent-executions" });
+  const recentBox = h("div", { id: "recent-executions", class: "table-wrap" });  // scrolls inside itself on a phone
   section.append(h("h2", {}, "Queue"),
     h("section", { class: "panel" }, h("h3", {}, "Start a campaign"), form),
     h("section", { class: "panel" }, h("h3", {}, "Executions"), executions),
