@@ -70,16 +70,7 @@ json snapshot(ApiContext& ctx, std::int64_t last_seq) {
 }  // namespace
 
 HttpResponse get_events(ApiContext& ctx, const HttpRequest& req, const PathParams&) {
-  std::int64_t after = 0;
-  if (auto it = req.query.find("after"); it != req.query.end()) {
-    try {
-      std::size_t used = 0;
-      after = std::stoll(it->second, &used);
-      if (used != it->second.size() || after < 0) throw std::invalid_argument("after");
-    } catch (const std::exception&) {
-      throw Error(ErrorClass::bad_parameter, "after must be a non-negative event sequence number");
-    }
-  }
+  const std::int64_t after = non_negative_query(req, "after", "after must be a non-negative event sequence number");
   std::optional<std::string> topic;
   if (auto it = req.query.find("topic"); it != req.query.end()) topic = it->second;
   auto events = ctx.reads().events(after, page_limit(req), topic);

@@ -69,16 +69,7 @@ HttpResponse get_run_measurements(ApiContext& ctx, const HttpRequest& req, const
   const std::string& id = params["id"];
   auto& reads = ctx.reads();
   unsigned limit = page_limit(req, protocol::kDefaultMeasurementPageLimit, protocol::kMaxMeasurementPageLimit);
-  std::int64_t after = 0;
-  if (auto it = req.query.find("cursor"); it != req.query.end()) {
-    try {
-      std::size_t used = 0;
-      after = std::stoll(it->second, &used);
-      if (used != it->second.size() || after < 0) throw std::invalid_argument("cursor");
-    } catch (const std::exception&) {
-      throw Error(ErrorClass::bad_parameter, "cursor must be the next_cursor of the previous page");
-    }
-  }
+  const std::int64_t after = non_negative_query(req, "cursor", "cursor must be the next_cursor of the previous page");
   store::MeasurementFilter filter;
   auto take = [&req](const char* name, std::string& into) {
     if (auto it = req.query.find(name); it != req.query.end()) into = it->second;
