@@ -58,7 +58,11 @@ void check_listener(const std::string& host, bool tls, bool allow_plaintext) {
 
 Access::Access(store::Store& writer, boost::asio::any_io_executor writer_thread, AccessOptions options,
                ControlLock* control)
-    : writer_(writer), writer_thread_(std::move(writer_thread)), options_(options), control_(control) {
+    : writer_(writer),
+      writer_thread_(std::move(writer_thread)),
+      options_(std::move(options)),
+      control_(control),
+      failures_(options_.key_failures) {
   reload();
 }
 
@@ -106,7 +110,42 @@ HttpResponse unauthorized(const std::string& code, const std::string& detail, bo
   return r;
 }
 
+// The peer's host without its port: the limit is per machine, not per connection.
+std::string host_of(const http::Peer& peer) {
+  auto colon = peer.address.rfind(':');
+  return colon == std::string::npos ? peer.address : peer.address.substr(0, colon);
+}
+
+HttpResponse too_many(const std::string& host, std::chrono::seconds left, const KeyFailureLimit::Options& o) {
+  auto r = problem_response(
+      429, "key-failures", "Too many wrong API keys",
+      host + " sent " + std::to_string(o.max_failures) + " wrong API keys within " + std::to_string(o.window.count()) +
+          " s; every request from it is refused for " + std::to_string(left.count()) + " s more",
+      "wait for Retry-After, then send the right key (colorlab keys list over the daemon's Unix socket shows "
+      "which exist); the Unix socket is never limited",
+      {{"retry_after_s", left.count()}});
+  r.headers["Retry-After"] = std::to_string(left.count());
+  return r;
+}
+
 }  // namespace
+
+std::optional<HttpResponse> Access::limit(const HttpRequest& req, KeyState key) {
+  if (req.peer.transport == Transport::unix_socket) return std::nullopt;
+  auto host = host_of(req.peer);
+  auto now = options_.now();
+  if (auto left = failures_.blocked(host, now)) return too_many(host, *left, failures_.options());
+  if (key == KeyState::malformed || key == KeyState::unknown || key == KeyState::revoked) {
+    if (failures_.failed(host, now)) {
+      // Once per block, and never the key: only how many, from where, for how long.
+      log::warning("access", host + " sent " + std::to_string(failures_.options().max_failures) +
+                                 " wrong API keys within " + std::to_string(failures_.options().window.count()) +
+                                 " s: its requests are refused (429) for " +
+                                 std::to_string(failures_.options().block.count()) + " s");
+    }
+  }
+  return std::nullopt;
+}
 
 Access::Identified Access::identify(const HttpRequest& req) const {
   Identified id;
@@ -174,6 +213,7 @@ std::optional<HttpResponse> Access::check(const HttpRequest& req) {
 
 std::optional<HttpResponse> Access::check(const HttpRequest& req, Scope needed, bool gated) {
   auto [caller, key] = identify(req);
+  if (auto refused = limit(req, key)) return refused;
   switch (key) {
     case KeyState::malformed:
       return unauthorized("key-malformed", "the Authorization header is not \"Bearer <key>\"", true);

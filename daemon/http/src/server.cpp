@@ -8,6 +8,7 @@
 #include <atomic>
 #include <optional>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 #include <boost/asio/co_spawn.hpp>
@@ -316,6 +317,10 @@ asio::awaitable<void> session(Stream stream, Peer peer, std::shared_ptr<Shared> 
     bool head = req.method == "HEAD";
 
     HttpResponse r = co_await safe_handle(*shared, req);
+    if constexpr (std::is_same_v<Stream, TlsStream>) {
+      // A browser that once reached the console over HTTPS never falls back to plain HTTP for a year (RFC 6797).
+      r.headers.try_emplace("Strict-Transport-Security", "max-age=31536000");
+    }
     if (r.stream && !head) {
       co_await write_stream_response(stream, r, version, *shared, ec);
     } else if (r.file) {
@@ -410,6 +415,24 @@ asio::awaitable<void> accept_loop(Acceptor& acceptor, asio::io_context& pool, st
   }
 }
 
+// The TLS policy testssl.sh checks (tests/security/testssl_test.py; docs/configuration.md, "TLS"): TLS 1.2 and
+// 1.3 only; for 1.2 only forward-secret AEAD suites (ECDHE with AES-GCM or ChaCha20-Poly1305), in the server's
+// order, so no client can talk the daemon down to CBC or static RSA; no TLS compression (CRIME) and no
+// renegotiation (a client-driven CPU drain, and CVE-2009-3555's family); no session tickets, whose key would
+// live as long as the process and so undo forward secrecy.
+void harden(SSL_CTX* ctx) {
+  SSL_CTX_set_min_proto_version(ctx, TLS1_2_VERSION);
+  SSL_CTX_set_options(ctx, SSL_OP_CIPHER_SERVER_PREFERENCE | SSL_OP_NO_COMPRESSION | SSL_OP_NO_RENEGOTIATION |
+                               SSL_OP_NO_TICKET);
+  if (SSL_CTX_set_cipher_list(ctx, "ECDHE-ECDSA-AES256-GCM-SHA384:ECDHE-RSA-AES256-GCM-SHA384:"
+                                   "ECDHE-ECDSA-CHACHA20-POLY1305:ECDHE-RSA-CHACHA20-POLY1305:"
+                                   "ECDHE-ECDSA-AES128-GCM-SHA256:ECDHE-RSA-AES128-GCM-SHA256") != 1 ||
+      SSL_CTX_set1_groups_list(ctx, "X25519:P-256:P-384") != 1) {
+    throw Error(ErrorClass::internal, "the TLS library refused colorlabd's cipher policy",
+                "colorlabd needs OpenSSL 1.1.1 or later with ECDHE and AES-GCM");
+  }
+}
+
 std::shared_ptr<ssl::context> make_tls_context(const ServerOptions& o) {
   if (o.tls_certificate.empty() && o.tls_private_key.empty()) return nullptr;
   if (o.tls_certificate.empty() || o.tls_private_key.empty()) {
@@ -419,6 +442,7 @@ std::shared_ptr<ssl::context> make_tls_context(const ServerOptions& o) {
   auto ctx = std::make_shared<ssl::context>(ssl::context::tls_server);
   ctx->set_options(ssl::context::default_workarounds | ssl::context::no_sslv2 | ssl::context::no_sslv3 |
                    ssl::context::no_tlsv1 | ssl::context::no_tlsv1_1 | ssl::context::single_dh_use);
+  harden(ctx->native_handle());
   error_code ec;
   ctx->use_certificate_chain_file(o.tls_certificate.string(), ec);
   if (ec) {

@@ -8,6 +8,7 @@
 // not to ignore. Keys are looked up in an in-memory cache (SHA-256 → id, scope, revoked) that the
 // HTTP pool threads read under a mutex; it is re-read from the store whenever keys change.
 #include <chrono>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -18,6 +19,7 @@
 #include <boost/asio/any_io_executor.hpp>
 #include <boost/asio/io_context.hpp>
 
+#include "colorlab/api/key_failure_limit.hpp"
 #include "colorlab/api/scope.hpp"
 #include "colorlab/daemon/config.hpp"
 #include "colorlab/http/message.hpp"
@@ -43,6 +45,9 @@ struct AccessOptions {
   Scope loopback_scope = Scope::read;
   // last_used_at is written at most this often per key: the writer's commits are precious.
   std::chrono::seconds touch_interval{60};
+  // Wrong keys limited per address (key_failure_limit.hpp); `now` is injectable for tests.
+  KeyFailureLimit::Options key_failures;
+  std::function<KeyFailureLimit::Clock::time_point()> now = [] { return KeyFailureLimit::Clock::now(); };
 };
 
 class ControlLock;
@@ -57,7 +62,8 @@ class Access {
   // Re-reads every key from the store (on the writer's thread). At start and after each change.
   void reload();
 
-  // Every API request, on whatever thread serves it: 401 (no, unknown or revoked key where one is
+  // Every API request, on whatever thread serves it: 429 (the address sent too many wrong keys lately,
+  // whatever it sends now), 401 (no, unknown or revoked key where one is
   // needed), 403 (the scope is too small), 409 (a control request while someone else holds the
   // control lock, when `gated`); nullopt lets the request through. `needed` and `gated` come from
   // the request's row in the route table (router.hpp).
@@ -78,11 +84,13 @@ class Access {
   };
   Identified identify(const http::HttpRequest& req) const;
   void note_use(const std::string& key_id);
+  std::optional<http::HttpResponse> limit(const http::HttpRequest& req, KeyState key);
 
   store::Store& writer_;
   boost::asio::any_io_executor writer_thread_;
   AccessOptions options_;
   ControlLock* control_;
+  KeyFailureLimit failures_;
   mutable std::mutex mutex_;
   std::map<std::string, store::ApiKeyEntry> keys_;  // by secret SHA-256
   std::map<std::string, std::chrono::steady_clock::time_point> touched_;  // key id → last write
