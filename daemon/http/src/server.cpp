@@ -102,6 +102,12 @@ template <class Message>
 void set_common(Message& res, const HttpResponse& r, bool keep_alive, const std::string& server_name) {
   res.set(bhttp::field::server, server_name);
   res.set(bhttp::field::content_type, r.content_type);
+  // Every answer, API or console: no MIME sniffing (a JSON body naming a campaign's hostile string is never
+  // run as a page), the console never framed by another site (clickjacking its Start and Resume buttons), and
+  // no URL of the daemon leaked to another site as a Referer. A handler's own header wins.
+  res.set("X-Content-Type-Options", "nosniff");
+  res.set("X-Frame-Options", "DENY");
+  res.set("Referrer-Policy", "no-referrer");
   for (const auto& [k, v] : r.headers) res.set(k, v);
   res.keep_alive(keep_alive);
 }
