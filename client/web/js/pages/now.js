@@ -162,6 +162,8 @@ export function mount(section, ctx) {
       const t = what.event && what.event.topic;
       if (what.kind === "snapshot" || what.kind === "access" || t === "operator") renderRequests();
       if (what.kind === "snapshot" || t === "execution" || t === "progress") { renderRunning(); fetchReadings(); }
+      // A key given while a run waits suspended must enable its Resume at once, not at the run's next event.
+      else if (what.kind === "access") renderRunning();
     },
   };
 }
