@@ -8,6 +8,7 @@ by colorlabd, and says why. The whole JSON is kept in the build's test-artifacts
 from __future__ import annotations
 
 import json
+import re
 import os
 import shutil
 import subprocess
@@ -27,15 +28,13 @@ SEVERITY = ["DEBUG", "INFO", "OK", "LOW", "MEDIUM", "HIGH", "CRITICAL"]
 # Findings the test's certificate or address cause, not colorlabd. id → why it is not colorlabd's.
 SELF_SIGNED = {
     "cert_chain_of_trust": "the test certificate is self-signed: no CA in testssl's trust stores issued it",
-    "cert_trust": "the same self-signed certificate, named by the loopback IP it was made for",
-    "cert_caIssuers": "a self-signed certificate has no issuer to point at",
     "cert_revocation": "a self-signed test certificate has no CRL or OCSP responder to name",
-    "cert_crlDistributionPoints": "as cert_revocation",
-    "cert_ocspURL": "as cert_revocation",
     "OCSP_stapling": "nothing to staple without an OCSP responder (see cert_revocation)",
     "DNS_CAArecord": "127.0.0.1 has no DNS name, so no CAA record to find",
-    "cert_certificateTransparency": "a self-signed certificate is logged in no CT log",
 }
+# TLS 1.2 suites: forward secrecy (ECDHE) with an AEAD cipher (AES-GCM, RFC 5288/5289; ChaCha20-Poly1305,
+# RFC 7905) — what docs/configuration.md, "TLS", promises; TLS 1.3's suites are all AEAD with (EC)DHE.
+TLS12_OK = re.compile(r"^ECDHE-(ECDSA|RSA)-(AES(128|256)-GCM-SHA(256|384)|CHACHA20-POLY1305)$")
 
 
 def findings(json_file: Path) -> list[dict]:
@@ -94,6 +93,10 @@ class TestsslTest(unittest.TestCase):
         self.assertIn("offered", by_id["TLS1_2"]["finding"])
         self.assertNotIn("not", by_id["TLS1_2"]["finding"])
         self.assertIn("31536000", by_id["HSTS_time"]["finding"], "HSTS for a year")
+        self.assertEqual(by_id["cipher_order"]["severity"], "OK", by_id["cipher_order"])  # the server's order
+        suites = by_id["cipherorder_TLSv1_2"]["finding"].split()
+        self.assertTrue(suites, "no TLS 1.2 suite listed")
+        self.assertEqual([c for c in suites if not TLS12_OK.match(c)], [], "TLS 1.2 suites without ECDHE + AEAD")
 
 
 if __name__ == "__main__":
