@@ -134,7 +134,9 @@ class HostileScript(unittest.TestCase):
         self.assertEqual(done["status"], "finished_ok", done)
         run_id = done["run_id"]
 
-        self.open("queue", [NAME])
+        # A client's own text too: a queue item (not started) whose parameter is hostile, listed on Queue.
+        conn.post("/v1/queue", {"campaign": NAME, "params": {"label": HOSTILE[1], "level": 3}})
+        self.open("queue", [NAME, HOSTILE[1]])
         self.open("lab", [])
         self.open("runs", [NAME])
         self.open(f"runs/{run_id}", [NAME, HOSTILE[0], HOSTILE[1], HOSTILE[2]])
