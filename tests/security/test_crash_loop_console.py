@@ -99,6 +99,11 @@ class CrashLoopInTheConsole(unittest.TestCase):
         resumed = [ev["payload"] for ev in daemon.client.conn.get("/v1/events?topic=execution&limit=300")["items"]
                    if ev["payload"].get("execution_id") == e["id"] and ev["payload"].get("resumed_by")]
         self.assertTrue(resumed and resumed[-1]["resumed_by"] != "back-off", f"resumed by the page: {resumed}")
+        # The key rode in headers only: no URL the page fetched holds it (issue 27, "keys never in URLs").
+        urls = driver.execute_script("return performance.getEntriesByType('resource').map(e => e.name)"
+                                     ".concat([location.href])")
+        self.assertTrue(any("/v1/" in u for u in urls), urls)
+        self.assertEqual([u for u in urls if key[4:16] in u], [], "the key in a URL")
         daemon.client.conn.post(f"/v1/executions/{e['id']}/abort", {})
         daemon.wait_terminal(e["id"], timeout=60)
         # The daemon restarted under the page: its stream dropped and came back.
