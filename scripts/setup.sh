@@ -32,6 +32,8 @@ packages=(
   libclang-rt-14-dev
   # the Debian package (docs/packaging.md): cpack's dpkg-shlibdeps, lintian, and mmdebstrap's throwaway chroot
   dpkg-dev binutils lintian mmdebstrap debian-archive-keyring
+  # the house's tools (scripts/format.sh, scripts/tidy.sh; docs/TESTING.md)
+  clang-format clang-tidy
 )
 
 missing=()
