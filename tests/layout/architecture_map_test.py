@@ -6,7 +6,8 @@
 - the newcomer's types: each is declared (class, struct or function) in a project header;
 - invariant 4, threads and locks: every daemon class that owns a std::thread or a std::mutex is named there, and the
   number of mutexes it states is the number the code has;
-- every check an invariant cites exists: each `ctest -R` alternative matches a defined test, each Suite.Name a TEST."""
+- every check an invariant cites exists: each `ctest -R` alternative matches a defined test, each Suite.Name a TEST;
+- README.md's "Layout" line names existing folders, and every top-level folder that builds something."""
 from __future__ import annotations
 
 import fnmatch
@@ -150,6 +151,18 @@ class ArchitectureMap(unittest.TestCase):
             if not any(g == f"{suite}.{case}" or g.startswith(f"{suite}.{case}") for g in gtests):
                 missing.append(f"{suite}.{case}")
         self.assertEqual(missing, [], "docs/ARCHITECTURE.md cites checks that do not exist")
+
+    def test_the_readmes_layout_line_names_the_top_level_folders(self):
+        readme = (SOURCE / "README.md").read_text()
+        m = re.search(r"^## Layout\n(.*?)(?=^## |\Z)", readme, re.M | re.S)
+        self.assertIsNotNone(m, "README.md has no '## Layout' section")
+        named = {f.rstrip("/") for f in re.findall(r"`([a-z][\w-]*/)`", m.group(1))}
+        missing = sorted(f for f in named if not (SOURCE / f).is_dir())
+        building = {p.relative_to(SOURCE).parts[0] for p in cmake_files()
+                    if len(p.relative_to(SOURCE).parts) > 1 and p.relative_to(SOURCE).parts[0] != "cmake"}
+        unnamed = sorted(building - named)
+        self.assertEqual((missing, unnamed), ([], []),
+                         "README.md's Layout line: (folders that do not exist, top-level folders it does not name)")
 
 
 if __name__ == "__main__":
