@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """Issue 24: docs/ARCHITECTURE.md against the code, so the map cannot drift without a test noticing.
 
-- the code map's table: every folder it names exists, every target it names is defined by a CMake file, and every
-  library or program the project defines (outside tests/ and bench/) lives in a folder the table names;
+- the code map's table: every folder it names exists, every target it names is defined by a CMake file, every
+  library or program the project defines (outside tests/ and bench/) lives in a folder the table names, and what
+  each row's targets link of the project is within the folders its "may depend on" column names;
 - the newcomer's types: each is declared (class, struct or function) in a project header;
 - invariant 4, threads and locks: every daemon class that owns a std::thread or a std::mutex is named there, and the
   number of mutexes it states is the number the code has;
@@ -51,6 +52,19 @@ def cmake_targets() -> dict[str, str]:
     return out
 
 
+def cmake_links() -> tuple[dict[str, str], list[tuple[str, str]]]:
+    """{alias: real target}, [(target, linked item)] from every target_link_libraries line."""
+    aliases, links = {}, []
+    for p in cmake_files():
+        text = re.sub(r"#[^\n]*", "", p.read_text())
+        for m in re.finditer(r"\badd_library\s*\(\s*([^\s)]+)\s+ALIAS\s+([^\s)]+)", text):
+            aliases[m.group(1)] = m.group(2)
+        for m in re.finditer(r"\btarget_link_libraries\s*\(([^)]*)\)", text):
+            words = m.group(1).split()
+            links += [(words[0], w) for w in words[1:] if w not in ("PUBLIC", "PRIVATE", "INTERFACE")]
+    return aliases, links
+
+
 def cmake_tests() -> set[str]:
     names = set()
     for p in cmake_files():
@@ -86,6 +100,35 @@ class ArchitectureMap(unittest.TestCase):
                 if not fnmatch.filter(self.targets, t):
                     missing.append(f"target {t}")
         self.assertEqual(missing, [], "docs/ARCHITECTURE.md's code map names what the tree does not have")
+
+    def test_each_rows_targets_link_only_what_its_row_allows(self):
+        aliases, links = cmake_links()
+        rows = []
+        for line in section(self.doc, "Code map").splitlines():
+            cells = [c.strip() for c in line.strip().strip("|").split("|")]
+            if line.startswith("| `") and len(cells) >= 4:
+                rows.append((re.findall(r"`([^`]+)`", cells[0]), re.findall(r"`([^`]+)`", cells[1]), cells[3]))
+        wrong = []
+        for folders, targets, deps in rows:
+            if not targets or "anything" in deps:
+                continue
+            own = [re.sub(r"<[^>]+>", "*", f.rstrip("/")) for f in folders]
+            allowed = list(own)
+            for word in re.findall(r"[a-z][\w/-]*", re.sub(r"\([^)]*\)", "", deps)):
+                for cand in (word, f"daemon/{word}", f"drivers/{word}"):
+                    if (SOURCE / cand).is_dir():
+                        allowed.append(cand)
+                        break
+            mine = {t for pat in targets for t in fnmatch.filter(self.targets, pat)}
+            for target, item in links:
+                if aliases.get(target, target) not in mine:
+                    continue
+                home = self.targets.get(aliases.get(item, item))
+                if home is None or home.split("/")[0] == "cmake":
+                    continue  # a system library or an imported dependency
+                if not any(fnmatch.fnmatch(home, a) or fnmatch.fnmatch(home, a + "/*") for a in allowed):
+                    wrong.append(f"{target} links {item} ({home}); its row allows: {deps}")
+        self.assertEqual(sorted(set(wrong)), [], "docs/ARCHITECTURE.md's 'may depend on' column is out of date")
 
     def test_every_target_lives_in_a_mapped_folder(self):
         folders = [re.sub(r"<[^>]+>", "*", f.rstrip("/")) for fs, _ in self.code_map_rows() for f in fs]
