@@ -34,6 +34,8 @@ packages=(
   dpkg-dev binutils lintian mmdebstrap debian-archive-keyring
   # the TLS listener checked by a tool colorlab did not write (tests/security/testssl_test.py)
   testssl.sh
+  # the house's tools (scripts/format.sh, scripts/tidy.sh; docs/TESTING.md)
+  clang-format clang-tidy
 )
 
 missing=()

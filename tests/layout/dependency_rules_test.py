@@ -7,7 +7,10 @@ target links (every target_link_libraries line, each target resolved to the fold
 - analysis/ does no networking: no Asio, Beast or socket headers, no link to Boost, colorlab_asio, daemon/ or
   drivers/ targets, no include of their headers;
 - core/ depends on nothing else in the project, links nothing, and includes only the standard library and the two
-  header-only parsers it is built on.
+  header-only parsers it is built on;
+- drivers/ never links or includes daemon/ (the daemon drives the drivers, not the other way);
+- colorlabd's production targets (everything its link lines reach) link no sim/ target and their code includes no
+  sim/ header, except what EMBEDDED_LAB_NEEDS names with its reason: the simulated lab stays out of the daemon.
 
 Any violation that must wait for a move is listed once, in KNOWN_EXCEPTIONS, so that a new one fails; today there
 are none."""
@@ -18,7 +21,7 @@ import sys
 import unittest
 from pathlib import Path
 
-SOURCE = Path(sys.argv.pop(1) if len(sys.argv) > 1 else Path(__file__).resolve().parents[2])
+SOURCE = Path(sys.argv.pop(1) if len(sys.argv) > 1 else Path(__file__).resolve().parents[2]).resolve()
 # Not the project's own code: build trees, tests' fixtures, the vendored nothing.
 SKIP_DIRS = {".git", "build", "build-release", "build-asan", "build-fuzz", "build-tsan", "node_modules"}
 CODE = {".cpp", ".hpp", ".h", ".cc", ".c"}
@@ -26,6 +29,13 @@ CODE = {".cpp", ".hpp", ".h", ".cc", ".c"}
 # Violations waiting for a move (issue 24 moved the LS-110 and HID relay codecs into drivers/wire/, emptying it).
 # Nothing may be added here.
 KNOWN_EXCEPTIONS: set[tuple[str, str, str]] = set()
+
+# sim/ targets colorlabd may link because its embedded simulated lab needs them, each with the reason. Empty: the
+# embedded lab is colorlab-sim run as a child process (daemon/core/src/embedded_sim.cpp) reached over its sockets,
+# and the simulated DSLR the daemon drives is SimDslrCamera, a socket client in drivers/camera. The in-process
+# SimulatedCamera is its own target (colorlab::drivers_simulated_camera) for tests and benches.
+EMBEDDED_LAB_NEEDS: dict[str, str] = {}
+PRODUCTION_ROOT = "colorlabd"
 
 NETWORK_HEADERS = re.compile(r"^(boost/asio|boost/beast|asio\.hpp|asio/|sys/socket\.h|netinet/|arpa/|netdb\.h|sys/un\.h)")
 CORE_EXTERNAL_HEADERS = {"nlohmann/json.hpp", "toml++/toml.h"}  # header-only; no library behind them
@@ -63,6 +73,39 @@ def header_owners() -> dict[str, set[str]]:
 
 def cmake_text(p: Path) -> str:
     return re.sub(r"#[^\n]*", "", p.read_text())  # comments, which may name targets in prose
+
+
+def target_files() -> tuple[dict[str, str], dict[str, set[str]], dict[str, str]]:
+    """{alias or name: real target name}, {target: its source files and include directories (repo-relative)},
+    {target: the folder of the CMake file that defines it}."""
+    real: dict[str, str] = {}
+    owned: dict[str, set[str]] = {}
+    home: dict[str, str] = {}
+    for p in files(".", names={"CMakeLists.txt"}):
+        text, here = cmake_text(p), p.parent
+        for m in re.finditer(r"\badd_(library|executable)\s*\(\s*([^\s)]+)([^)]*)\)", text):
+            name, rest = m.group(2), m.group(3).split()
+            if len(rest) >= 2 and rest[0] == "ALIAS":
+                real[name] = rest[1]
+                continue
+            real.setdefault(name, name)
+            home[name] = rel(here) if here != SOURCE else "."
+            owned.setdefault(name, set()).update(source_paths(here, rest))
+        for m in re.finditer(r"\btarget_(?:sources|include_directories)\s*\(\s*([^\s)]+)([^)]*)\)", text):
+            owned.setdefault(m.group(1), set()).update(source_paths(here, m.group(2).split()))
+    return real, owned, home
+
+
+def source_paths(here: Path, words: list[str]) -> set[str]:
+    out = set()
+    for w in words:
+        w = w.replace("${CMAKE_CURRENT_SOURCE_DIR}", str(here)).replace("${PROJECT_SOURCE_DIR}", str(SOURCE))
+        if "$" in w or w.isupper():
+            continue  # keywords (PRIVATE, STATIC, SYSTEM) and variables we do not evaluate
+        path = (here / w).resolve()
+        if path.exists() and SOURCE in path.parents:
+            out.add(rel(path))
+    return out
 
 
 def targets() -> tuple[dict[str, str], list[tuple[str, str, str]]]:
@@ -168,6 +211,60 @@ class DependencyRules(unittest.TestCase):
         for target, item, _ in self.links_of("core"):
             found.append(("link", target, item))
         self.assertEqual(self.violations(found), [], "core/ is the bottom of the house: it depends on nothing")
+
+
+    def production(self) -> set[str]:
+        """Every project target colorlabd's link lines reach, by real name."""
+        real, _, _ = target_files()
+        edges: dict[str, set[str]] = {}
+        for target, item, _ in self.links:
+            edges.setdefault(real.get(target, target), set()).add(real.get(item, item))
+        seen, todo = {PRODUCTION_ROOT}, [PRODUCTION_ROOT]
+        while todo:
+            for nxt in edges.get(todo.pop(), ()):
+                if nxt in real and nxt not in seen:
+                    seen.add(nxt)
+                    todo.append(nxt)
+        return seen
+
+    def test_drivers_never_depend_on_the_daemon(self):
+        found = []
+        for path, _, header in self.includes("drivers"):
+            if any(o.split("/")[0] == "daemon" for o in self.headers.get(header, set())):
+                found.append(("include", path, header))
+        for target, item, _ in self.links_of("drivers"):
+            if self.defined.get(item, "").split("/")[0] == "daemon":
+                found.append(("link", target, item))
+        self.assertEqual(self.violations(found), [], "drivers/ must not know the daemon that drives them")
+
+    def test_colorlabd_carries_no_simulator_beyond_what_the_embedded_lab_needs(self):
+        real, owned, home = target_files()
+        production = self.production()
+        # Not vacuous: the walk reached the daemon's stack down to the camera driver.
+        for t in ("colorlab_api", "colorlab_daemon", "colorlab_campaigns", "colorlab_drivers_camera", "colorlab_core"):
+            assert t in production, f"{t} not reached from {PRODUCTION_ROOT}: the link parser needs a look"
+        found = []
+        for t in sorted(production):
+            if home.get(t, "").split("/")[0] == "sim" and t not in EMBEDDED_LAB_NEEDS:
+                found.append(("link", PRODUCTION_ROOT, t))
+        # The code of those targets: their folders, less the files other targets defined there own (a test-only
+        # target such as drivers/camera's simulated one may share its folder with a production target).
+        others = set().union(*(owned.get(t, set()) for t in home if t not in production))
+        others -= set().union(*(owned.get(t, set()) for t in production))
+        allowed_headers = {h for h, owners in self.headers.items() if owners & {home.get(t) for t in EMBEDDED_LAB_NEEDS}}
+        for folder in sorted({home[t] for t in production if t in home and home[t] != "."}):
+            for p in files(folder, CODE):
+                path = rel(p)
+                if path in others or any(path.startswith(o + "/") for o in others):
+                    continue
+                for m in INCLUDE.finditer(p.read_text(errors="replace")):
+                    owners = self.headers.get(m.group(2), set())
+                    if any(o.split("/")[0] == "sim" for o in owners) and m.group(2) not in allowed_headers:
+                        found.append(("include", path, m.group(2)))
+        self.assertEqual(self.violations(found), [],
+                         "colorlabd's targets carry the simulator: move the simulated device into its own target "
+                         "(as colorlab::drivers_simulated_camera), or name what the embedded lab needs, and why, "
+                         "in EMBEDDED_LAB_NEEDS")
 
 
 if __name__ == "__main__":

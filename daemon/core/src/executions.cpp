@@ -207,7 +207,7 @@ store::ExecutionRecord Executions::start(const std::string& campaign_name, const
 }
 
 void Executions::resume_unfinished() {
-  for (auto record : store_.unfinished_executions()) {
+  for (const auto& record : store_.unfinished_executions()) {
     if (record.status == ExecutionStatus::paused) {
       log::info("executions", record.id + " stays paused (" + record.reason + "); resume it with `colorlab resume`");
       continue;
