@@ -32,6 +32,8 @@ packages=(
   libclang-rt-14-dev
   # the Debian package (docs/packaging.md): cpack's dpkg-shlibdeps, lintian, and mmdebstrap's throwaway chroot
   dpkg-dev binutils lintian mmdebstrap debian-archive-keyring
+  # the wall clock stepped under colorlabd in tests (libfaketime, tests/integration/clock_step_test.cpp)
+  faketime
 )
 
 missing=()
