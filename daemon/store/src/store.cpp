@@ -79,7 +79,7 @@ Store::Store(const fs::path& database_path) {
                                           ec.message());
   }
   db_ = Database(database_path.string(), false);
-  db_.exec("PRAGMA busy_timeout = 5000");
+  db_.exec("PRAGMA busy_timeout = " + std::to_string(kBusyTimeoutMs));
   {
     auto st = db_.prepare("PRAGMA journal_mode = WAL");
     st.step();

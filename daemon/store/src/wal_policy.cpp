@@ -24,7 +24,11 @@ void bound_wal(Database& db) noexcept {
   if (!file || !*file) return;  // an in-memory database has no WAL
   if (wal_bytes(file) <= kJournalSizeLimitBytes) return;
   int log_frames = 0, checkpointed = 0;
+  // Without the busy handler: the writer runs on the daemon's io thread, which must not wait for a long
+  // reader (an export); a checkpoint a reader prevents now is tried again after the next commit.
+  sqlite3_busy_timeout(db.handle(), 0);
   const int rc = sqlite3_wal_checkpoint_v2(db.handle(), nullptr, SQLITE_CHECKPOINT_RESTART, &log_frames, &checkpointed);
+  sqlite3_busy_timeout(db.handle(), kBusyTimeoutMs);
   if (rc != SQLITE_OK && rc != SQLITE_BUSY) {
     log::warning("store", std::string("cannot checkpoint the WAL past its limit: ") + sqlite3_errstr(rc));
   }
