@@ -144,7 +144,10 @@ TEST(DiskFaults, AnIoErrorDuringACommitSuspendsTheRunUntilTheDiskWritesAgainAndN
 // store. With only the blob store refusing writes, the capture that keeps them suspends the run; no file,
 // whole or partial, is left in the store and no blob is listed; with room again the step is measured anew
 // and each kept blob reads back whole (its bytes hash to its name, its length is the listed size).
-void blobs_through(const std::string& how, const std::string& cause_text) {
+// `where`: how far the blob store got first — a full disk refuses the new fan-out directory ("cannot
+// create"); a failing one makes it but fails its parent's sync ("cannot sync directory"), and each retry while
+// the run is suspended gets as far as a temporary file whose bytes are refused, which the store must remove.
+void blobs_through(const std::string& how, const std::string& cause_text, const std::string& where) {
   TempDir dir;
   std::ofstream(dir / "lab.toml") << "[genicam]\nenabled = false\n[dslr]\nsize = [320, 214]\n";
   std::ofstream(dir / "colorlabd.toml") << "[simulator]\nenabled = true\ntime_scale = 200\nseed = 3\nconfig = \"lab.toml\"\n"
@@ -158,6 +161,7 @@ void blobs_through(const std::string& how, const std::string& cause_text) {
   EXPECT_EQ(reason.rfind("storage: ", 0), 0u) << reason;
   EXPECT_NE(reason.find(cause_text), std::string::npos) << reason;
   EXPECT_NE(reason.find("blobs"), std::string::npos) << reason;
+  EXPECT_NE(reason.find(where), std::string::npos) << reason;
   const std::string blobs_of_run = "/v1/runs/" + e["run_id"].get<std::string>() + "/blobs";
   EXPECT_TRUE(api.get(blobs_of_run)["items"].empty());
   EXPECT_EQ(files_under(faults.state_dir() / "blobs"), std::vector<std::filesystem::path>{}) << "a half-kept blob was left";
@@ -182,14 +186,16 @@ void blobs_through(const std::string& how, const std::string& cause_text) {
   EXPECT_EQ(integrity_check(faults.state_dir()), "ok");
 }
 
-TEST(DiskFaults, AFullBlobStoreSuspendsTheCaptureAndEveryKeptBlobReadsBackWhole) { blobs_through("ENOSPC", "No space"); }
-
-TEST(DiskFaults, AnIoErrorInTheBlobStoreSuspendsTheCaptureAndEveryKeptBlobReadsBackWhole) {
-  blobs_through("EIO", "Input/output error");
+TEST(DiskFaults, AFullBlobStoreSuspendsTheCaptureAndEveryKeptBlobReadsBackWhole) {
+  blobs_through("ENOSPC", "No space", "cannot create");
 }
 
-// A report asked for while the reports directory refuses writes fails with the cause and leaves no report
-// to serve; asked for again with room (after the daemon's next start: a failure is remembered for a minute,
+TEST(DiskFaults, AnIoErrorInTheBlobStoreSuspendsTheCaptureAndEveryKeptBlobReadsBackWhole) {
+  blobs_through("EIO", "Input/output error", "cannot sync directory");
+}
+
+// A report asked for while the reports directory refuses writes fails with the cause and leaves only a
+// half-written temporary file, never served; asked for again with room (after the daemon's next start: a failure is remembered for a minute,
 // ReportService::Options::retry_after_failure), it is served whole.
 TEST(DiskFaults, AReportOnAFullDiskFailsWithTheCauseAndIsNeverServedHalfWritten) {
   TempDir dir;
@@ -208,9 +214,14 @@ TEST(DiskFaults, AReportOnAFullDiskFailsWithTheCauseAndIsNeverServedHalfWritten)
   } while (r.status == 202 && std::chrono::steady_clock::now() < deadline);
   ASSERT_EQ(r.status, 500) << "a report was served from a full disk: " << r.body.substr(0, 300);
   EXPECT_NE(r.body.find("No space left on device"), std::string::npos) << r.body;
+  // The report module got as far as its temporary file (a full disk still creates files); never renamed,
+  // it is never served.
+  bool partial = false;
   for (const auto& f : files_under(faults.state_dir() / "reports")) {
     EXPECT_NE(f.extension(), ".html") << "a report file exists after the failure: " << f;
+    partial = partial || f.extension() == ".tmp";
   }
+  EXPECT_TRUE(partial) << "no half-written report: the test no longer exercises one";
   faults.mend();
   daemon->kill9();
   daemon.reset();

@@ -1,10 +1,13 @@
 // An LD_PRELOAD shim that makes the disk under one directory full (ENOSPC) or failing (EIO) on demand,
 // without privileges: libfiu's fiu-run fails every write, sockets included, and a size-limited tmpfs
-// needs CAP_SYS_ADMIN. Only writes that would change what is stored under COLORLAB_FAULT_DIR fail:
-// write/pwrite/writev on descriptors of files there, their syncs, size changes, and new entries
-// (creating, renaming into, mkdir). Reads, unlinks (they free space) and every other descriptor pass.
+// needs CAP_SYS_ADMIN. Only what would store data under COLORLAB_FAULT_DIR fails: write/pwrite/writev on
+// descriptors of files there, their syncs and size changes, and (ENOSPC only) mkdir, which needs a block.
+// Creating, opening and renaming files still work, as on a real full disk, whose free inodes outlast its
+// blocks: a writer gets as far as a half-written file, which is what the tests must never see served.
+// Reads, unlinks (they free space) and every other descriptor pass.
 //
-// COLORLAB_FAULT_DIR      the directory (the daemon's state directory)
+// COLORLAB_FAULT_DIR      the directory (the daemon's state directory); it must exist when the process
+//                         first writes, for the shim resolves it once
 // COLORLAB_FAULT_CONTROL  a file the test rewrites (atomically, by rename) to switch faults at run time:
 //                         absent or "off": none; "ENOSPC" or "EIO", optionally followed by a path relative
 //                         to the directory ("ENOSPC blobs") to fail only what lies under it.
@@ -209,55 +212,8 @@ int posix_fallocate64(int fd, off64_t off, off64_t len) {
   return REAL(posix_fallocate64)(fd, off, len);
 }
 
-// A new entry needs a free inode and directory space; an existing file opens as on a full disk.
-static int refuse_create(int dirfd, const char* path, int flags) {
-  if (!(flags & O_CREAT)) return 0;
-  int e = active_errno();
-  if (!e || !path_in_scope(dirfd, path)) return 0;
-  struct stat st;
-  if (!(flags & O_EXCL) && fstatat(dirfd, path, &st, 0) == 0) return 0;
-  errno = e;
-  return 1;
-}
-
-static mode_t mode_of(int flags, va_list ap) { return (flags & (O_CREAT | O_TMPFILE)) ? (mode_t)va_arg(ap, int) : 0; }
-
-int open(const char* path, int flags, ...) {
-  va_list ap;
-  va_start(ap, flags);
-  mode_t mode = mode_of(flags, ap);
-  va_end(ap);
-  if (refuse_create(AT_FDCWD, path, flags)) return -1;
-  return REAL(open)(path, flags, mode);
-}
-int open64(const char* path, int flags, ...) {
-  va_list ap;
-  va_start(ap, flags);
-  mode_t mode = mode_of(flags, ap);
-  va_end(ap);
-  if (refuse_create(AT_FDCWD, path, flags)) return -1;
-  return REAL(open64)(path, flags, mode);
-}
-int openat(int dirfd, const char* path, int flags, ...) {
-  va_list ap;
-  va_start(ap, flags);
-  mode_t mode = mode_of(flags, ap);
-  va_end(ap);
-  if (refuse_create(dirfd, path, flags)) return -1;
-  return REAL(openat)(dirfd, path, flags, mode);
-}
-int openat64(int dirfd, const char* path, int flags, ...) {
-  va_list ap;
-  va_start(ap, flags);
-  mode_t mode = mode_of(flags, ap);
-  va_end(ap);
-  if (refuse_create(dirfd, path, flags)) return -1;
-  return REAL(openat64)(dirfd, path, flags, mode);
-}
-int creat(const char* path, mode_t mode) { return open(path, O_WRONLY | O_CREAT | O_TRUNC, mode); }
-int creat64(const char* path, mode_t mode) { return open64(path, O_WRONLY | O_CREAT | O_TRUNC, mode); }
-
-// glibc's stdio writes through internal calls the shim cannot see: a stream opened for writing there fails at fopen.
+// glibc's stdio writes through internal calls the shim cannot see: a stream opened for writing there fails at
+// fopen instead, the nearest the shim can come to its first write failing.
 static int refuse_stream(const char* path, const char* mode) {
   if (!mode || !strpbrk(mode, "wa+")) return 0;
   int e = active_errno();
@@ -274,23 +230,12 @@ FILE* fopen64(const char* path, const char* mode) {
   return REAL(fopen64)(path, mode);
 }
 
+// A new directory needs a block of its own: refused on a full disk.
 static int refuse_entry(int dirfd, const char* path) {
   int e = active_errno();
-  if (!e || !path_in_scope(dirfd, path)) return 0;
+  if (e != ENOSPC || !path_in_scope(dirfd, path)) return 0;
   errno = e;
   return 1;
-}
-int rename(const char* from, const char* to) {
-  if (refuse_entry(AT_FDCWD, to)) return -1;
-  return REAL(rename)(from, to);
-}
-int renameat(int fromfd, const char* from, int tofd, const char* to) {
-  if (refuse_entry(tofd, to)) return -1;
-  return REAL(renameat)(fromfd, from, tofd, to);
-}
-int renameat2(int fromfd, const char* from, int tofd, const char* to, unsigned int flags) {
-  if (refuse_entry(tofd, to)) return -1;
-  return REAL(renameat2)(fromfd, from, tofd, to, flags);
 }
 int mkdir(const char* path, mode_t mode) {
   if (refuse_entry(AT_FDCWD, path)) return -1;
