@@ -53,7 +53,7 @@ static void reload(void) {
   char text[PATH_MAX + 16] = {0};
   long fd = syscall(SYS_openat, AT_FDCWD, g_control, O_RDONLY | O_CLOEXEC);
   if (fd < 0) {
-    g_errno = 0;
+    __atomic_store_n(&g_errno, 0, __ATOMIC_SEQ_CST);
     return;
   }
   long n = syscall(SYS_read, (int)fd, text, sizeof text - 1);
@@ -62,7 +62,9 @@ static void reload(void) {
   text[n] = '\0';
   char word[16] = {0}, sub[PATH_MAX] = {0};
   int fields = sscanf(text, "%15s %4095s", word, sub);
-  g_errno = fields >= 1 && strcmp(word, "ENOSPC") == 0 ? ENOSPC : fields >= 1 && strcmp(word, "EIO") == 0 ? EIO : 0;
+  __atomic_store_n(&g_errno,
+                   fields >= 1 && strcmp(word, "ENOSPC") == 0 ? ENOSPC : fields >= 1 && strcmp(word, "EIO") == 0 ? EIO : 0,
+                   __ATOMIC_SEQ_CST);
   if (fields == 2) {
     snprintf(g_scope, sizeof g_scope, "%s/%s", g_dir, sub);
     size_t len = strlen(g_scope);
@@ -72,29 +74,32 @@ static void reload(void) {
   }
 }
 
-// The errno to fail with now (0: none), the control file re-read if it changed.
+// The errno to fail with now (0: none), the control file re-read if it changed. The lock is only ever tried:
+// a write from a signal handler (asio's self-pipe) that interrupts a thread holding it must not deadlock, so
+// that call goes by the last state read (a switch takes effect a call later).
 static int active_errno(void) {
   pthread_once(&g_once, init);
   if (!g_dir[0]) return 0;
   struct stat st;
   int present = stat(g_control, &st) == 0;
-  pthread_mutex_lock(&g_mutex);
-  if (!present) {
-    g_errno = 0;
-    g_seen_valid = 0;
-  } else if (!g_seen_valid || st.st_ino != g_seen.st_ino || st.st_size != g_seen.st_size ||
-             st.st_mtim.tv_sec != g_seen.st_mtim.tv_sec || st.st_mtim.tv_nsec != g_seen.st_mtim.tv_nsec) {
-    reload();
-    g_seen = st;
-    g_seen_valid = 1;
+  if (pthread_mutex_trylock(&g_mutex) == 0) {
+    if (!present) {
+      __atomic_store_n(&g_errno, 0, __ATOMIC_SEQ_CST);
+      g_seen_valid = 0;
+    } else if (!g_seen_valid || st.st_ino != g_seen.st_ino || st.st_size != g_seen.st_size ||
+               st.st_mtim.tv_sec != g_seen.st_mtim.tv_sec || st.st_mtim.tv_nsec != g_seen.st_mtim.tv_nsec) {
+      reload();
+      g_seen = st;
+      g_seen_valid = 1;
+    }
+    pthread_mutex_unlock(&g_mutex);
   }
-  int e = g_errno;
-  pthread_mutex_unlock(&g_mutex);
-  return e;
+  return __atomic_load_n(&g_errno, __ATOMIC_SEQ_CST);
 }
 
+// Not in scope while another thread holds the lock (re-reading the scope): that call passes.
 static int under_scope(const char* canonical) {
-  pthread_mutex_lock(&g_mutex);
+  if (pthread_mutex_trylock(&g_mutex) != 0) return 0;
   size_t n = strlen(g_scope);
   int inside = strncmp(canonical, g_scope, n) == 0 && (canonical[n] == '/' || canonical[n] == '\0');
   pthread_mutex_unlock(&g_mutex);
