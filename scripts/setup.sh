@@ -36,6 +36,8 @@ packages=(
   testssl.sh
   # the house's tools (scripts/format.sh, scripts/tidy.sh; docs/TESTING.md)
   clang-format clang-tidy
+  # the wall clock stepped under colorlabd in tests (libfaketime, tests/integration/clock_step_test.cpp)
+  faketime
 )
 
 missing=()

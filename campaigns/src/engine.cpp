@@ -212,6 +212,7 @@ asio::awaitable<RunOutcome> run_campaign_script(ScriptRunSetup setup, Lab& lab, 
               const std::string timing_key = timing_keys.key(call, args);
               // A restore or a wait for disk space is not what the call costs on a normal night.
               bool interrupted = storage_suspended || restored_now;
+              bool storage_waiting = false;
               for (;;) {
                 std::optional<Error> failure;
                 try {
@@ -220,6 +221,7 @@ asio::awaitable<RunOutcome> run_campaign_script(ScriptRunSetup setup, Lab& lab, 
                   failure = e;
                 }
                 if (!failure) {
+                  if (storage_waiting) sink.resumed(json{{"condition", "storage"}});
                   if (!interrupted) {
                     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - call_started).count();
                     const double lab_s = std::max(0.0, wall * lab.time_scale() - TimingKeys::asked_wait_s(call, args));
@@ -228,6 +230,17 @@ asio::awaitable<RunOutcome> run_campaign_script(ScriptRunSetup setup, Lab& lab, 
                   break;
                 }
                 interrupted = true;
+                if (failure->cls() == ErrorClass::io_error && !control.requested()) {
+                  // The disk refused what the call keeps (a frame, a preview): wait for room as for a commit, then
+                  // make the call again. Announced once, so a long full disk does not fill the log as well.
+                  if (!storage_waiting) {
+                    storage_waiting = true;
+                    log::warning(script.name, "suspended at " + call + ": storage: " + failure->what());
+                    sink.suspended(std::string("storage: ") + failure->what(), *failure);
+                  }
+                  co_await lab.wait_retry(control);
+                  continue;
+                }
                 auto cause = Lab::suspend_cause(*failure);
                 if (!cause || control.requested()) throw *failure;
                 std::string reason = *cause + ": " + failure->what();

@@ -7,6 +7,7 @@
 #include "colorlab/core/log.hpp"
 #include "colorlab/store/blob_index.hpp"
 #include "colorlab/store/schema.hpp"
+#include "colorlab/store/wal_policy.hpp"
 
 namespace colorlab::store {
 
@@ -78,14 +79,14 @@ Store::Store(const fs::path& database_path) {
                                           ec.message());
   }
   db_ = Database(database_path.string(), false);
-  db_.exec("PRAGMA busy_timeout = 5000");
+  db_.exec("PRAGMA busy_timeout = " + std::to_string(kBusyTimeoutMs));
   {
     auto st = db_.prepare("PRAGMA journal_mode = WAL");
     st.step();
   }
   db_.exec("PRAGMA synchronous = FULL");
   db_.exec("PRAGMA foreign_keys = ON");
-  db_.exec("PRAGMA journal_size_limit = 67108864");
+  apply_wal_policy(db_);
   db_.exec("PRAGMA temp_store = MEMORY");
   {
     auto st = db_.prepare("PRAGMA quick_check");
@@ -352,6 +353,7 @@ void Store::commit_step(const ExecutionRecord& execution, const StepRecord& step
                             {"step", step.step},
                             {"measurements", step.measurements.size()}});
   tx.commit();
+  bound_wal(db_);
 }
 
 std::vector<JournalRow> Store::journal(const std::string& execution_id) {

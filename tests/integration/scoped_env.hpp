@@ -1,0 +1,41 @@
+#pragma once
+// Environment for a child process that preloads a library (the fault shim, libfaketime).
+#include <cstdlib>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace colorlab::testing {
+
+// Environment variables set while a child starts (it inherits them), then restored: the test process
+// itself must not run under what it preloads into the daemon.
+class ScopedEnv {
+ public:
+  ScopedEnv(std::initializer_list<std::pair<const char*, std::string>> vars) {
+    for (const auto& [name, value] : vars) {
+      const char* old = std::getenv(name);
+      saved_.emplace_back(name, old ? std::optional<std::string>(old) : std::nullopt);
+      ::setenv(name, value.c_str(), 1);
+    }
+  }
+  ~ScopedEnv() {
+    for (const auto& [name, value] : saved_) {
+      if (value) ::setenv(name, value->c_str(), 1);
+      else ::unsetenv(name);
+    }
+  }
+  ScopedEnv(const ScopedEnv&) = delete;
+  ScopedEnv& operator=(const ScopedEnv&) = delete;
+
+ private:
+  std::vector<std::pair<const char*, std::optional<std::string>>> saved_;
+};
+
+// ASan (the asan preset) refuses to start when a preloaded library precedes its runtime.
+inline std::string asan_options_for_preload() {
+  const char* old = std::getenv("ASAN_OPTIONS");
+  return std::string(old ? old : "") + ":verify_asan_link_order=0";
+}
+
+}  // namespace colorlab::testing
