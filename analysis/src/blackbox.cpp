@@ -126,6 +126,7 @@ BlackBoxModel fit_blackbox(const Eigen::MatrixXd& spectra, const Eigen::MatrixXd
       model.lambda[static_cast<std::size_t>(c)] = fit.lambda;
       model.sensitivities.row(c) = fit.curve.transpose() / xscale;
       model.sensitivity_sdev.row(c) = fit.sdev.transpose() / xscale;
+      model.sensitivity_covariance[static_cast<std::size_t>(c)] = fit.covariance / (xscale * xscale);
     }
     return model;
   }

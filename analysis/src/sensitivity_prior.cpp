@@ -241,7 +241,7 @@ PriorFit fit_with_prior(const ChannelPrior& prior, const Eigen::MatrixXd& X, con
   if (grid.empty()) grid.emplace_back(lambda, 0.0);
   double top_ll = -std::numeric_limits<double>::infinity();
   for (const auto& g : grid) top_ll = std::max(top_ll, g.second);
-  Eigen::VectorXd second = Eigen::VectorXd::Zero(bands);
+  Eigen::MatrixXd second = Eigen::MatrixXd::Zero(bands, bands);
   double total = 0;
   for (const auto& [l, ll] : grid) {
     const double w = std::exp(ll - top_ll);
@@ -251,10 +251,12 @@ PriorFit fit_with_prior(const ChannelPrior& prior, const Eigen::MatrixXd& X, con
     const Eigen::LDLT<Eigen::MatrixXd> ldlt(Eg.transpose() * Eg);
     const Eigen::VectorXd mean = B * ldlt.solve(Eg.transpose() * f);
     const Eigen::MatrixXd cov = (q_at(l) / reml.m) * ldlt.solve(I);
-    second += w * ((B * cov * B.transpose()).diagonal().cwiseMax(0.0) + (mean - fit.curve).array().square().matrix());
+    const Eigen::VectorXd off = mean - fit.curve;
+    second += w * (B * cov * B.transpose() + off * off.transpose());
     total += w;
   }
-  fit.sdev = (second / total).cwiseSqrt();
+  fit.covariance = second / total;
+  fit.sdev = fit.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
   return fit;
 }
 

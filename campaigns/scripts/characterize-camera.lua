@@ -20,6 +20,8 @@ return {
     lamp = { type = "string", default = "D65", description = "the cabinet lamp to photograph under; empty = leave the cabinet as it is" },
     dimmer_percent = { type = "number", default = 100, min = 1, max = 100, unit = "%", description = "the cabinet's dimmer level" },
     cv = { type = "string", default = "loo", description = "cross-validation: loo, or kN for N folds" },
+    target_lamps = { type = "array", items = "string", default = {}, max_items = 8,
+                     description = "lamps to characterize the raw for besides the photographed one (TL84, CWF, A, …): from the camera's estimated sensitivities, one characterization per lamp, each with a per-patch 95 % band; a lamp's nominal CIE spectrum is warned about" },
     prior_exclude = { type = "array", items = "string", default = {}, max_items = 28,
                       description = "camspec cameras the black box's prior leaves out (the camera under test, to judge its curves against its published ones)" },
     load_timeout_s = { type = "number", default = 600, min = 0, max = 86400, unit = "s",
@@ -141,7 +143,17 @@ return {
       end
       lab.progress(0.1 + 0.9 * (k - 0.5) / #p.formats, "fitting " .. format)
       -- The black box (raw only) takes the lamp's spectrum to be its standard illuminant's.
-      local c = lab.analysis.characterize(f, ref, { cv = p.cv, lamp = p.lamp, prior_exclude = p.prior_exclude })
+      local c = lab.analysis.characterize(f, ref, { cv = p.cv, lamp = p.lamp, prior_exclude = p.prior_exclude,
+                                                    target_lamps = p.target_lamps })
+      -- Issue 26: one characterization per other lamp, named by it, from the sensitivities the raw gives.
+      for lamp, x in pairs(c.across_lamps or {}) do
+        for _, w in ipairs(x.warnings) do lab.log("warning: " .. w) end
+        lab.record("characterization/" .. format .. "/lamp/" .. lamp, {
+          quantity = "delta_e00_cv_mean", value = x.cv.mean, unit = "ΔE00", instrument = shots.instrument,
+          data = { format = format, lamp = lamp, method = x.method, lamp_measured = x.lamp_measured, warnings = x.warnings,
+                   uncertainty95 = x.uncertainty95, model = x.model },
+        })
+      end
       for name, approach in pairs(c.approaches) do
         lab.record("characterization/" .. format .. "/" .. name, {
           quantity = "delta_e00_cv_mean", value = approach.cv.mean, unit = "ΔE00", instrument = shots.instrument,
@@ -154,7 +166,7 @@ return {
       if best_cv == nil or chosen < best_cv then best_format, best_cv = format, chosen end
       out.formats[format] = { confidence = f.confidence, rotation_deg = f.rotation_deg, corners = f.corners,
                               check = f.check, approaches = c.approaches, best_approach = c.best_approach,
-                              selected = c.selected, not_fitted = c.not_fitted }
+                              selected = c.selected, not_fitted = c.not_fitted, across_lamps = c.across_lamps }
     end
     -- The model to use from now on: the adapted mapping of the format that cross-validates best.
     out.selected = { format = best_format, cv_mean_de00 = best_cv, model = out.formats[best_format].selected }

@@ -1,4 +1,5 @@
 #include "colorlab/campaigns/characterize.hpp"
+#include "colorlab/campaigns/characterize_lamps.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -485,6 +486,8 @@ json characterize(const json& camera, const json& reference, const json& options
   } else if (raw) {
     not_fitted["black_box"] = setup.missing;
   }
+  json across_lamps = json::object();
+  if (raw && options.contains("target_lamps")) across_lamps = characterize_across_lamps(d, reference, options);  // issue 26
   std::string best;
   double best_cv = std::numeric_limits<double>::infinity();
   for (const auto& [name, a] : approaches.items()) {
@@ -495,7 +498,7 @@ json characterize(const json& camera, const json& reference, const json& options
   }
   return json{{"format", format},     {"patches", d.size()},   {"cv", cv.name()},
               {"approaches", approaches}, {"best_approach", best}, {"selected", selected},
-              {"not_fitted", not_fitted}, {"unit", "ΔE00"}};
+              {"not_fitted", not_fitted}, {"unit", "ΔE00"}, {"across_lamps", across_lamps}};
 }
 
 json characterize_black_box(const json& camera, const json& reference, const json& options) {

@@ -13,6 +13,8 @@
 #include "colorlab/analysis/colorimetry.hpp"
 #include "colorlab/analysis/standard_data.hpp"
 #include "colorlab/campaigns/characterize.hpp"
+#include "colorlab/campaigns/characterize_lamps.hpp"
+#include "colorlab/core/data_paths.hpp"
 #include "colorlab/core/error.hpp"
 #include "colorlab/sim/scene.hpp"
 
@@ -193,6 +195,33 @@ TEST(CharacterizeBlackBox, SaysWhyItWasNotFitted) {
   // characterize_black_box refuses rather than returns nothing.
   EXPECT_THROW(campaigns::characterize_black_box(s.camera, s.reference, {{"lamp", "UV"}, {"mapping", {{"method", "ccm"}, {"target", "xyz"}}}}),
                Error);
+}
+
+// Issue 26: one characterization per other lamp, named by it, from the raw's sensitivities; a lamp known only by its
+// standard's name is warned about, a measured one is not. (Accuracy against truth: tests/analysis/across_lamps_test.)
+TEST(CharacterizeAcrossLamps, OnePerOtherLampNamedByItAndNominalLampsWarned) {
+  if (!paths::shared_data_file("camera_ssf_camspec_jiang2013_28cams_10nm_400_720.csv")) GTEST_SKIP() << "no camspec curves (../shared/data)";
+  const Synthetic s = make_chart(5);
+  const auto a = analysis::load_illuminant("A");
+  json measured_a{{"wavelengths", a.wavelengths}, {"values", std::vector<double>(a.values.data(), a.values.data() + a.values.size())}};
+  const json options{{"lamp", "TL84"}, {"target_lamps", {"TL84", "A", "CWF"}}, {"draws", 5}, {"lamp_spectra", {{"A", measured_a}}}};
+  const json out = campaigns::characterize_across_lamps(s.chart, s.reference, options);
+  EXPECT_FALSE(out.contains("TL84")) << "the photographed lamp is the adapted mapping's, not an across-lamps one";
+  ASSERT_TRUE(out.contains("A"));
+  ASSERT_TRUE(out.contains("CWF"));
+  EXPECT_TRUE(out["A"]["lamp_measured"].get<bool>());
+  EXPECT_TRUE(out["A"]["warnings"].empty());
+  EXPECT_FALSE(out["CWF"]["lamp_measured"].get<bool>());
+  ASSERT_EQ(out["CWF"]["warnings"].size(), 1u);
+  EXPECT_NE(out["CWF"]["warnings"][0].get<std::string>().find("nominal"), std::string::npos);
+  EXPECT_EQ(out["CWF"]["method"].get<std::string>().rfind("across-lamps:CWF:", 0), 0u) << out["CWF"]["method"];
+  EXPECT_EQ(out["A"]["uncertainty95"]["de00"].size(), s.chart.size());
+  for (const auto& r : out["A"]["uncertainty95"]["de00"]) EXPECT_GT(r.get<double>(), 0);
+
+  json no_spectra = s.reference;
+  no_spectra.erase("spectra");
+  EXPECT_THROW((void)campaigns::characterize_across_lamps(s.chart, no_spectra, options), Error);
+  EXPECT_THROW((void)campaigns::characterize_across_lamps(s.chart, s.reference, {{"lamp", "TL84"}, {"target_lamps", {"sodium"}}}), Error);
 }
 
 }  // namespace

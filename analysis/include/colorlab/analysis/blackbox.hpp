@@ -32,6 +32,8 @@ struct BlackBoxModel {
   // With a prior: 3 × bands posterior standard deviations of `sensitivities` (see PriorFit::sdev); credible_band()
   // turns a row into a band. Empty without a prior: the smoothness penalty has no calibrated posterior.
   Eigen::MatrixXd sensitivity_sdev;
+  // With a prior: per channel, the bands × bands posterior covariance (sdev² on its diagonal), for drawing curves.
+  std::array<Eigen::MatrixXd, 3> sensitivity_covariance;
   Eigen::MatrixXd predict(const Eigen::MatrixXd& spectra) const;  // n × bands → n × 3 RAW
 };
 

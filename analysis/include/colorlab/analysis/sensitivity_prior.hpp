@@ -46,6 +46,9 @@ struct PriorFit {
   // (amplitude, components) given y, with the noise variance at its REML estimate. A point estimate can be far off
   // where the chart does not see the curve (the SG under one lamp pins ~8 of 33 directions); this says where.
   Eigen::VectorXd sdev;
+  // The posterior's full covariance across bands (sdev² on its diagonal). Neighbouring bands move together, so
+  // drawing curves to propagate the uncertainty into anything computed from them needs it, not only sdev.
+  Eigen::MatrixXd covariance;
   double noise_sdev = 0;  // REML estimate of the RAW noise σ, in y's units
 };
 

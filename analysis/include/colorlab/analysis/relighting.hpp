@@ -1,0 +1,112 @@
+#pragma once
+// Characterization across a lamp change (issue 26): a chart photographed under lamp A, a characterization for lamp B.
+//
+// Why: a mapping fitted under A and used under B carries the camera's departure from the Luther condition into every
+// patch (1.5–4.8 ΔE00 mean for D65 → A / F11, docs/ACCURACY.md §2), and cross-validation under A cannot see it. But the
+// lab has what it takes to photograph the chart under B without doing so: the chart's measured reflectances, B's
+// spectrum, and the camera's sensitivities estimated from the photograph under A (§7.4, with a posterior). So:
+//
+//   1. sensitivities s_c from RAW_A = (reflectance × A) · s (estimate_sensitivities: the prior-based black box);
+//   2. the chart predicted under B: RAW_B = (reflectance × B) · s, white-balanced by the perfect white under B, with
+//      reference colours under B (Bradford-adapted to the ICC D50 white, as every other characterization here);
+//   3. every model family fitted and selected (LOO) on that predicted chart, as under A;
+//   4. the same chosen model refitted on charts predicted from curves drawn from the sensitivities' posterior: their
+//      spread at a patch is what the sensitivities' credible bands mean for that patch's colour.
+//
+// Inputs under B must be white-balanced the same way: camera RAW ÷ the RAW of a perfect (or known neutral) white
+// under B.
+#include <Eigen/Dense>
+#include <array>
+#include <optional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "colorlab/analysis/characterization.hpp"
+#include "colorlab/analysis/sensitivity_prior.hpp"
+#include "colorlab/analysis/spectral.hpp"
+
+namespace colorlab::analysis {
+
+// A lamp's spectrum and where it came from. A lab's TL84 is not CIE F11: the standard tables stand in only until the
+// lamp is measured, and every characterization that rests on one says so (warning()).
+struct LampSpectrum {
+  std::string name;       // the lab's name for the lamp ("TL84", "A", "D65", …)
+  SpectralSet spd;        // one row, any positive scale
+  bool measured = false;  // false: the CIE standard the lamp is named after stands in for it
+  std::string warning() const;  // empty when measured
+};
+// The CIE standard a cabinet lamp is named after: D65, D50, A, TL84 (→ F11), CWF (→ F2), F-series by name.
+// Throws Error(not_found) with a hint for a lamp that has no standard.
+LampSpectrum nominal_lamp(const std::string& lamp);
+// A measured spectrum (one row, non-negative, not all zero); throws Error(bad_data) otherwise.
+LampSpectrum measured_lamp(const std::string& lamp, SpectralSet spd);
+
+// The chart under one lamp, precomputed so that a chart can be predicted from any curves cheaply.
+struct ChartUnderLamp {
+  std::string lamp;
+  bool lamp_measured = false;
+  std::string lamp_warning;  // LampSpectrum::warning(), carried into every characterization under this lamp
+  std::vector<double> wavelengths;  // the curves' grid
+  // n × bands: RAW = radiance · curveᵀ for a curve linear between the grid's wavelengths, integrated at 1 nm
+  // (reflectances Sprague or cubic, lamp linear, so a fluorescent line between two bands counts in both).
+  Eigen::MatrixXd radiance;
+  Eigen::RowVectorXd white;  // the perfect white's row of `radiance`
+  ChartData reference;       // ids, XYZ (CIE 1931 2° under the lamp, Bradford to ICC D50) and L*a*b*; rgb empty
+
+  // rgb = RAW ÷ RAW of the perfect white under this lamp, per channel; curves: 3 × bands.
+  ChartData predict(const Eigen::MatrixXd& curves) const;
+};
+// grid: the sensitivities' wavelengths (inside the reflectances' and the lamp's range).
+ChartUnderLamp chart_under_lamp(const SpectralSet& reflectances, const LampSpectrum& lamp, const std::vector<double>& grid);
+
+// Spectral sensitivities with their posterior (the prior-based black box, blackbox.hpp).
+struct SensitivityEstimate {
+  std::vector<double> wavelengths;
+  Eigen::MatrixXd curves;                  // 3 × bands, in the RAW's units per unit of ChartUnderLamp::radiance
+  std::array<Eigen::MatrixXd, 3> covariance;  // per channel, bands × bands
+  // One set of curves drawn from the (Gaussian) posterior, clipped at 0 as the sensitivities are.
+  Eigen::MatrixXd draw(std::mt19937& rng) const;
+};
+// raw: n × 3 counts of the chart photographed under `photographed` (patches in chart.reference.ids order).
+SensitivityEstimate estimate_sensitivities(const ChartUnderLamp& photographed, const Eigen::MatrixXd& raw,
+                                           const SensitivityPrior& prior);
+
+struct AcrossLampsOptions {
+  // Every family, as under the photographed lamp. (Only the five LOO chose on predicted charts — ccm, rootpoly:2–4,
+  // rbf:ccm — cost the same CPU time: the spline's λ search dominates either way.)
+  std::vector<std::string> methods = all_methods();
+  std::vector<FitTarget> targets = {FitTarget::xyz_then_lab, FitTarget::xyz_lightness_weighted, FitTarget::lab_direct};
+  CvSpec cv = CvSpec::loo();
+  int draws = 40;      // posterior draws propagated to the per-patch uncertainty
+  unsigned seed = 1;   // of the draws: a characterization is reproducible
+};
+
+// One characterization per lamp, named by it.
+struct LampCharacterization {
+  std::string lamp;
+  bool lamp_measured = false;
+  std::vector<std::string> warnings;
+  std::string method;  // "across-lamps:<lamp>:<chosen family>"
+  std::string family;  // the chosen family on the predicted chart ("rbf:ccm", "rootpoly:3", …)
+  FitTarget target = FitTarget::xyz_then_lab;
+  double parameters = 0;
+  ErrorStats cv;               // cross-validated on the predicted chart
+  Characterization model;      // white-balanced RGB under the lamp → L*a*b* (D50)
+  std::vector<Characterization> draws;  // the family refitted on charts predicted from posterior draws
+
+  double misfit95 = 0;  // 95th percentile of the cross-validated ΔE00 on the predicted chart
+
+  Eigen::MatrixXd apply(const Eigen::MatrixXd& rgb) const { return model.apply(rgb); }
+  // Per row of rgb, the radius (ΔE00 about apply(rgb)) of its 95 % band, two independent parts in quadrature:
+  // - the sensitivities' uncertainty: the 95th percentile over the draws of the distance to the point prediction;
+  // - the family's misfit (which the draws do not contain): misfit95.
+  // (A local misfit — the RMS CV error of the 8 nearest training patches — was tried: narrower bands, 84 % pooled
+  // coverage against 94 % on four cameras; docs/ACCURACY.md §6.)
+  Eigen::VectorXd uncertainty95(const Eigen::MatrixXd& rgb) const;
+};
+
+LampCharacterization characterize_across_lamps(const SensitivityEstimate& sensitivities, const ChartUnderLamp& target,
+                                               const AcrossLampsOptions& options = {});
+
+}  // namespace colorlab::analysis

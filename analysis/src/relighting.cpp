@@ -1,0 +1,195 @@
+#include "colorlab/analysis/relighting.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <map>
+
+#include "colorlab/analysis/blackbox.hpp"
+#include "colorlab/analysis/color_difference.hpp"
+#include "colorlab/analysis/colorimetry.hpp"
+#include "colorlab/analysis/standard_data.hpp"
+#include "colorlab/core/error.hpp"
+
+namespace colorlab::analysis {
+
+namespace {
+
+double quantile(std::vector<double> v, double q) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const double pos = q * static_cast<double>(v.size() - 1);
+  const auto lo = static_cast<std::size_t>(std::floor(pos));
+  const auto hi = std::min(lo + 1, v.size() - 1);
+  return v[lo] + (v[hi] - v[lo]) * (pos - static_cast<double>(lo));
+}
+
+}  // namespace
+
+std::string LampSpectrum::warning() const {
+  if (measured) return {};
+  return "lamp " + name + ": its spectrum is the nominal standard " + (spd.names.empty() ? std::string("?") : spd.names.front()) +
+         ", not a measurement of this lamp; a real " + name +
+         " differs from its standard (phosphors, age, dimming), and the characterization inherits that difference — measure the "
+         "lamp's spectrum (spectroradiometer on the cabinet's white) and characterize again";
+}
+
+LampSpectrum nominal_lamp(const std::string& lamp) {
+  std::string key = lamp;
+  for (auto& c : key) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  // The cabinet's lamps and the CIE table each is sold as (sim/scene's lamps; colorimetry-notes §6.2).
+  static const std::map<std::string, std::string, std::less<>> table{{"D65", "D65"}, {"D50", "D50"}, {"A", "A"},
+                                                                     {"TL84", "F11"}, {"840", "F11"}, {"CWF", "F2"}};
+  std::string standard = key;
+  if (auto it = table.find(key); it != table.end()) standard = it->second;
+  LampSpectrum out;
+  out.name = lamp;
+  try {
+    out.spd = load_illuminant(standard);
+  } catch (const Error& e) {
+    throw Error(ErrorClass::not_found, "lamp " + lamp + " has no standard spectrum (" + e.what() + ")",
+                "name one of D65, D50, A, TL84, CWF or a CIE F-series illuminant, or give the lamp's measured spectrum");
+  }
+  out.measured = false;
+  return out;
+}
+
+LampSpectrum measured_lamp(const std::string& lamp, SpectralSet spd) {
+  spd.check_shape();
+  if (spd.size() != 1) throw Error(ErrorClass::bad_data, "lamp " + lamp + ": a measured spectrum is one row, not " + std::to_string(spd.size()));
+  validate_emission(spd);
+  if (!(spd.values.maxCoeff() > 0)) throw Error(ErrorClass::bad_data, "lamp " + lamp + ": the measured spectrum is zero everywhere");
+  return {lamp, std::move(spd), true};
+}
+
+ChartUnderLamp chart_under_lamp(const SpectralSet& refl, const LampSpectrum& lamp, const std::vector<double>& grid) {
+  refl.check_shape();
+  validate_reflectance(refl, 0.02);
+  if (grid.size() < 3) throw Error(ErrorClass::bad_parameter, "chart under a lamp: the sensitivities' grid needs at least 3 wavelengths");
+  const double lo = grid.front(), hi = grid.back();
+  for (const auto* s : {&refl, &lamp.spd})
+    if (s->wavelengths.front() > lo + 1e-9 || s->wavelengths.back() < hi - 1e-9)
+      throw Error(ErrorClass::bad_data, "chart under lamp " + lamp.name + ": " + s->source + " covers " +
+                                            std::to_string(s->wavelengths.front()) + "–" + std::to_string(s->wavelengths.back()) +
+                                            " nm, the sensitivities " + std::to_string(lo) + "–" + std::to_string(hi) + " nm");
+  const auto fine = uniform_grid(lo, hi, 1.0);
+  const SpectralSet r = resample(refl, fine, sprague_applicable(refl.wavelengths) ? Interpolation::sprague : Interpolation::cubic_spline);
+  const SpectralSet l = resample(lamp.spd, fine, Interpolation::linear);
+  // A curve linear between the grid's wavelengths is S_fine = M · s (M: fine × bands); RAW = Σ_fine r·l·S_fine.
+  const Eigen::MatrixXd M = resampling_matrix(grid, fine, Interpolation::linear);
+  const Eigen::RowVectorXd e = l.values.row(0);
+  ChartUnderLamp out;
+  out.lamp = lamp.name;
+  out.lamp_measured = lamp.measured;
+  out.lamp_warning = lamp.warning();
+  out.wavelengths = grid;
+  out.radiance = (r.values.array().rowwise() * e.array()).matrix() * M;
+  out.white = e * M;
+
+  ChartData& c = out.reference;
+  c.ids = refl.names;
+  c.white = kIccD50White;
+  const ReflectanceIntegrator integ(lamp.spd, load_observer(Observer::cie1931_2deg), refl.wavelengths);
+  const auto xyz = integ.xyz(refl);
+  c.xyz.resize(static_cast<Eigen::Index>(xyz.size()), 3);
+  for (std::size_t i = 0; i < xyz.size(); ++i) {
+    const Xyz a = bradford_adapt(xyz[i], integ.white(), kIccD50White);
+    c.xyz.row(static_cast<Eigen::Index>(i)) << a.X, a.Y, a.Z;
+  }
+  c.lab = xyz_rows_to_lab(c.xyz, c.white);
+  return out;
+}
+
+ChartData ChartUnderLamp::predict(const Eigen::MatrixXd& curves) const {
+  if (curves.rows() != 3 || curves.cols() != radiance.cols())
+    throw Error(ErrorClass::bad_data, "chart under lamp " + lamp + ": curves are " + std::to_string(curves.rows()) + " × " +
+                                          std::to_string(curves.cols()) + ", need 3 × " + std::to_string(radiance.cols()));
+  const Eigen::RowVectorXd w = white * curves.transpose();
+  if (!(w.minCoeff() > 0))
+    throw Error(ErrorClass::bad_data, "chart under lamp " + lamp + ": a channel sees nothing of the lamp's white",
+                "the lamp's spectrum and the sensitivities do not overlap");
+  ChartData c = reference;
+  c.rgb = (radiance * curves.transpose()).array().rowwise() / w.array();
+  return c;
+}
+
+Eigen::MatrixXd SensitivityEstimate::draw(std::mt19937& rng) const {
+  std::normal_distribution<double> nd(0, 1);
+  Eigen::MatrixXd out = curves;
+  for (std::size_t c = 0; c < 3; ++c) {
+    // Eigen-decomposition rather than Cholesky: the mixture covariance is only positive semi-definite.
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(covariance[c]);
+    const Eigen::VectorXd root = eig.eigenvalues().cwiseMax(0.0).cwiseSqrt();
+    Eigen::VectorXd z(root.size());
+    for (Eigen::Index k = 0; k < z.size(); ++k) z(k) = nd(rng);
+    out.row(static_cast<Eigen::Index>(c)) += (eig.eigenvectors() * root.cwiseProduct(z)).transpose();
+  }
+  return out.cwiseMax(0.0);
+}
+
+SensitivityEstimate estimate_sensitivities(const ChartUnderLamp& photographed, const Eigen::MatrixXd& raw, const SensitivityPrior& prior) {
+  if (raw.rows() != photographed.radiance.rows())
+    throw Error(ErrorClass::bad_data, "sensitivities: " + std::to_string(raw.rows()) + " RAW triples for " +
+                                          std::to_string(photographed.radiance.rows()) + " patches");
+  BlackBoxOptions o;
+  o.prior = prior;
+  const BlackBoxModel m = fit_blackbox(photographed.radiance, raw, o);
+  return {photographed.wavelengths, m.sensitivities, m.sensitivity_covariance};
+}
+
+LampCharacterization characterize_across_lamps(const SensitivityEstimate& s, const ChartUnderLamp& target,
+                                               const AcrossLampsOptions& o) {
+  if (s.wavelengths != target.wavelengths)
+    throw Error(ErrorClass::bad_data, "across lamps: the sensitivities and the chart under " + target.lamp + " are on different grids");
+  if (o.draws < 0) throw Error(ErrorClass::bad_parameter, "across lamps: draws must be ≥ 0");
+  const ChartData predicted = target.predict(s.curves);
+  FitOptions fo;
+  fo.input_scale = 1.0;  // white-balanced: the perfect white is 1 in every channel, under any lamp
+  const Selection sel = select_method(o.methods, o.targets, predicted, fo, o.cv);
+  const FitReport& chosen = sel.candidates[sel.chosen];
+  fo.target = chosen.target;
+  Characterization model = fit_method(chosen.method, predicted, fo);
+  // Each draw refits the chosen family at the point fit's smoothing: the draws measure what the curves' uncertainty
+  // does to this model, not to a λ search (which would cost 41 fits per draw).
+  auto refit = [&](const ChartData& chart) {
+    if (!model.spline()) return fit_method(chosen.method, chart, fo);
+    SplineOptions so = spline_options(chosen.method, fo);
+    so.smoothing = model.spline()->smoothing();
+    return Characterization(fit_spline(chart, so));
+  };
+  std::vector<Characterization> draws;
+  std::mt19937 rng(o.seed);
+  for (int d = 0; d < o.draws; ++d) draws.push_back(refit(target.predict(s.draw(rng))));
+
+  LampCharacterization out{.lamp = target.lamp,
+                           .lamp_measured = target.lamp_measured,
+                           .warnings = {},
+                           .method = "across-lamps:" + target.lamp + ":" + chosen.method,
+                           .family = chosen.method,
+                           .target = chosen.target,
+                           .parameters = chosen.parameters,
+                           .cv = chosen.cv,
+                           .model = std::move(model),
+                           .draws = std::move(draws),
+                           .misfit95 = quantile(chosen.cv.de00, 0.95)};
+  if (!target.lamp_warning.empty()) out.warnings.push_back(target.lamp_warning);
+  return out;
+}
+
+Eigen::VectorXd LampCharacterization::uncertainty95(const Eigen::MatrixXd& rgb) const {
+  const Eigen::MatrixXd centre = model.apply(rgb);
+  std::vector<Eigen::MatrixXd> drawn;
+  drawn.reserve(draws.size());
+  for (const auto& d : draws) drawn.push_back(d.apply(rgb));
+  Eigen::VectorXd out(rgb.rows());
+  for (Eigen::Index i = 0; i < rgb.rows(); ++i) {
+    std::vector<double> de;
+    const Lab c{centre(i, 0), centre(i, 1), centre(i, 2)};
+    for (const auto& m : drawn) de.push_back(delta_e2000(c, Lab{m(i, 0), m(i, 1), m(i, 2)}));
+    const double spread = quantile(de, 0.95);
+    out(i) = std::hypot(spread, misfit95);
+  }
+  return out;
+}
+
+}  // namespace colorlab::analysis

@@ -1,0 +1,142 @@
+// Issue 26: a characterization carried across a lamp change through the camera's estimated sensitivities, against an
+// independent truth. The issue's fairness rules: the camera is left out of the sensitivity prior; the sensitivities
+// are estimated from a noisy photograph under the training lamp (SG × D65, 0.5 % multiplicative RAW noise); the test
+// chart (CC24, a different chart) is photographed under a MEASURED booth lamp (Gretag booth A and CWF, ../shared/data)
+// while the model assumes the CIE standard it is named after (A, F2). The truth is rendered here, on the booth file's
+// own 5 nm grid (the model integrates at 1 nm), with CIE 1931 XYZ Bradford-adapted to the ICC D50 white.
+//
+// What is asserted and why (bounds from the issue, never from a run):
+// - the across-lamps model beats the same-lamp selection applied across lamps (today's path) on mean and maximum
+//   ΔE00 in every case — the honest claim; the issue's Argyll targets (max below `colprof -ax` in ≥ 16/18, mean in
+//   18/18) are measured by bench_analysis_across_lamps, which runs colprof (docs/ACCURACY.md §6);
+// - the per-patch 95 % band holds the truth at ≥ 80 % of patches in every case (the issue's per-case bound) and at
+//   90–98 % pooled (the issue's calibration target) — see the comment at that assertion for what was measured;
+// - a nominal lamp is warned about, a measured one is not; bad lamps are typed errors.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "colorlab/analysis/colorimetry.hpp"
+#include "colorlab/analysis/relighting.hpp"
+#include "colorlab/analysis/standard_data.hpp"
+#include "colorlab/core/error.hpp"
+#include "test_support.hpp"
+
+namespace ca = colorlab::analysis;
+
+namespace {
+
+const std::vector<ca::FitTarget> kTargets = {ca::FitTarget::xyz_then_lab, ca::FitTarget::xyz_lightness_weighted, ca::FitTarget::lab_direct};
+
+// White-balanced camera RGB and reference L*a*b* of a chart under a lamp, on the lamp's own grid (5 nm for the booth).
+ca::ChartData truth_chart(const ca::SpectralSet& refl, const ca::SpectralSet& lamp, const ca::SpectralSet& curves) {
+  std::vector<double> grid;
+  for (double w : lamp.wavelengths)
+    if (w >= curves.wavelengths.front() && w <= curves.wavelengths.back()) grid.push_back(w);
+  const auto r = ca::resample(refl, grid, ca::Interpolation::linear);
+  const auto s = ca::resample(curves, grid, ca::Interpolation::linear);
+  const auto l = ca::resample(lamp, grid, ca::Interpolation::linear);
+  const Eigen::RowVectorXd e = l.values.row(0);
+  const Eigen::MatrixXd raw = (r.values.array().rowwise() * e.array()).matrix() * s.values.transpose();
+  const Eigen::RowVectorXd white = e * s.values.transpose();
+  ca::ChartData c;
+  c.ids = refl.names;
+  c.rgb = raw.array().rowwise() / white.array();
+  const ca::ReflectanceIntegrator integ(lamp, ca::load_observer(ca::Observer::cie1931_2deg), refl.wavelengths);
+  const auto xyz = integ.xyz(refl);
+  c.xyz.resize(static_cast<Eigen::Index>(xyz.size()), 3);
+  for (std::size_t i = 0; i < xyz.size(); ++i) {
+    const ca::Xyz a = ca::bradford_adapt(xyz[i], integ.white(), ca::kIccD50White);
+    c.xyz.row(static_cast<Eigen::Index>(i)) << a.X, a.Y, a.Z;
+  }
+  c.lab = ca::xyz_rows_to_lab(c.xyz, c.white);
+  return c;
+}
+
+ca::SpectralSet camera(const ca::SpectralSet& cams, const std::string& name) {
+  ca::SpectralSet s = cams.select({cams.require(name + "_R"), cams.require(name + "_G"), cams.require(name + "_B")});
+  s.names = {"R", "G", "B"};
+  return s;
+}
+
+}  // namespace
+
+TEST(AcrossLamps, BeatsTheSameLampModelAndItsBandHoldsTheTruth) {
+  COLORLAB_REQUIRE_SHARED(cams_file, "camera_ssf_camspec_jiang2013_28cams_10nm_400_720.csv");
+  COLORLAB_REQUIRE_SHARED(sg_file, "colorcheckersg_isetcam_imai_lin_2010_10nm_380_730.csv");
+  COLORLAB_REQUIRE_SHARED(cc_file, "colorchecker24_babelcolor_avg30_10nm_380_730.csv");
+  COLORLAB_REQUIRE_SHARED(booth_file, "gretag_lightbooth_measured_spd_isetcam_2020_5nm_380_780.csv");
+  const auto cams = ca::read_spectra(cams_file), sg = ca::read_spectra(sg_file), cc = ca::read_spectra(cc_file);
+  const auto booth = ca::read_spectra(booth_file);
+  const auto& grid = cams.wavelengths;
+  const auto sg_d65 = ca::chart_under_lamp(sg, ca::nominal_lamp("D65"), grid);
+  const std::vector<std::pair<std::string, std::string>> lamps = {{"A", "booth_A"}, {"F2", "booth_CWF"}};
+  std::map<std::string, ca::ChartUnderLamp> assumed;
+  for (const auto& [standard, measured] : lamps) assumed.emplace(standard, ca::chart_under_lamp(sg, ca::nominal_lamp(standard), grid));
+
+  long inside_all = 0, patches_all = 0;
+  for (const std::string cam : {"Canon_20D", "Nikon_D3X"}) {
+    const auto curves = camera(cams, cam);
+    ca::ChartData photo = truth_chart(sg, ca::resample(ca::load_illuminant("D65"), std::vector<double>(grid), ca::Interpolation::linear), curves);
+    std::mt19937 rng(7);
+    std::normal_distribution<double> nd(0, 1);
+    for (Eigen::Index i = 0; i < photo.rgb.rows(); ++i)
+      for (int c = 0; c < 3; ++c) photo.rgb(i, c) *= 1 + 0.005 * nd(rng);
+    const auto est = ca::estimate_sensitivities(sg_d65, photo.rgb, ca::learn_sensitivity_prior(cams, grid, {cam}));
+
+    ca::FitOptions fo;
+    fo.input_scale = 1.0;
+    const auto sel = ca::select_method(ca::all_methods(), kTargets, photo, fo, ca::CvSpec::loo());
+    fo.target = sel.candidates[sel.chosen].target;
+    const auto today = ca::fit_method(sel.candidates[sel.chosen].method, photo, fo);
+
+    for (const auto& [standard, measured] : lamps) {
+      SCOPED_TRACE(cam + " D65 → " + measured + " (model assumes CIE " + standard + ")");
+      const auto test = truth_chart(cc, booth.select({booth.require(measured)}), curves);
+      const auto relit = ca::characterize_across_lamps(est, assumed.at(standard));
+      EXPECT_EQ(relit.lamp, standard);
+      ASSERT_FALSE(relit.warnings.empty()) << "a nominal lamp must be warned about";
+      const auto e = ca::evaluate(relit.apply(test.rgb), test.lab);
+      const auto t = ca::evaluate(today.apply(test.rgb), test.lab);
+      EXPECT_LT(e.s00.mean, t.s00.mean);
+      EXPECT_LT(e.s00.max, t.s00.max);
+      const Eigen::VectorXd band = relit.uncertainty95(test.rgb);
+      long inside = 0;
+      for (Eigen::Index i = 0; i < band.size(); ++i) inside += e.de00[static_cast<std::size_t>(i)] <= band(i);
+      EXPECT_GE(static_cast<double>(inside) / static_cast<double>(band.size()), 0.80) << "issue 26: ≥ 80 % in every single case";
+      inside_all += inside;
+      patches_all += band.size();
+      std::cout << cam << " → " << measured << ": across lamps " << relit.family << " " << e.s00.mean << " / " << e.s00.max
+                << ", today " << t.s00.mean << " / " << t.s00.max << ", inside band " << inside << "/" << band.size() << "\n";
+    }
+  }
+  const double pooled = static_cast<double>(inside_all) / static_cast<double>(patches_all);
+  // The issue's 90–98 %: the lower end is asserted (the band is not overconfident). The upper end is not, here: over
+  // 96 patches one patch is 1 %, and a 95 % band's count has a binomial standard deviation of 2.2 %; the bench measures
+  // it over 9 cameras × 3 lamps (docs/ACCURACY.md §6).
+  EXPECT_GE(pooled, 0.90) << "issue 26: the truth inside the 95 % band at 90–98 % over all cases";
+}
+
+TEST(AcrossLamps, NominalLampsAreWarnedAboutAndBadLampsAreTypedErrors) {
+  const auto tl84 = ca::nominal_lamp("TL84");
+  EXPECT_FALSE(tl84.measured);
+  EXPECT_NE(tl84.warning().find("nominal"), std::string::npos);
+  EXPECT_NE(tl84.warning().find("TL84"), std::string::npos);
+  const auto m = ca::measured_lamp("TL84", tl84.spd);
+  EXPECT_TRUE(m.measured);
+  EXPECT_TRUE(m.warning().empty());
+  try {
+    (void)ca::nominal_lamp("sodium");
+    FAIL() << "no standard for a sodium lamp";
+  } catch (const colorlab::Error& e) {
+    EXPECT_EQ(e.cls(), colorlab::ErrorClass::not_found);
+  }
+  ca::SpectralSet bad = tl84.spd;
+  bad.values(0, 3) = -1;
+  EXPECT_THROW((void)ca::measured_lamp("TL84", bad), colorlab::Error);
+  ca::SpectralSet two = tl84.spd;
+  two.values.conservativeResize(2, Eigen::NoChange);
+  two.values.row(1) = two.values.row(0);
+  two.names.push_back("x");
+  EXPECT_THROW((void)ca::measured_lamp("TL84", two), colorlab::Error);
+}
