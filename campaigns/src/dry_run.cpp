@@ -149,7 +149,9 @@ asio::awaitable<json> dry_run_campaign_async(DryRunSetup setup) {
         json computed;
         const auto started = std::chrono::steady_clock::now();
         try {
-          computed = co_await setup.compute(sink.what, std::move(sink.compute_job));
+          // The awaitable first, then co_await it: no temporaries in the co_await expression (GCC 12).
+          auto pending = setup.compute(sink.what, std::move(sink.compute_job));
+          computed = co_await std::move(pending);
         } catch (const Error& e) {
           failure = e.info().message;
         } catch (const std::exception& e) {

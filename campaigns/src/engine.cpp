@@ -132,7 +132,9 @@ asio::awaitable<RunOutcome> run_campaign_script(ScriptRunSetup setup, Lab& lab, 
           std::optional<std::string> failure;
           json computed;
           try {
-            computed = co_await setup.compute(engine.compute_what_, std::move(job));
+            // The awaitable first, then co_await it: no temporaries in the co_await expression (GCC 12).
+            auto pending = setup.compute(engine.compute_what_, std::move(job));
+            computed = co_await std::move(pending);
           } catch (const Error& e) {
             failure = e.info().message;
           } catch (const std::exception& e) {

@@ -246,7 +246,8 @@ Daemon::Daemon(DaemonConfig config) : impl_(std::make_unique<Impl>()) {
     // A heavy route's answer (a dry run): awaited on the main thread, which serves meanwhile while
     // the work runs on the worker pool. `later` stays alive here until it has answered.
     const auto later = answer.later;
-    co_return co_await asio::co_spawn(io, later->answer(), asio::use_awaitable);
+    auto answered = asio::co_spawn(io, later->answer(), asio::use_awaitable);
+    co_return co_await std::move(answered);
   };
   d.server = std::make_unique<http::Server>(d.io, so, http::AsyncHandler(handler));
   d.server->start();

@@ -128,7 +128,7 @@ TEST(WorkerPool, ExceptionsArriveAsTypedErrors) {
   run_until(io, [&] { return typed.arrived && foreign.arrived; }, "both errors");
   ASSERT_TRUE(typed.error);
   EXPECT_EQ(typed.error->cls(), ErrorClass::bad_data);
-  EXPECT_STREQ(typed.error->what(), "too few patches");
+  EXPECT_EQ(typed.error->info().message, "too few patches");
   ASSERT_TRUE(foreign.error);
   EXPECT_EQ(foreign.error->cls(), ErrorClass::internal);
   EXPECT_NE(std::string(foreign.error->what()).find("Eigen gave up"), std::string::npos);

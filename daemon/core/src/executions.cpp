@@ -190,7 +190,8 @@ asio::awaitable<json> Executions::dry_run(const std::string& campaign_name, cons
       return pool->run(std::move(what), std::move(job), Admission::always);
     };
   }
-  co_return co_await campaigns::dry_run_campaign_async(std::move(setup));
+  auto report = campaigns::dry_run_campaign_async(std::move(setup));
+  co_return co_await std::move(report);
 }
 
 store::ExecutionRecord Executions::start(const std::string& campaign_name, const json& params,

@@ -37,20 +37,36 @@ void WorkerPool::submit(std::string what, std::function<json()> job, std::functi
   wake_.notify_one();
 }
 
+namespace {
+
+// Named, and handed to async_initiate outside any co_await: GCC 12 destroys some temporaries of a
+// co_await expression twice.
+struct RunInitiation {
+  WorkerPool* pool;
+  asio::any_io_executor results;
+  std::string what;
+  std::function<json()> job;
+  Admission admission;
+
+  template <class Handler>
+  void operator()(Handler handler) {
+    // The awaitable's handler is move-only; the pool's callbacks are std::function.
+    auto shared = std::make_shared<Handler>(std::move(handler));
+    try {
+      pool->submit(std::move(what), std::move(job), [shared](std::exception_ptr e, json j) { (*shared)(e, std::move(j)); },
+                   admission);
+    } catch (...) {
+      // A refusal arrives like a job's error, and never inside the initiation.
+      asio::post(results, [shared, e = std::current_exception()] { (*shared)(e, json()); });
+    }
+  }
+};
+
+}  // namespace
+
 asio::awaitable<json> WorkerPool::run(std::string what, std::function<json()> job, Admission admission) {
-  co_return co_await asio::async_initiate<const asio::use_awaitable_t<>&, void(std::exception_ptr, json)>(
-      [this, what = std::move(what), job = std::move(job), admission](auto handler) mutable {
-        // The awaitable's handler is move-only; the pool's callbacks are std::function.
-        auto shared = std::make_shared<decltype(handler)>(std::move(handler));
-        try {
-          submit(std::move(what), std::move(job), [shared](std::exception_ptr e, json j) { (*shared)(e, std::move(j)); },
-                 admission);
-        } catch (...) {
-          // A refusal arrives like a job's error, and never inside the initiation.
-          asio::post(results_, [shared, e = std::current_exception()] { (*shared)(e, json()); });
-        }
-      },
-      asio::use_awaitable);
+  return asio::async_initiate<const asio::use_awaitable_t<>&, void(std::exception_ptr, json)>(
+      RunInitiation{this, results_, std::move(what), std::move(job), admission}, asio::use_awaitable);
 }
 
 std::shared_ptr<void> WorkerPool::admit(const std::string& what) {

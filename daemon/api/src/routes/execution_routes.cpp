@@ -35,7 +35,9 @@ HttpResponse control(ApiContext& ctx, const std::string& id, const std::string& 
 // Parameters by value: a coroutine's frame keeps them, whatever becomes of the request.
 boost::asio::awaitable<HttpResponse> dry_run_answer(ApiContext& ctx, std::string campaign, json params, std::string path) {
   try {
-    co_return HttpResponse::json(200, co_await ctx.executions.dry_run(campaign, params));
+    auto report = ctx.executions.dry_run(campaign, params);
+    const json answer = co_await std::move(report);
+    co_return HttpResponse::json(200, answer);
   } catch (const Error& e) {
     co_return error_response(e, path);
   }
