@@ -9,11 +9,11 @@ one run:
    characterize-camera at full size, dimmer-exposure) and the probe runs until the group has ended.
 
 The probe in each phase: two clients, each polling every 20 ms, in turn, GET /v1, /v1/instruments, /v1/runs,
-/v1/runs/{id} (the newest run), /v1/control and /v1/queue; a third client runs `probe-ask` (a campaign of
-this probe's, touching no instrument, written to the daemon's campaign directory) and answers each of its
-operator requests as it appears (POST /v1/requests/{id}), and every 20 ms pauses and resumes it (POST
-/v1/executions/{id}/pause, /resume: a resume just after the pause cancels it before its safe point, or
-resumes the paused run). Every answer's time is from the request sent to the whole answer read.
+/v1/runs/{id} (the newest run), /v1/control and /v1/queue; a third client, every 20 ms, answers an operator request and pauses and
+resumes an execution (POST /v1/requests/{id}, /v1/executions/{id}/pause, /resume). Any unfinished execution
+holds the night's queue, so these go to `probe-ask` (a campaign of this probe's, touching no instrument, run
+once before the phases and answered): its request is no longer open (404) and it has ended (409). The same
+handlers on the same main thread find and refuse them: what they measure is the wait behind other work there. Every answer's time is from the request sent to the whole answer read.
 
 Reports per route and phase: count, p50, p99 and the slowest answer (ms), and the machine's load average.
 Target (issue 27): the slowest answer of every route <= 50 ms in the busy phase.
@@ -120,38 +120,44 @@ def reader(url, times, stop, run_id):
             time.sleep(0.02)
 
 
-def operator(url, times, stop):
-    """Runs probe-ask and answers its requests; pauses and resumes it."""
+def operator(url, times, stop, ended_id):
+    """Operator answers, pause and resume, on the main thread's handlers. Any unfinished execution holds the
+    night's queue, so none is kept waiting beside the study: the answer goes to a request that is no longer
+    open (404) and pause/resume to an ended execution (409) — the same routes, found and refused on the main
+    thread, which is where they would wait behind heavy work."""
     session = requests.Session()
-    e = session.post(url + "/v1/executions", json={"campaign": "probe-ask", "params": {}}).json()
-    eid = e["id"]
     while not stop.is_set():
-        r = session.get(url + "/v1/requests")
-        items = [i for i in r.json().get("items", []) if i.get("execution_id", eid) == eid] if r.ok else []
-        if items:
-            timed(session, times, "POST /v1/requests/{id}", "POST", url + "/v1/requests/" + items[0]["id"],
-                  json={"answer": "again"})
-        timed(session, times, "POST /v1/executions/{id}/pause", "POST", url + f"/v1/executions/{eid}/pause", json={})
-        timed(session, times, "POST /v1/executions/{id}/resume", "POST", url + f"/v1/executions/{eid}/resume",
+        timed(session, times, "POST /v1/requests/{id}", "POST", url + "/v1/requests/" + ended_id[1], json={"answer": "go"})
+        timed(session, times, "POST /v1/executions/{id}/pause", "POST", url + f"/v1/executions/{ended_id[0]}/pause",
+              json={})
+        timed(session, times, "POST /v1/executions/{id}/resume", "POST", url + f"/v1/executions/{ended_id[0]}/resume",
               json={})
         time.sleep(0.02)
-    # Let it end: answer stop (resume first, should the last pause have landed).
-    for _ in range(500):
-        session.post(url + f"/v1/executions/{eid}/resume", json={})
-        st = session.get(url + f"/v1/executions/{eid}").json()
-        if st["status"] in TERMINAL:
-            return
-        for i in session.get(url + "/v1/requests").json().get("items", []):
-            session.post(url + "/v1/requests/" + i["id"], json={"answer": "stop"})
-        time.sleep(0.05)
 
 
-def probe(url, until, label):
+def answered_execution(url):
+    """probe-ask run once and answered: (its execution id, its request id), both ended."""
+    session = requests.Session()
+    e = session.post(url + "/v1/executions", json={"campaign": "probe-ask", "params": {}}).json()
+    for _ in range(2000):
+        items = [i for i in session.get(url + "/v1/requests").json().get("items", []) if i.get("execution_id") == e["id"]]
+        if items:
+            session.post(url + "/v1/requests/" + items[0]["id"], json={"answer": "stop"})
+            break
+        time.sleep(0.02)
+    for _ in range(2000):
+        if session.get(url + f"/v1/executions/{e['id']}").json()["status"] in TERMINAL:
+            return e["id"], items[0]["id"]
+        time.sleep(0.02)
+    raise SystemExit("probe-ask did not end")
+
+
+def probe(url, until, label, ended_id):
     times = Times()
     stop = threading.Event()
     run_id = [""]
     threads = [threading.Thread(target=reader, args=(url, times, stop, run_id)) for _ in range(2)]
-    threads.append(threading.Thread(target=operator, args=(url, times, stop)))
+    threads.append(threading.Thread(target=operator, args=(url, times, stop, ended_id)))
     load0 = os.getloadavg()
     t0 = time.monotonic()
     for t in threads:
@@ -200,9 +206,10 @@ def main():
     with tempfile.TemporaryDirectory(prefix="latency-probe-") as state:
         proc, url = start_daemon(a.build, state, a.time_scale)
         try:
-            idle = probe(url, lambda: time.sleep(a.idle_s), "idle")
+            ended = answered_execution(url)
+            idle = probe(url, lambda: time.sleep(a.idle_s), "idle", ended)
             study = {}
-            busy = probe(url, lambda: study.update(run_study(url)), "study")
+            busy = probe(url, lambda: study.update(run_study(url)), "study", ended)
         finally:
             proc.terminate()
             proc.wait(timeout=60)
