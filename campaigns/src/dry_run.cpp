@@ -3,9 +3,16 @@
 #include <algorithm>
 #include <chrono>
 #include <map>
+#include <optional>
 #include <set>
 #include <system_error>
 
+#include <boost/asio/co_spawn.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/post.hpp>
+#include <boost/asio/this_coro.hpp>
+#include <boost/asio/use_awaitable.hpp>
+#include <boost/asio/use_future.hpp>
 #include <lua5.4/lua.hpp>
 
 #include "colorlab/campaigns/lab_api.hpp"
@@ -18,6 +25,7 @@
 
 namespace colorlab::campaigns {
 
+namespace asio = boost::asio;
 using nlohmann::json;
 
 namespace {
@@ -37,7 +45,18 @@ class DrySink final : public LabCallSink {
   }
   void progress(double, const std::string&) override {}
   void log(const std::string&) override {}
+  bool compute(const std::string& w, std::function<json()>& job) override {
+    if (!offload) return false;
+    what = w;
+    compute_job = std::move(job);
+    has_compute = true;
+    return true;
+  }
 
+  bool offload = false;
+  bool has_compute = false;
+  std::string what;
+  std::function<json()> compute_job;
   lua_State* thread = nullptr;
   bool has_request = false;
   std::string call;
@@ -81,12 +100,23 @@ double nominal_lab_seconds(const std::string& key, const LabOptions& options) {
 }
 
 json dry_run_campaign(const DryRunSetup& setup) {
+  // No executor of the caller's: the dry run's own, for its (then inline) computations.
+  asio::io_context io;
+  DryRunSetup inline_setup = setup;
+  inline_setup.compute = nullptr;
+  auto result = asio::co_spawn(io, dry_run_campaign_async(std::move(inline_setup)), asio::use_future);
+  io.run();
+  return result.get();
+}
+
+asio::awaitable<json> dry_run_campaign_async(DryRunSetup setup) {
   const CampaignScript& script = *setup.script;
   const std::string file = script.name + ".lua";
   const double scale = setup.options.time_scale > 0 ? setup.options.time_scale : 1.0;
   static const InstrumentSet no_instruments;
   DryLab lab(setup.instruments ? *setup.instruments : no_instruments, setup.runs);
   DrySink sink;
+  sink.offload = static_cast<bool>(setup.compute);
   TimingKeys keys;
   std::vector<DryProblem> problems;
   std::map<std::string, KeyCost> by_key;
@@ -112,7 +142,34 @@ json dry_run_campaign(const DryRunSetup& setup) {
     script_wall_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - resumed).count();
     if (status == LUA_YIELD) {
       lua_pop(thread, nresults);
+      if (sink.has_compute) {
+        // An analysis on the daemon's worker pool: its time is the script's own, as if inline.
+        sink.has_compute = false;
+        std::optional<std::string> failure;
+        json computed;
+        const auto started = std::chrono::steady_clock::now();
+        try {
+          // The awaitable first, then co_await it: no temporaries in the co_await expression (GCC 12).
+          auto pending = setup.compute(sink.what, std::move(sink.compute_job));
+          computed = co_await std::move(pending);
+        } catch (const Error& e) {
+          failure = e.info().message;
+        } catch (const std::exception& e) {
+          failure = e.what();
+        }
+        script_wall_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+        if (failure) {
+          lua_pushstring(thread, failure->c_str());
+        } else {
+          push_json(thread, computed);
+        }
+        lua_pushboolean(thread, failure ? 0 : 1);
+        nargs = 2;
+        continue;
+      }
       if (sandbox.take_slice_yield() && !sink.has_request) {
+        // A long stretch of the script's own computation: on the daemon, let it serve meanwhile.
+        if (setup.compute) co_await asio::post(co_await asio::this_coro::executor, asio::use_awaitable);
         nargs = 0;
         continue;
       }
@@ -280,7 +337,7 @@ json dry_run_campaign(const DryRunSetup& setup) {
                             {"script_wall_s", script_wall_s},
                             {"by_key", keys_json}};
   report["storage"] = storage;
-  return report;
+  co_return report;
 }
 
 }  // namespace colorlab::campaigns

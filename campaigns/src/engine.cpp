@@ -51,6 +51,13 @@ class Engine final : public LabCallSink {
     if (live_) progress_changed_ = true;
   }
   void log(const std::string& text) override { log::info(setup_.script->name, text); }
+  bool compute(const std::string& what, std::function<json()>& job) override {
+    if (!setup_.compute) return false;
+    compute_what_ = what;
+    compute_job_ = std::move(job);
+    has_compute_ = true;
+    return true;
+  }
 
   ScriptRunSetup& setup_;
   lua_State* thread_ = nullptr;
@@ -63,6 +70,9 @@ class Engine final : public LabCallSink {
   double progress_ = 0;
   bool progress_changed_ = false;
   bool live_ = false;
+  bool has_compute_ = false;
+  std::string compute_what_;
+  std::function<json()> compute_job_;
 };
 
 }  // namespace
@@ -114,6 +124,31 @@ asio::awaitable<RunOutcome> run_campaign_script(ScriptRunSetup setup, Lab& lab, 
       int status = lua_resume(thread, L, nargs, &nresults);
       if (status == LUA_YIELD) {
         lua_pop(thread, nresults);
+        if (engine.has_compute_) {
+          // An analysis off this thread (the daemon's worker pool): the daemon serves while it runs.
+          // Not a lab call: nothing is journaled, and a replay computes it again.
+          engine.has_compute_ = false;
+          auto job = std::move(engine.compute_job_);
+          std::optional<std::string> failure;
+          json computed;
+          try {
+            // The awaitable first, then co_await it: no temporaries in the co_await expression (GCC 12).
+            auto pending = setup.compute(engine.compute_what_, std::move(job));
+            computed = co_await std::move(pending);
+          } catch (const Error& e) {
+            failure = e.info().message;
+          } catch (const std::exception& e) {
+            failure = e.what();
+          }
+          if (failure) {
+            lua_pushstring(thread, failure->c_str());
+          } else {
+            push_json(thread, computed);
+          }
+          lua_pushboolean(thread, failure ? 0 : 1);
+          nargs = 2;
+          continue;
+        }
         if (sandbox.take_slice_yield() && !engine.has_request_) {
           // A long computation between lab calls: let the daemon serve, then go on.
           co_await asio::post(co_await asio::this_coro::executor, asio::use_awaitable);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <vector>
 
@@ -309,30 +310,72 @@ int analysis_compare_lamps(lua_State* L) {
   return 1;
 }
 
+// The stack holds what the engine resumed the script with: the result and true, or a message and false.
+int finish_computed(lua_State* L, int /*status*/, lua_KContext /*ctx*/) {
+  const bool ok = lua_toboolean(L, -1);
+  lua_pop(L, 1);
+  if (!ok) return raise_top(L);
+  return 1;
+}
+
+// A computation that may take seconds (a fit): its arguments are read here, on the script's thread,
+// and the sink may run it elsewhere (the daemon's worker pool) while the script waits, yielded, so
+// that the daemon serves meanwhile. Without such a sink (a script's declaration, a coroutine of the
+// script's own, the dry run) it runs here, as any analysis. `prepare` returns the job, which must own
+// everything it reads. Every C++ object is gone before a Lua error longjmps over this frame.
+template <class Prepare>
+int computed(lua_State* L, const char* what, Prepare&& prepare) {
+  LabCallSink* sink = sink_of(L);
+  bool failed = false;
+  bool yielded = false;
+  {
+    try {
+      std::function<json()> job = prepare();
+      if (sink && sink->is_campaign_thread(L) && lua_isyieldable(L) && sink->compute(what, job)) {
+        yielded = true;
+      } else {
+        json result = job();
+        lua_settop(L, 0);
+        push_json(L, result);
+      }
+    } catch (const Error& e) {
+      lua_pushstring(L, e.info().message.c_str());
+      failed = true;
+    } catch (const std::exception& e) {
+      lua_pushstring(L, e.what());
+      failed = true;
+    }
+  }
+  if (failed) return raise_top(L);
+  if (yielded) {
+    lua_settop(L, 0);
+    return lua_yieldk(L, 0, 0, finish_computed);
+  }
+  return 1;
+}
+
 // lab.analysis.characterize(camera_values, reference, options) → chapter 7's approaches (characterize.hpp).
 int analysis_characterize(lua_State* L) {
-  guarded(L, [&] {
+  return computed(L, "lab.analysis.characterize", [L]() -> std::function<json()> {
     json camera = to_json(L, 1, "lab.analysis.characterize's camera values");
     json reference = to_json(L, 2, "lab.analysis.characterize's reference");
     json options = lua_gettop(L) >= 3 && !lua_isnil(L, 3) ? to_json(L, 3, "lab.analysis.characterize's options") : json::object();
-    json result = characterize(camera, reference, options);
-    lua_settop(L, 0);
-    push_json(L, result);
+    return [camera = std::move(camera), reference = std::move(reference), options = std::move(options)] {
+      return characterize(camera, reference, options);
+    };
   });
-  return 1;
 }
 
 // lab.analysis.floor_luminance(photograph, calibration, {degree =, subset =}) → the floor's luminance (floor_photograph.hpp).
 int analysis_floor_luminance(lua_State* L) {
-  guarded(L, [&] {
+  return computed(L, "lab.analysis.floor_luminance", [L]() -> std::function<json()> {
     json photo = to_json(L, 1, "lab.analysis.floor_luminance's photograph");
     json calibration = to_json(L, 2, "lab.analysis.floor_luminance's calibration");
     json options = lua_gettop(L) >= 3 && !lua_isnil(L, 3) ? to_json(L, 3, "lab.analysis.floor_luminance's options") : json::object();
-    json result = floor_luminance(photo, calibration, options);
-    lua_settop(L, 0);
-    push_json(L, result);
+    return [photo = std::move(photo), calibration = std::move(calibration), options = std::move(options)] {
+      return floor_luminance(photo, calibration, options);
+    };
   });
-  return 1;
 }
 
 // lab.chart.plan{chart=, first_x_mm=, first_y_mm=, pitch_mm=} → the chart's patches on the table in visiting order.
@@ -400,10 +443,8 @@ void install_lab_api(lua_State* L, LabCallSink* sink) {
   lua_setfield(L, -2, "dimmer_proportionality");
   lua_pushcfunction(L, analysis_compare_lamps);
   lua_setfield(L, -2, "compare_lamps");
-  lua_pushcfunction(L, analysis_characterize);
-  lua_setfield(L, -2, "characterize");
-  lua_pushcfunction(L, analysis_floor_luminance);
-  lua_setfield(L, -2, "floor_luminance");
+  set_function(L, "characterize", analysis_characterize, sink);  // the sink may compute them off this thread
+  set_function(L, "floor_luminance", analysis_floor_luminance, sink);
   lua_setfield(L, -2, "analysis");
   lua_newtable(L);
   lua_pushcfunction(L, chart_plan_fn);

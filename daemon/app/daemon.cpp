@@ -33,6 +33,7 @@
 #include "colorlab/daemon/notifier.hpp"
 #include "colorlab/daemon/store_run_reader.hpp"
 #include "colorlab/daemon/systemd_notify.hpp"
+#include "colorlab/daemon/worker_pool.hpp"
 #include "colorlab/drivers/discovery_monitor.hpp"
 #include "colorlab/http/server.hpp"
 
@@ -53,6 +54,7 @@ struct Daemon::Impl {
   campaigns::OperatorDesk desk;
   std::unique_ptr<SimulatorHands> hands;
   std::unique_ptr<StoreRunReader> run_reader;  // lab.runs.* (characterize-camera's reference)
+  std::unique_ptr<WorkerPool> workers;  // fits and dry runs' analyses (worker_pool.hpp); outlives executions
   std::unique_ptr<Notifier> notices;  // [notify]: tells the operator (notifier.hpp); outlives executions
   std::unique_ptr<Executions> executions;
   std::unique_ptr<NightQueue> queue;
@@ -179,7 +181,10 @@ Daemon::Daemon(DaemonConfig config) : impl_(std::make_unique<Impl>()) {
       log::warning("operator", std::string("cannot record the request: ") + e.what());
     }
   });
+  // Fits, analyses and dry runs' analyses: off the io thread (worker_pool.hpp).
+  d.workers = std::make_unique<WorkerPool>(d.io.get_executor(), with_test_hooks(WorkerPoolOptions{}));
   ExecutionOptions execution_options;
+  execution_options.workers = d.workers.get();
   execution_options.crash_loop = {cc.max_resume_attempts, cc.crash_loop_backoff_s, cc.crash_loop_backoff_max_s,
                                   cc.crash_loop_retries};
   execution_options.state_dir = d.config.state_dir;
@@ -228,11 +233,21 @@ Daemon::Daemon(DaemonConfig config) : impl_(std::make_unique<Impl>()) {
   // thread. The route's row in the route table says which.
   auto handler = [api = d.api.get(), &io = d.io](http::HttpRequest& req) -> asio::awaitable<http::HttpResponse> {
     const Routed routed = route_request(req);
-    if (routed.placement() == Placement::pool) co_return handle_api(*api, req, routed);
-    // `req` and `routed` live in this coroutine's frame until the main thread has answered.
-    co_return co_await asio::co_spawn(
-        io, [api, &req, &routed]() -> asio::awaitable<http::HttpResponse> { co_return handle_api(*api, req, routed); },
-        asio::use_awaitable);
+    http::HttpResponse answer;
+    if (routed.placement() == Placement::pool) {
+      answer = handle_api(*api, req, routed);
+    } else {
+      // `req` and `routed` live in this coroutine's frame until the main thread has answered.
+      answer = co_await asio::co_spawn(
+          io, [api, &req, &routed]() -> asio::awaitable<http::HttpResponse> { co_return handle_api(*api, req, routed); },
+          asio::use_awaitable);
+    }
+    if (!answer.later) co_return answer;
+    // A heavy route's answer (a dry run): awaited on the main thread, which serves meanwhile while
+    // the work runs on the worker pool. `later` stays alive here until it has answered.
+    const auto later = answer.later;
+    auto answered = asio::co_spawn(io, later->answer(), asio::use_awaitable);
+    co_return co_await std::move(answered);
   };
   d.server = std::make_unique<http::Server>(d.io, so, http::AsyncHandler(handler));
   d.server->start();

@@ -2,6 +2,7 @@
 
 #include "colorlab/protocol/api.hpp"
 #include "colorlab/protocol/problem.hpp"
+#include "colorlab/daemon/worker_pool.hpp"
 #include "colorlab/store/queue.hpp"
 
 namespace colorlab::daemon {
@@ -31,6 +32,14 @@ http::HttpResponse error_response(const Error& e, const std::string& instance) {
   // A refusal about a queue item's references: its own code, so a client can tell it from another conflict.
   if (const auto* q = dynamic_cast<const store::QueueConflict*>(&e)) p.code = q->code();
   p.instance = instance;
+  // The worker pool's queue is full: busy, not broken; the client may try again shortly.
+  if (const auto* full = dynamic_cast<const WorkerPoolFull*>(&e)) {
+    p.code = "busy";
+    p.title = "Busy";
+    auto r = respond(p, nlohmann::json::object());
+    r.headers["Retry-After"] = std::to_string(full->retry_after_s());
+    return r;
+  }
   return respond(p, nlohmann::json::object());
 }
 

@@ -16,6 +16,7 @@
 #include "colorlab/daemon/blob_service.hpp"
 #include "colorlab/daemon/campaign_request.hpp"
 #include "colorlab/daemon/notifier.hpp"
+#include "colorlab/daemon/worker_pool.hpp"
 #include "colorlab/protocol/problem.hpp"
 
 namespace colorlab::daemon {
@@ -169,8 +170,10 @@ Executions::Executions(asio::io_context& io, store::Store& store, campaigns::Scr
 
 Executions::~Executions() = default;
 
-json Executions::dry_run(const std::string& campaign_name, const json& params) {
+asio::awaitable<json> Executions::dry_run(const std::string& campaign_name, const json& params) {
   auto [script, normalized] = validate_campaign_params(catalogue_, campaign_name, params);
+  // A slot in the worker pool's queue for the whole dry run, refused (503) while the pool is full.
+  std::shared_ptr<void> admitted = options_.workers ? options_.workers->admit("a dry run of " + campaign_name) : nullptr;
   campaigns::DryRunSetup setup;
   setup.script = script;
   setup.params = normalized;
@@ -180,7 +183,15 @@ json Executions::dry_run(const std::string& campaign_name, const json& params) {
   setup.runs = lab_.run_reader();
   setup.hands = lab_.hands();
   setup.state_dir = options_.state_dir;
-  return campaigns::dry_run_campaign(setup);
+  // The script's lab calls are answered here, on the io thread, where the instruments live; its fits
+  // run on the pool with their own copies of the data.
+  if (auto* pool = options_.workers) {
+    setup.compute = [pool](std::string what, std::function<json()> job) {
+      return pool->run(std::move(what), std::move(job), Admission::always);
+    };
+  }
+  auto report = campaigns::dry_run_campaign_async(std::move(setup));
+  co_return co_await std::move(report);
 }
 
 store::ExecutionRecord Executions::start(const std::string& campaign_name, const json& params,
@@ -369,6 +380,11 @@ void Executions::launch(store::ExecutionRecord record, std::shared_ptr<const cam
           setup.random_seed = record.random_seed;
           setup.initial_label = record.step;
           setup.initial_progress = record.progress;
+          if (auto* pool = options_.workers) {
+            setup.compute = [pool](std::string what, std::function<json()> job) {
+              return pool->run(std::move(what), std::move(job), Admission::always);
+            };
+          }
           auto run = store_.run(record.run_id);
           json snapshot = run ? run->instruments : json(nullptr);
           if (resumed) {

@@ -10,7 +10,11 @@
 // run would.
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
+#include <string>
+
+#include <boost/asio/awaitable.hpp>
 
 #include <nlohmann/json.hpp>
 
@@ -33,6 +37,9 @@ struct DryRunSetup {
   const OperatorHands* hands = nullptr;  // actions the simulated lab does itself
   std::filesystem::path state_dir;       // where the run's data would go (free space)
   std::size_t max_calls = 2'000'000;     // a script waiting for a reading the model never gives
+  // Where the script's long computations run (as ScriptRunSetup::compute): in the daemon, its worker
+  // pool, so a dry run's fits leave the io thread free. Empty: inline.
+  std::function<boost::asio::awaitable<nlohmann::json>(std::string what, std::function<nlohmann::json()> job)> compute;
 };
 
 // {campaign, ok, problems = [{kind, message, line?, call?}], stopped_at?, calls, measurements,
@@ -43,6 +50,9 @@ struct DryRunSetup {
 //  storage = {estimated_bytes, available_bytes}}.
 // Throws only for a script that cannot be loaded at all; everything else is a problem in the report.
 nlohmann::json dry_run_campaign(const DryRunSetup& setup);
+// The same as a coroutine on the caller's executor (the daemon's io thread), which it leaves between
+// stretches of the script's computation and while setup.compute runs the analyses.
+boost::asio::awaitable<nlohmann::json> dry_run_campaign_async(DryRunSetup setup);
 
 // The nominal cost of a call never timed on this lab, in lab seconds per unit (assumed figures:
 // no source publishes these instruments' timings), and why.

@@ -8,6 +8,7 @@
 // stored are skipped, and at the first call past the journal the lab is restored to the state the
 // replay says it should be in; from there the script runs live. docs/ARCHITECTURE.md says why.
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -93,6 +94,10 @@ struct ScriptRunSetup {
   // (resuming it from the API accepts the unit: verify_serials = false).
   std::map<std::string, std::string> expected_serials;
   bool verify_serials = true;
+  // Where long computations run (lab.analysis.characterize): the daemon's worker pool, so its io
+  // thread serves meanwhile. Resumes on the engine's executor with the result or the job's error.
+  // Empty: they run inline, on the engine's thread.
+  std::function<boost::asio::awaitable<nlohmann::json>(std::string what, std::function<nlohmann::json()> job)> compute;
 };
 
 boost::asio::awaitable<RunOutcome> run_campaign_script(ScriptRunSetup setup, Lab& lab, ExecutionSink& sink,

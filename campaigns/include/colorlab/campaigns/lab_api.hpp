@@ -3,6 +3,7 @@
 // checkpoint and the analysis library. Calls that touch an instrument or take time yield the
 // script's coroutine with a request the engine carries out (or answers from the journal on
 // replay); the rest run at once. Arguments are checked here so an error names the script line.
+#include <functional>
 #include <set>
 #include <string>
 
@@ -23,6 +24,10 @@ class LabCallSink {
   virtual void record(const std::string& step, const nlohmann::json& fields) = 0;
   virtual void progress(double fraction, const std::string& label) = 0;
   virtual void log(const std::string& text) = 0;
+  // A long computation (lab.analysis.characterize's fit): true when the sink takes `job` to run it
+  // elsewhere and resumes the script with its result (the script yields meanwhile); false leaves
+  // `job` to run at once, on the script's thread. The job owns what it reads.
+  virtual bool compute(const std::string& /*what*/, std::function<nlohmann::json()>& /*job*/) { return false; }
 };
 
 // A sink's record(): throws Error{script_error} when the script recorded `step` before in this run

@@ -1,5 +1,8 @@
 // Executions: POST /v1/executions (start or dry run), GET /v1/executions (the list, on the pool),
 // GET /v1/executions/{id}, and pause, resume, abort.
+#include <memory>
+
+#include <boost/asio/awaitable.hpp>
 #include <nlohmann/json.hpp>
 
 #include "colorlab/api/problem.hpp"
@@ -29,6 +32,17 @@ HttpResponse control(ApiContext& ctx, const std::string& id, const std::string& 
   return r;
 }
 
+// Parameters by value: a coroutine's frame keeps them, whatever becomes of the request.
+boost::asio::awaitable<HttpResponse> dry_run_answer(ApiContext& ctx, std::string campaign, json params, std::string path) {
+  try {
+    auto report = ctx.executions.dry_run(campaign, params);
+    const json answer = co_await std::move(report);
+    co_return HttpResponse::json(200, answer);
+  } catch (const Error& e) {
+    co_return error_response(e, path);
+  }
+}
+
 }  // namespace
 
 HttpResponse post_execution(ApiContext& ctx, const HttpRequest& req, const PathParams&) {
@@ -52,7 +66,13 @@ HttpResponse post_execution(ApiContext& ctx, const HttpRequest& req, const PathP
   }
   if (body.value("dry_run", false)) {
     // Nothing is stored and nothing moves: 200 with the dry run's report, not 202 with an execution.
-    return HttpResponse::json(200, ctx.executions.dry_run(body["campaign"].get<std::string>(), params));
+    // Answered later: the io thread serves other requests while the dry run's fits run on the pool.
+    HttpResponse later;
+    later.later = std::make_shared<http::LaterAnswer>(http::LaterAnswer{
+        [&ctx, campaign = body["campaign"].get<std::string>(), params, path = req.path] {
+          return dry_run_answer(ctx, campaign, params, path);
+        }});
+    return later;
   }
   auto record = ctx.executions.start(body["campaign"].get<std::string>(), params, req.header("idempotency-key"));
   auto r = HttpResponse::json(202, record.to_json());

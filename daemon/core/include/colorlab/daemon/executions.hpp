@@ -12,6 +12,7 @@
 #include <optional>
 #include <string>
 
+#include <boost/asio/awaitable.hpp>
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/steady_timer.hpp>
 #include <nlohmann/json.hpp>
@@ -25,11 +26,13 @@
 namespace colorlab::daemon {
 
 class Notifier;
+class WorkerPool;
 
 struct ExecutionOptions {
   CrashLoopPolicy crash_loop;       // includes max_resume_attempts
   std::filesystem::path state_dir;  // where runs are stored (a dry run checks its free space)
   Notifier* notifier = nullptr;     // told of suspensions, crash loops and failures; none: nobody is
+  WorkerPool* workers = nullptr;    // where scripts' analyses (fits) and dry runs compute; none: inline
 };
 
 class Executions {
@@ -44,8 +47,10 @@ class Executions {
                                const std::optional<std::string>& idempotency_key);
   // The campaign run against a lab that moves nothing (campaigns/dry_run.hpp): limits, instruments,
   // disk, operator actions and the estimated duration from this lab's learned call timings.
-  // Throws Error{bad_parameter|not_found} for an unknown campaign or invalid parameters.
-  nlohmann::json dry_run(const std::string& campaign, const nlohmann::json& params);
+  // Throws Error{bad_parameter|not_found} for an unknown campaign or invalid parameters, and
+  // WorkerPoolFull while the worker pool's queue is full. Runs on the io thread, which it leaves
+  // while the script's analyses run on the worker pool.
+  boost::asio::awaitable<nlohmann::json> dry_run(const std::string& campaign, const nlohmann::json& params);
   // At start-up: every execution a previous process left running or suspended continues, except one
   // the crash-loop guard suspends (or, its retries spent, ends) and one waiting out the guard's back-off.
   void resume_unfinished();

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <functional>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -52,6 +53,8 @@ class StreamWriter {
 };
 using StreamProducer = std::function<boost::asio::awaitable<void>(StreamWriter&)>;
 
+struct LaterAnswer;
+
 struct HttpResponse {
   int status = 200;
   std::string content_type = "application/json";
@@ -59,10 +62,17 @@ struct HttpResponse {
   std::map<std::string, std::string> headers;
   std::optional<FileSpan> file;  // when set, the body is this range of the file
   StreamProducer stream;         // when set, a chunked body produced until it returns
+  // When set, the handler's answer is not ready: the daemon awaits this on the thread that ran the
+  // handler (the io thread), which serves other requests meanwhile (a dry run's fits on the worker pool).
+  std::shared_ptr<const LaterAnswer> later;
 
   static HttpResponse json(int status, const nlohmann::json& body);
   static HttpResponse problem(int status, const std::string& code, const std::string& title, const std::string& detail,
                               const std::string& hint = {});
+};
+
+struct LaterAnswer {
+  std::function<boost::asio::awaitable<HttpResponse>()> answer;
 };
 
 using Handler = std::function<HttpResponse(const HttpRequest&)>;
