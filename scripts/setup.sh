@@ -32,6 +32,9 @@ packages=(
   libclang-rt-14-dev
   # the Debian package (docs/packaging.md): cpack's dpkg-shlibdeps, lintian, and mmdebstrap's throwaway chroot
   dpkg-dev binutils lintian mmdebstrap debian-archive-keyring
+  # colorlab-ship (fleet/): libpq for the central PostgreSQL; its tests start a throwaway PostgreSQL 15 and a
+  # one-replica OpenStack Swift with s3api (the bookworm S3 server that checks SigV4 and payload hashes)
+  libpq-dev postgresql-15 postgresql-client-15 swift swift-proxy swift-object swift-container swift-account memcached
 )
 
 missing=()
