@@ -204,7 +204,7 @@ TEST_F(Fleet, KillNineAtRandomMomentsConverges) {
   rng.seed(seed);
   // Calibrate: how long one cycle of 4 runs takes here, so the kills spread over all its phases (connect, blob
   // HEAD/PUT, COPY, insert, digest, commit, the position note).
-  for (int i = 0; i < 4; ++i) bench.run_campaign(ExecutionStatus::finished_ok, 40, 8);
+  for (int i = 0; i < 4; ++i) bench.run_campaign(ExecutionStatus::finished_ok, 15, 5);
   auto t0 = std::chrono::steady_clock::now();
   auto first = ship(config);
   ASSERT_EQ(first.exit_code, 0) << first.err;
@@ -213,7 +213,7 @@ TEST_F(Fleet, KillNineAtRandomMomentsConverges) {
 
   int kills = 0;
   for (int attempt = 0; kills < 20 && attempt < 80; ++attempt) {
-    bench.run_campaign(attempt % 3 == 1 ? ExecutionStatus::aborted : ExecutionStatus::finished_ok, 40, 8);
+    bench.run_campaign(attempt % 3 == 1 ? ExecutionStatus::aborted : ExecutionStatus::finished_ok, 15, 5);
     ct::Process agent({bin_path("colorlab-ship"), "--config", config.string(), "once"});
     std::this_thread::sleep_for(std::chrono::microseconds(when(rng)));
     if (agent.running()) {
