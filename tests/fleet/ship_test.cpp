@@ -312,4 +312,27 @@ TEST_F(Fleet, CentralSchemaOfAnotherVersionIsRefusedWithWhatToUpgrade) {
   EXPECT_EQ(pg.query("SELECT count(*) FROM runs").int64(0, 0), 0);
 }
 
+TEST_F(Fleet, PostgresStoppedInImmediateModeMidCycleConverges) {
+  SimBench bench(dir_ / "bench", "bench-p", 6);
+  for (int i = 0; i < 6; ++i) bench.run_campaign(ExecutionStatus::finished_ok, 15, 5);
+  auto config = bench.write_config(target(), 2);
+  ASSERT_EQ(ship(config).exit_code, 0);  // central set up, two runs in
+  for (int i = 0; i < 3; ++i) bench.run_campaign(ExecutionStatus::aborted, 15, 5);
+  // The server goes away without a checkpoint while (or before) the agent ships: crash recovery on restart.
+  ct::Process agent({bin_path("colorlab-ship"), "--config", config.string(), "once"});
+  servers().pg->stop_immediate();
+  auto code = agent.wait(std::chrono::seconds(120));
+  ASSERT_TRUE(code.has_value()) << "the agent hung with PostgreSQL gone";
+  EXPECT_TRUE(*code == 0 || *code == 1) << "exit " << *code;
+  servers().pg->start();
+  for (int i = 0; i < 10; ++i) {
+    auto r = ship(config);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    if (nlohmann::json::parse(r.out)["runs_shipped"] == 0) break;
+  }
+  fleet::BenchReader reader(bench.database());
+  EXPECT_EQ(position("bench-p"), reader.ended_after(0, 1000).back().ended_event);
+  expect_converged(bench);
+}
+
 }  // namespace
