@@ -37,6 +37,12 @@ struct Servers {
   fs::path root;
   std::unique_ptr<PostgresServer> pg;
   std::unique_ptr<SwiftServer> swift;
+  ~Servers() {
+    swift.reset();
+    pg.reset();
+    std::error_code ec;
+    fs::remove_all(root, ec);  // the Swift storage and the benches' state directories
+  }
 };
 
 // Under the build tree, on disk: Swift needs extended attributes, which tmpfs lacks.
@@ -48,16 +54,18 @@ fs::path scratch_root() {
 }
 
 Servers& servers() {
-  static Servers s = [] {
-    Servers x;
-    x.root = scratch_root();
-    x.pg = std::make_unique<PostgresServer>(fs::temp_directory_path() / ("colorlab-fleet-pg-" + std::to_string(::getpid())));
-    x.pg->start();
-    x.swift = std::make_unique<SwiftServer>(x.root / "swift");
-    std::cerr << "fleet servers: PostgreSQL initdb + start " << x.pg->start_seconds << " s, Swift s3api ready in "
-              << x.swift->start_seconds << " s\n";
-    return x;
-  }();
+  static Servers s;
+  if (!s.swift) {  // first use, or a previous start that failed
+    s.swift.reset();
+    s.pg.reset();
+    s.root = scratch_root();
+    s.pg = std::make_unique<PostgresServer>(fs::temp_directory_path() /
+                                            ("colorlab-fleet-pg-" + std::to_string(::getpid())));
+    s.pg->start();
+    s.swift = std::make_unique<SwiftServer>(s.root / "swift");
+    std::cerr << "fleet servers: PostgreSQL initdb + start " << s.pg->start_seconds << " s, Swift s3api ready in "
+              << s.swift->start_seconds << " s\n";
+  }
   return s;
 }
 
