@@ -217,20 +217,26 @@ TEST_F(Fleet, KillNineAtRandomMomentsConverges) {
   auto first = ship(config);
   ASSERT_EQ(first.exit_code, 0) << first.err;
   const auto cycle = std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - t0);
-  std::uniform_int_distribution<long long> when(0, cycle.count());
-
+  // Kill moments uniform in [0, upper). A kill that comes too late (the agent had already finished its smaller
+  // batch) halves `upper`, one that lands lets it grow back towards a whole cycle: the 20 kills always come (at
+  // upper = 0 the kill follows the fork at once), spread over every phase the machine's speed allows.
+  long long upper = cycle.count();
   int kills = 0;
-  for (int attempt = 0; kills < 20 && attempt < 80; ++attempt) {
+  for (int attempt = 0; kills < 20 && attempt < 400; ++attempt) {
     bench.run_campaign(attempt % 3 == 1 ? ExecutionStatus::aborted : ExecutionStatus::finished_ok, 15, 5);
     ct::Process agent({bin_path("colorlab-ship"), "--config", config.string(), "once"});
-    std::this_thread::sleep_for(std::chrono::microseconds(when(rng)));
+    std::this_thread::sleep_for(std::chrono::microseconds(
+        upper > 0 ? std::uniform_int_distribution<long long>(0, upper - 1)(rng) : 0));
     if (agent.running()) {
       agent.signal(SIGKILL);
       ++kills;
+      upper = std::min<long long>(cycle.count(), upper + upper / 2 + 1);
+    } else {
+      upper /= 2;
     }
     ASSERT_TRUE(agent.wait(std::chrono::seconds(60)).has_value());
   }
-  ASSERT_GE(kills, 20) << "the agent finished before every kill; the calibrated cycle was " << cycle.count() << " us";
+  ASSERT_GE(kills, 20) << "the calibrated cycle was " << cycle.count() << " us";
   // Convergence: cycles until nothing is left, each a clean exit.
   for (int i = 0; i < 40; ++i) {
     auto r = ship(config);
