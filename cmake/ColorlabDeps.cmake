@@ -64,6 +64,8 @@ colorlab_require_pkg(LIBTIFF libtiff-4 libtiff-dev)
 colorlab_require_pkg(SYSTEMD libsystemd libsystemd-dev)
 # colorlabd's webhook notifications ([notify]).
 colorlab_require_pkg(CURL libcurl libcurl4-openssl-dev)
+# colorlab-ship's central catalog (fleet/).
+colorlab_require_pkg(LIBPQ libpq libpq-dev)
 
 # Asio on Boost 1.74 + GCC 12 in C++20 uses std::exchange without including <utility>.
 add_library(colorlab_asio INTERFACE)

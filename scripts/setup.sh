@@ -38,6 +38,9 @@ packages=(
   clang-format clang-tidy
   # the wall clock stepped under colorlabd in tests (libfaketime, tests/integration/clock_step_test.cpp)
   faketime
+  # colorlab-ship (fleet/): libpq for the central PostgreSQL; its tests start a throwaway PostgreSQL 15 and a
+  # one-replica OpenStack Swift with s3api (the bookworm S3 server that checks SigV4 and payload hashes)
+  libpq-dev postgresql-15 postgresql-client-15 swift swift-proxy swift-object swift-container swift-account memcached
 )
 
 missing=()

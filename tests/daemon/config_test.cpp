@@ -132,3 +132,13 @@ events = ["crash-loop"]
     }
   }
 }
+
+// colorlab-ship's [ship] section lives in the same file (docs/fleet.md): colorlabd accepts it, learns only that
+// retention must keep unshipped blobs, and leaves its keys to colorlab-ship.
+TEST(DaemonConfig, ShipSectionTurnsOnRetentionsGuardForUnshippedBlobs) {
+  using colorlab::daemon::parse_config;
+  EXPECT_FALSE(parse_config("", "d.toml").blobs.keep_unshipped);
+  auto c = parse_config("[ship]\nbench_id = \"bench-1\"\npostgres = \"host=pg\"\n", "s.toml");
+  EXPECT_TRUE(c.blobs.keep_unshipped);
+  EXPECT_THROW(parse_config("ship = 3\n", "bad.toml"), Error);
+}

@@ -32,6 +32,15 @@ json capped(const json& list) {
   return out;
 }
 
+// colorlab-ship's note of what central holds (docs/fleet.md); 0, keeping everything, when it never shipped or the
+// note is unreadable.
+std::int64_t shipped_position(const fs::path& note) {
+  std::ifstream in(note);
+  long long v = 0;
+  if (!in || !(in >> v) || v < 0) return 0;
+  return v;
+}
+
 }  // namespace
 
 BlobService::BlobService(boost::asio::io_context& io, store::Store& writer, const fs::path& state_dir, BlobConfig config)
@@ -180,7 +189,12 @@ json BlobService::apply_retention(bool dry_run) {
                       std::chrono::duration_cast<std::chrono::system_clock::duration>(std::chrono::duration<double>(config_.retention_days * 86400));
   out["cutoff"] = iso8601_utc(cutoff);
   store::BlobIndex index(writer_);
-  auto expired = index.expired(out["cutoff"].get<std::string>(), config_.keep);
+  std::optional<std::int64_t> shipped;
+  if (config_.keep_unshipped) {
+    shipped = shipped_position(files_.root().parent_path() / "ship" / "shipped-position");
+    out["shipped_position"] = *shipped;
+  }
+  auto expired = index.expired(out["cutoff"].get<std::string>(), config_.keep, shipped);
   std::uint64_t bytes = 0;
   for (const auto& b : expired) {
     out["removed"].push_back({{"sha256", b.sha256}, {"size", b.size}, {"references", b.references}});

@@ -311,6 +311,10 @@ static DaemonConfig from_toml(const toml::table& root, const std::filesystem::pa
       }
     } else if (k == "blobs") {
       parse_blobs(node, c.blobs, file);
+    } else if (k == "ship") {
+      // colorlab-ship's section (fleet/, which checks its keys); colorlabd only learns that shipping is on.
+      if (!node.as_table()) bad(file, node.source(), "[ship] must be a table");
+      c.blobs.keep_unshipped = true;
     } else if (k == "instrument") {
       auto arr = node.as_array();
       if (!arr) bad(file, node.source(), "instruments are [[instrument]] tables");

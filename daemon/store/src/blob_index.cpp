@@ -57,13 +57,21 @@ std::optional<std::string> BlobIndex::preview_of(const std::string& sha256) {
   return st.text(0);
 }
 
-std::vector<ExpiredBlob> BlobIndex::expired(const std::string& cutoff, const std::vector<std::string>& keep) {
+std::vector<ExpiredBlob> BlobIndex::expired(const std::string& cutoff, const std::vector<std::string>& keep,
+                                            std::optional<std::int64_t> shipped_upto) {
   const std::string kinds = nlohmann::json(keep).dump();
+  // ?3 < 0: no shipping. Otherwise a run counts as shipped when the event that ended it is at or before ?3, the
+  // same test colorlab-ship uses to pick what to ship (fleet/src/bench_reader.cpp).
   auto st = db_.prepare(
       "SELECT b.sha256, b.size, r.run_id, r.name FROM blobs b LEFT JOIN run_blobs r ON r.sha256 = b.sha256 "
       "WHERE b.created_at < ?1 AND NOT EXISTS (SELECT 1 FROM run_blobs k WHERE k.sha256 = b.sha256 AND "
-      "(k.created_at >= ?1 OR k.kind IN (SELECT value FROM json_each(?2)))) ORDER BY b.sha256");
-  st.bind(1, std::string_view(cutoff)).bind(2, std::string_view(kinds));
+      "(k.created_at >= ?1 OR k.kind IN (SELECT value FROM json_each(?2)))) "
+      "AND (?3 < 0 OR NOT EXISTS (SELECT 1 FROM run_blobs u WHERE u.sha256 = b.sha256 AND NOT EXISTS ("
+      "SELECT 1 FROM event_log e WHERE e.seq <= ?3 AND e.topic = 'execution' AND "
+      "json_extract(e.payload, '$.run_id') = u.run_id AND "
+      "json_extract(e.payload, '$.status') IN ('finished_ok', 'finished_error', 'aborted', 'interrupted')))) "
+      "ORDER BY b.sha256");
+  st.bind(1, std::string_view(cutoff)).bind(2, std::string_view(kinds)).bind(3, shipped_upto.value_or(-1));
   std::vector<ExpiredBlob> out;
   while (st.step()) {
     if (out.empty() || out.back().sha256 != st.text(0)) {

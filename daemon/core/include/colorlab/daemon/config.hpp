@@ -71,6 +71,9 @@ struct BlobConfig {
   double retention_days = 0;      // 0: blobs are kept for ever
   std::vector<std::string> keep;  // kinds retention never removes ("raw", "average", …)
   bool verify_hashes = true;      // the start-up check hashes every file (false: sizes only)
+  // Set when the TOML has a [ship] section (colorlab-ship's, docs/fleet.md): retention then keeps every blob of a
+  // run that has not shipped yet, by the position the agent notes in <state_dir>/ship/shipped-position.
+  bool keep_unshipped = false;
 };
 
 // [api]: how the HTTP API serves (docs/configuration.md).

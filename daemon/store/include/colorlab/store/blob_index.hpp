@@ -52,8 +52,10 @@ class BlobIndex {
   std::optional<std::string> preview_of(const std::string& sha256);
 
   // Blobs whose every reference was created before `cutoff` (ISO 8601) and is of a kind not in
-  // `keep`, plus unreferenced rows older than the cutoff.
-  std::vector<ExpiredBlob> expired(const std::string& cutoff, const std::vector<std::string>& keep);
+  // `keep`, plus unreferenced rows older than the cutoff. With `shipped_upto` (colorlab-ship's position in the
+  // event log), only blobs whose every referencing run ended at or before that event: nothing unshipped goes.
+  std::vector<ExpiredBlob> expired(const std::string& cutoff, const std::vector<std::string>& keep,
+                                   std::optional<std::int64_t> shipped_upto = std::nullopt);
   // Removes the rows of these blobs and every reference to them, in one transaction, with an event.
   void remove(const std::vector<ExpiredBlob>& blobs, const nlohmann::json& event);
 

@@ -1,0 +1,41 @@
+#pragma once
+// colorlab-ship's settings: the [ship] section of colorlabd's own TOML, plus its state_dir, so one file
+// describes the bench (docs/fleet.md). Credentials are named by file and read when needed, never kept in
+// anything that is printed or logged.
+#include <filesystem>
+#include <string>
+
+namespace colorlab::fleet {
+
+struct ShipConfig {
+  std::filesystem::path state_dir = "./colorlab-state";  // colorlabd's: colorlab.db and blobs/
+  std::string bench_id;                                   // stable, unique in the lab: the events' key
+  std::string bench_name;
+  std::string postgres;      // libpq conninfo; a password belongs in a passfile=, never here
+  std::string s3_endpoint;   // e.g. https://s3.lab.example:443 (path-style requests)
+  std::string bucket;
+  std::string region = "us-east-1";
+  std::filesystem::path access_key_file;
+  std::filesystem::path secret_key_file;
+  int batch_runs = 50;       // runs shipped per cycle, each in its own PostgreSQL transaction
+  double interval_s = 30;    // between cycles when running as a service
+
+  std::filesystem::path database_path() const { return state_dir / "colorlab.db"; }
+  std::filesystem::path blob_root() const { return state_dir / "blobs"; }
+  // Where the agent records the position central holds, for colorlabd's blob retention (docs/fleet.md).
+  std::filesystem::path shipped_position_file() const { return state_dir / "ship" / "shipped-position"; }
+};
+
+// Error{bad_parameter} naming the file, line and key for anything missing or malformed.
+ShipConfig load_ship_config(const std::filesystem::path& toml_file);
+
+// The first line of a credential file, without its line ending; Error{bad_parameter} when it cannot be
+// read or is empty. The message names the file, never its content.
+std::string read_secret_file(const std::filesystem::path& file, const char* what);
+
+// The position the agent last saw central accept for this bench (0 when it never shipped).
+long long read_shipped_position(const std::filesystem::path& file);
+// Durable: temporary file, fsync, rename, directory fsync.
+void write_shipped_position(const std::filesystem::path& file, long long position);
+
+}  // namespace colorlab::fleet

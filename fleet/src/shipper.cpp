@@ -1,0 +1,245 @@
+#include "colorlab/fleet/shipper.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include "colorlab/core/error.hpp"
+#include "colorlab/core/log.hpp"
+#include "colorlab/fleet/bench_reader.hpp"
+#include "colorlab/fleet/central_schema.hpp"
+#include "colorlab/fleet/digest.hpp"
+#include "colorlab/fleet/pg.hpp"
+#include "colorlab/fleet/s3.hpp"
+#include "colorlab/store/blob_store.hpp"
+#include "colorlab/store/schema.hpp"
+
+#ifndef COLORLAB_SHIP_VERSION
+#define COLORLAB_SHIP_VERSION "unknown"
+#endif
+
+namespace colorlab::fleet {
+
+namespace {
+
+// Staging table, its columns in COPY order (bench_reader.cpp writes them so), and the key that makes a re-sent
+// row a no-op. Staging tables are per session and emptied at every commit or rollback.
+struct Staged {
+  const char* table;
+  const char* columns;
+  const char* key;
+};
+
+constexpr Staged kStaged[] = {
+    {"runs",
+     "id, bench_id, bench_seq, campaign, params, status, simulated, instruments, created_at, started_at, finished_at, "
+     "summary, error, script_sha256, ended_event",
+     "id"},
+    {"executions",
+     "id, run_id, campaign, status, progress, step, created_at, updated_at, error, reason, steps_committed", "id"},
+    {"measurements", "run_id, step, seq, instrument_id, simulated, quantity, value, unit, data, measured_at",
+     "run_id, step"},
+    {"blobs", "sha256, size, media_type, meta", "sha256"},
+    {"run_blobs", "run_id, name, sha256, step, kind, created_at", "run_id, name"},
+    {"events", "bench_id, seq, time, topic, payload", "bench_id, seq"},
+};
+
+const std::string& batch_part(const RunBatch& b, int i) {
+  switch (i) {
+    case 0: return b.runs;
+    case 1: return b.executions;
+    case 2: return b.measurements;
+    case 3: return b.blobs;
+    case 4: return b.run_blobs;
+    default: return b.events;
+  }
+}
+
+S3Client make_s3(const ShipConfig& c) {
+  S3Credentials k{read_secret_file(c.access_key_file, "S3 access key"),
+                  read_secret_file(c.secret_key_file, "S3 secret key")};
+  return S3Client(c.s3_endpoint, c.bucket, c.region, std::move(k));
+}
+
+void check_bench_schema(BenchReader& bench) {
+  const int v = bench.schema_version();
+  if (v > store::kSchemaVersion) {
+    throw Error(ErrorClass::conflict,
+                "the bench's database has schema version " + std::to_string(v) + ", newer than this colorlab-ship (" +
+                    std::to_string(store::kSchemaVersion) + ")",
+                "upgrade colorlab-ship to the same version as colorlabd on this bench");
+  }
+}
+
+// Registers the bench (or refreshes its name, version and last_seen) and returns the position central holds.
+std::int64_t register_bench(Pg& pg, const ShipConfig& c, int bench_schema) {
+  auto r = pg.query(
+      "INSERT INTO benches (id, name, software_version, bench_schema) VALUES ($1, $2, $3, $4) "
+      "ON CONFLICT (id) DO UPDATE SET name = excluded.name, software_version = excluded.software_version, "
+      "bench_schema = excluded.bench_schema, last_seen = now() RETURNING shipped_position",
+      {c.bench_id, c.bench_name, std::string(COLORLAB_SHIP_VERSION), std::to_string(bench_schema)});
+  return r.int64(0, 0);
+}
+
+void create_staging(Pg& pg) {
+  for (const auto& s : kStaged) {
+    pg.exec(std::string("CREATE TEMP TABLE IF NOT EXISTS stage_") + s.table + " (LIKE " + s.table +
+            " INCLUDING DEFAULTS) ON COMMIT DELETE ROWS");
+  }
+}
+
+void record_problem(Pg& pg, const std::string& bench_id, const Divergence& d) {
+  nlohmann::json detail{{"bench_digest", d.bench_digest}, {"central_digest", d.central_digest}};
+  pg.query("INSERT INTO ship_problems (bench_id, run_id, kind, detail) VALUES ($1, $2, 'digest_mismatch', $3)",
+           {bench_id, d.run_id, detail.dump()});
+  pg.query("UPDATE benches SET last_error = $2 WHERE id = $1",
+           {bench_id, "digest mismatch for run " + d.run_id + ": central holds different rows than the bench"});
+}
+
+std::string central_digest(Pg& pg, const std::string& run_id) {
+  auto r = pg.query(kCentralDigestSql, {run_id});
+  return r.rows() == 1 ? r.text(0, 0) : std::string("(run missing)");
+}
+
+void rollback(Pg& pg) {
+  try {
+    pg.exec("ROLLBACK");
+  } catch (...) {
+  }
+}
+
+enum class Outcome { committed, raced, diverged };
+
+// The run's rows and the bench's new position in one transaction; the digest is compared before COMMIT so a
+// divergent run never moves the position.
+Outcome commit_run(Pg& pg, const ShipConfig& c, const RunBatch& b, std::int64_t position, Divergence& divergence) {
+  pg.exec("BEGIN");
+  try {
+    auto held = pg.query("SELECT shipped_position FROM benches WHERE id = $1 FOR UPDATE", {c.bench_id});
+    if (held.int64(0, 0) != position) {  // another agent for this bench moved it: start over from there
+      rollback(pg);
+      return Outcome::raced;
+    }
+    for (int i = 0; i < 6; ++i) {
+      const auto& part = batch_part(b, i);
+      if (part.empty()) continue;
+      pg.copy_in(std::string("stage_") + kStaged[i].table + " (" + kStaged[i].columns + ")", part);
+    }
+    for (const auto& s : kStaged) {
+      pg.exec(std::string("INSERT INTO ") + s.table + " (" + s.columns + ") SELECT " + s.columns + " FROM stage_" +
+              s.table + " ON CONFLICT (" + s.key + ") DO NOTHING");
+    }
+    const std::string central = central_digest(pg, b.run.run_id);
+    if (central != b.digest) {
+      rollback(pg);
+      divergence = {b.run.run_id, b.digest, central};
+      return Outcome::diverged;
+    }
+    pg.query("UPDATE benches SET shipped_position = $2, last_seen = now(), last_error = NULL WHERE id = $1",
+             {c.bench_id, std::to_string(b.run.ended_event)});
+    pg.exec("COMMIT");
+  } catch (...) {
+    rollback(pg);
+    throw;
+  }
+  return Outcome::committed;
+}
+
+}  // namespace
+
+void central_init(const ShipConfig& config) {
+  Pg pg(config.postgres);
+  central_migrate(pg);
+}
+
+CycleReport ship_cycle(const ShipConfig& c) {
+  BenchReader bench(c.database_path());
+  check_bench_schema(bench);
+  Pg pg(c.postgres);
+  central_require(pg);
+  S3Client s3 = make_s3(c);
+  store::BlobStore files(c.blob_root());
+  const int bench_schema = bench.schema_version();
+
+  CycleReport report;
+  std::int64_t position = register_bench(pg, c, bench_schema);
+  report.position_before = position;
+  // Central may be ahead of the local note (a kill after COMMIT); retention reads the note, so catch it up.
+  write_shipped_position(c.shipped_position_file(), position);
+  create_staging(pg);
+
+  int budget = c.batch_runs;
+  while (budget > 0) {
+    auto ended = bench.ended_after(position, budget);
+    if (ended.empty()) break;
+    bool restart = false;
+    for (const auto& run : ended) {
+      RunBatch b = bench.read(c.bench_id, run, position);
+      // Blobs before the rows that reference them: central never names an object the bucket lacks.
+      for (const auto& blob : b.blob_files) {
+        const std::string key = "sha256/" + blob.sha256;
+        if (s3.exists(key)) continue;
+        const auto path = files.path_of(blob.sha256);
+        if (!std::filesystem::exists(path)) {
+          throw Error(ErrorClass::io_error, "run " + run.run_id + " references blob " + blob.sha256 +
+                                                ", whose file is missing from " + c.blob_root().string(),
+                      "colorlab blobs check; shipping cannot pass this run until the file is restored");
+        }
+        s3.put_file(key, path, blob.sha256);
+        ++report.blobs_uploaded;
+      }
+      Divergence d;
+      switch (commit_run(pg, c, b, position, d)) {
+        case Outcome::raced:
+          position = register_bench(pg, c, bench_schema);
+          restart = true;
+          break;
+        case Outcome::diverged:
+          record_problem(pg, c.bench_id, d);
+          log::error("ship", "run " + d.run_id + " differs between the bench (digest " + d.bench_digest +
+                                 ") and central (" + d.central_digest + "); shipping stops before it");
+          report.divergences.push_back(d);
+          report.position_after = position;
+          return report;
+        case Outcome::committed:
+          position = run.ended_event;
+          write_shipped_position(c.shipped_position_file(), position);
+          ++report.runs_shipped;
+          report.measurements += b.measurement_count;
+          report.events += b.event_count;
+          --budget;
+          break;
+      }
+      if (restart || budget == 0) break;
+    }
+  }
+  report.position_after = position;
+  return report;
+}
+
+std::vector<Divergence> verify_shipped(const ShipConfig& c) {
+  BenchReader bench(c.database_path());
+  check_bench_schema(bench);
+  Pg pg(c.postgres);
+  central_require(pg);
+  std::vector<Divergence> out;
+  auto runs = pg.query("SELECT id FROM runs WHERE bench_id = $1 ORDER BY ended_event", {c.bench_id});
+  for (int i = 0; i < runs.rows(); ++i) {
+    const std::string id = runs.text(i, 0);
+    std::string mine;
+    try {
+      mine = bench.digest(id);
+    } catch (const Error& e) {
+      if (e.cls() != ErrorClass::not_found) throw;
+      mine = "(run missing on the bench)";
+    }
+    const std::string theirs = central_digest(pg, id);
+    if (mine != theirs) {
+      Divergence d{id, mine, theirs};
+      record_problem(pg, c.bench_id, d);
+      log::error("ship", "run " + id + " differs between the bench (digest " + mine + ") and central (" + theirs + ")");
+      out.push_back(d);
+    }
+  }
+  return out;
+}
+
+}  // namespace colorlab::fleet
