@@ -38,7 +38,7 @@ function(colorlab_fuzz_parser target name)
   elseif(name STREQUAL "campaign_script" OR name STREQUAL "campaign_params")
     # The declaration sandbox and the `lab` table a script's top level sees; lab_api's analysis
     # functions (characterize, chart_plan, floor_luminance_fit) and the catalogue's sequences come with it.
-    foreach(f lua_sandbox lua_value lab_api script catalogue sequence characterize chart_plan floor_luminance_fit)
+    foreach(f lua_sandbox lua_value lab_api script catalogue sequence characterize characterize_lamps chart_plan floor_luminance_fit)
       list(APPEND sources ${s}/campaigns/src/${f}.cpp)
     endforeach()
     list(APPEND sources ${s}/analysis/src/chart_layout.cpp ${s}/drivers/core/src/serpentine.cpp)
