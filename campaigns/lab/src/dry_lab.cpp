@@ -1,4 +1,4 @@
-#include "dry_run_answers.hpp"
+#include "colorlab/campaigns/dry_lab.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -10,7 +10,7 @@
 #include "colorlab/core/ids.hpp"
 #include "colorlab/drivers/camera/camera_instrument.hpp"
 #include "colorlab/drivers/lab_capabilities.hpp"
-#include "roles.hpp"
+#include "colorlab/campaigns/roles.hpp"
 
 namespace colorlab::campaigns {
 
@@ -38,13 +38,8 @@ std::array<double, 3> camera_values(const json& xyz, const std::string& format) 
 }  // namespace
 
 std::string DryLab::role_of(const std::string& call) {
-  if (call == "meter.measure" || call == "wait_stable") return "luminance_meter";
-  if (call.rfind("lamps.", 0) == 0) return "lamps";
-  if (call == "dimmer.set") return "dimmer";
-  if (call.rfind("table.", 0) == 0) return "table";
-  if (call.rfind("spectro.", 0) == 0) return "spectrophotometer";
-  if (call.rfind("camera.", 0) == 0) return "camera";
-  return {};
+  const LabCall* c = find_lab_call(call);
+  return c ? std::string(c->role) : std::string();
 }
 
 std::shared_ptr<drivers::Instrument> DryLab::instrument_for(const std::string& role) const {
@@ -94,123 +89,167 @@ json DryLab::grey_spectrum(const std::string& role) const {
               {"Lab", {76.07, 0.0, 0.0}}};
 }
 
-json DryLab::answer(const std::string& call, const json& args, double lab_now_s, std::vector<DryProblem>& problems) {
-  json result = nullptr;
-  const std::string role = role_of(call);
-  auto instrument = role.empty() ? nullptr : instrument_for(role);
-  const std::string instrument_id = instrument ? instrument->id() : "dry-run";
-  const double dimmer = state_.dimmer_percent.value_or(100.0);
+std::string DryLab::id_for(const std::string& role) const {
+  auto i = instrument_for(role);
+  return i ? i->id() : std::string("dry-run");
+}
 
-  if (call == "meter.measure") {
-    result = json{{"luminance", dimmer}, {"unit", "cd/m2"}, {"instrument", instrument_id}, {"raw", "dry run"}};
-  } else if (call == "wait_stable") {
-    result = json{{"luminance", dimmer}, {"unit", "cd/m2"}, {"instrument", instrument_id},
-                  {"drift_pct", 0.0},    {"readings", 0},     {"waited_s", 0.0}};
-  } else if (call == "lamps.select" || call == "lamps.set") {
-    std::vector<std::string> on;
-    if (call == "lamps.select") on.push_back(args[0].get<std::string>());
-    for (const auto& l : call == "lamps.set" ? args[0] : json::array()) {
-      if (l.is_string()) on.push_back(l.get<std::string>());
-    }
-    if (auto lamps = std::dynamic_pointer_cast<drivers::LampController>(instrument)) {
-      auto names = lamps->lamp_names();
-      for (const auto& l : on) {
-        if (std::find(names.begin(), names.end(), l) == names.end()) {
-          std::string known;
-          for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
-          problems.push_back({"limit", "lamp '" + l + "' is not one of " + lamps->id() + "'s lamps (" + known + ")"});
-        }
-      }
-    }
-    result = json{{"lamps_on", on}};
-  } else if (call == "lamps.off") {
-    result = json{{"lamps_on", json::array()}};
-  } else if (call == "lamps.names") {
-    auto lamps = std::dynamic_pointer_cast<drivers::LampController>(instrument);
-    result = lamps ? json(lamps->lamp_names()) : json::array();
-  } else if (call == "dimmer.set") {
-    const double level = args[0].get<double>();
-    if (auto d = std::dynamic_pointer_cast<drivers::Dimmer>(instrument)) {
-      auto [lo, hi] = d->level_range();
-      if (level < 100 * lo - 1e-9 || level > 100 * hi + 1e-9) {
-        problems.push_back({"limit", "lab.dimmer.set(" + args[0].dump() + "): " + d->id() + " holds levels from " +
-                                         std::to_string(100 * lo) + " to " + std::to_string(100 * hi) + " %"});
-      }
-    }
-    result = json{{"dimmer_percent", args[0]}};
-  } else if (call == "table.move" || call == "table.measure_at" || call == "table.read_patch") {
-    check_position(call, args, problems);
-    if (call != "table.move") result = grey_spectrum("table");
-  } else if (call == "spectro.mode") {
-    const auto mode = args[0].get<std::string>();
-    if (mode != "reflectance" && mode != "emission" && mode != "transmission") {
-      throw Error(ErrorClass::script_error, "lab.spectro.mode: '" + mode + "' is not reflectance, emission or transmission");
-    }
-  } else if (call == "spectro.measure") {
-    result = grey_spectrum("spectrophotometer");
-  } else if (call == "camera.capture") {
-    const json o = args.empty() ? json::object() : args[0];
-    const int frames = o.value("frames", 1);
-    json rows = json::array();
-    for (int n : {1, 2, 4, 8, 16, 25, 32, 64, 128, 256}) {
-      if (n > frames) break;
-      for (const char* c : {"R", "G", "B"}) rows.push_back({{"frames", n}, {"channel", c}, {"stdev", 8.0 / std::sqrt(n)}});
-    }
-    result = json{{"frames", frames}, {"region", {0, 0, 32, 32}}, {"rows", rows}, {"instrument", instrument_id},
-                  {"unit", "DN above black"}};
-  } else if (call == "camera.photograph_chart") {
-    const json o = args.empty() || !args[0].is_object() ? json::object() : args[0];
-    const int frames = o.value("frames", 25);
-    json formats = o.contains("formats") && o["formats"].is_array() ? o["formats"] : json{"raw", "tiff16", "tiff8", "jpeg"};
-    json ids = json::array(), xyz = json::array();
-    if (o.contains("reference") && o["reference"].is_object() && o["reference"].contains("ids")) {
-      ids = o["reference"]["ids"];
-      xyz = o["reference"]["XYZ"];
-    } else {
-      for (int k = 0; k < 24; ++k) {
-        ids.push_back(std::to_string(k + 1));
-        const double y = 3 + 90.0 * k / 23;
-        xyz.push_back({0.9642 * y, y, 0.8249 * y});
-      }
-    }
-    json out = json{{"instrument", instrument_id}, {"chart", o.value("chart", std::string("sg"))}, {"frames", frames},
-                    {"formats", json::object()}};
-    for (const auto& f : formats) {
-      const std::string format = f.get<std::string>();
-      json values = json::array();
-      for (const auto& x : xyz) {
-        auto v = camera_values(x, format);
-        values.push_back({v[0], v[1], v[2]});
-      }
-      out["formats"][format] = json{{"format", format}, {"bits", format == "raw" ? 16 : (format == "tiff16" ? 16 : 8)},
-                                    {"confidence", 1.0}, {"rotation_deg", 0}, {"corners", json::array()},
-                                    {"patches_detected", ids.size()}, {"reprojection_rms_px", 0.0},
-                                    {"check", json::object()}, {"frames", frames}, {"files", json::array()},
-                                    {"width", 0}, {"height", 0}, {"notes", {"dry run: values from the reference"}},
-                                    {"ids", ids}, {"values", values},
-                                    {"detected", std::vector<bool>(ids.size(), true)}};
-    }
-    result = out;
-  } else if (call == "camera.photograph_floor") {
-    result = dry_floor_photograph(args[0], instrument_id);
-  } else if (call == "runs.chart_reference") {
-    if (!runs_) throw Error(ErrorClass::unsupported, "lab.runs.chart_reference: this lab keeps no runs to read");
-    result = chart_reference(*runs_, args[0].get<std::string>());
-  } else if (call == "operator.request") {
-    OperatorRequest r = parse_operator_request(args[0]);
-    // The first option is the one that says the action was done: the night as planned.
-    result = json{{"answer", r.options.front()}, {"by", "dry run"}, {"action", r.action}, {"details", r.details}};
-  } else if (call == "now") {
-    if (start_unix_s_ == 0) {
-      start_unix_s_ = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
-    }
-    const double t = start_unix_s_ + lab_now_s;
-    result = json{{"utc", iso8601_utc(std::chrono::system_clock::time_point(std::chrono::duration_cast<std::chrono::system_clock::duration>(
-                              std::chrono::duration<double>(t))))},
-                  {"unix", t}};
-  }
+json DryLab::answer(const std::string& call, const json& args, double lab_now_s, std::vector<DryProblem>& problems) {
+  const LabCall& c = lab_call(call);
+  DryContext context{lab_now_s, problems};
+  json result = c.dry_answer ? (this->*(c.dry_answer))(args, context) : json(nullptr);
   state_.apply(call, args, result);
   return result;
+}
+
+json DryLab::call_meter_measure(const json&, DryContext&) {
+  return json{{"luminance", state_.dimmer_percent.value_or(100.0)}, {"unit", "cd/m2"}, {"instrument", id_for("luminance_meter")},
+              {"raw", "dry run"}};
+}
+
+json DryLab::call_wait_stable(const json&, DryContext&) {
+  return json{{"luminance", state_.dimmer_percent.value_or(100.0)}, {"unit", "cd/m2"}, {"instrument", id_for("luminance_meter")},
+              {"drift_pct", 0.0}, {"readings", 0}, {"waited_s", 0.0}};
+}
+
+json DryLab::lamps_lit(std::vector<std::string> on, DryContext& context) const {
+  if (auto lamps = std::dynamic_pointer_cast<drivers::LampController>(instrument_for("lamps"))) {
+    auto names = lamps->lamp_names();
+    for (const auto& l : on) {
+      if (std::find(names.begin(), names.end(), l) == names.end()) {
+        std::string known;
+        for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
+        context.problems.push_back({"limit", "lamp '" + l + "' is not one of " + lamps->id() + "'s lamps (" + known + ")"});
+      }
+    }
+  }
+  return json{{"lamps_on", on}};
+}
+
+json DryLab::call_lamps_select(const json& args, DryContext& context) {
+  return lamps_lit({args[0].get<std::string>()}, context);
+}
+
+json DryLab::call_lamps_set(const json& args, DryContext& context) {
+  std::vector<std::string> on;
+  for (const auto& l : args[0]) {
+    if (l.is_string()) on.push_back(l.get<std::string>());
+  }
+  return lamps_lit(on, context);
+}
+
+json DryLab::call_lamps_off(const json&, DryContext&) { return json{{"lamps_on", json::array()}}; }
+
+json DryLab::call_lamps_names(const json&, DryContext&) {
+  auto lamps = std::dynamic_pointer_cast<drivers::LampController>(instrument_for("lamps"));
+  return lamps ? json(lamps->lamp_names()) : json::array();
+}
+
+json DryLab::call_dimmer_set(const json& args, DryContext& context) {
+  const double level = args[0].get<double>();
+  if (auto d = std::dynamic_pointer_cast<drivers::Dimmer>(instrument_for("dimmer"))) {
+    auto [lo, hi] = d->level_range();
+    if (level < 100 * lo - 1e-9 || level > 100 * hi + 1e-9) {
+      context.problems.push_back({"limit", "lab.dimmer.set(" + args[0].dump() + "): " + d->id() + " holds levels from " +
+                                               std::to_string(100 * lo) + " to " + std::to_string(100 * hi) + " %"});
+    }
+  }
+  return json{{"dimmer_percent", args[0]}};
+}
+
+json DryLab::call_table_move(const json& args, DryContext& context) {
+  check_position("table.move", args, context.problems);
+  return nullptr;
+}
+
+json DryLab::call_table_measure_at(const json& args, DryContext& context) {
+  check_position("table.measure_at", args, context.problems);
+  return grey_spectrum("table");
+}
+
+json DryLab::call_table_read_patch(const json& args, DryContext& context) {
+  check_position("table.read_patch", args, context.problems);
+  return grey_spectrum("table");
+}
+
+json DryLab::call_spectro_mode(const json& args, DryContext&) {
+  const auto mode = args[0].get<std::string>();
+  if (mode != "reflectance" && mode != "emission" && mode != "transmission") {
+    throw Error(ErrorClass::script_error, "lab.spectro.mode: '" + mode + "' is not reflectance, emission or transmission");
+  }
+  return nullptr;
+}
+
+json DryLab::call_spectro_measure(const json&, DryContext&) { return grey_spectrum("spectrophotometer"); }
+
+json DryLab::call_camera_capture(const json& args, DryContext&) {
+  const json o = args.empty() ? json::object() : args[0];
+  const int frames = o.value("frames", 1);
+  json rows = json::array();
+  for (int n : {1, 2, 4, 8, 16, 25, 32, 64, 128, 256}) {
+    if (n > frames) break;
+    for (const char* c : {"R", "G", "B"}) rows.push_back({{"frames", n}, {"channel", c}, {"stdev", 8.0 / std::sqrt(n)}});
+  }
+  return json{{"frames", frames}, {"region", {0, 0, 32, 32}}, {"rows", rows}, {"instrument", id_for("camera")},
+              {"unit", "DN above black"}};
+}
+
+json DryLab::call_camera_photograph_chart(const json& args, DryContext&) {
+  const json o = args.empty() || !args[0].is_object() ? json::object() : args[0];
+  const int frames = o.value("frames", 25);
+  json formats = o.contains("formats") && o["formats"].is_array() ? o["formats"] : json{"raw", "tiff16", "tiff8", "jpeg"};
+  json ids = json::array(), xyz = json::array();
+  if (o.contains("reference") && o["reference"].is_object() && o["reference"].contains("ids")) {
+    ids = o["reference"]["ids"];
+    xyz = o["reference"]["XYZ"];
+  } else {
+    for (int k = 0; k < 24; ++k) {
+      ids.push_back(std::to_string(k + 1));
+      const double y = 3 + 90.0 * k / 23;
+      xyz.push_back({0.9642 * y, y, 0.8249 * y});
+    }
+  }
+  json out = json{{"instrument", id_for("camera")}, {"chart", o.value("chart", std::string("sg"))}, {"frames", frames},
+                  {"formats", json::object()}};
+  for (const auto& f : formats) {
+    const std::string format = f.get<std::string>();
+    json values = json::array();
+    for (const auto& x : xyz) {
+      auto v = camera_values(x, format);
+      values.push_back({v[0], v[1], v[2]});
+    }
+    out["formats"][format] = json{{"format", format}, {"bits", format == "raw" ? 16 : (format == "tiff16" ? 16 : 8)},
+                                  {"confidence", 1.0}, {"rotation_deg", 0}, {"corners", json::array()},
+                                  {"patches_detected", ids.size()}, {"reprojection_rms_px", 0.0},
+                                  {"check", json::object()}, {"frames", frames}, {"files", json::array()},
+                                  {"width", 0}, {"height", 0}, {"notes", {"dry run: values from the reference"}},
+                                  {"ids", ids}, {"values", values},
+                                  {"detected", std::vector<bool>(ids.size(), true)}};
+  }
+  return out;
+}
+
+json DryLab::call_camera_photograph_floor(const json& args, DryContext&) { return dry_floor_photograph(args[0], id_for("camera")); }
+
+json DryLab::call_runs_chart_reference(const json& args, DryContext&) {
+  if (!runs_) throw Error(ErrorClass::unsupported, "lab.runs.chart_reference: this lab keeps no runs to read");
+  return chart_reference(*runs_, args[0].get<std::string>());
+}
+
+json DryLab::call_operator_request(const json& args, DryContext&) {
+  OperatorRequest r = parse_operator_request(args[0]);
+  // The first option is the one that says the action was done: the night as planned.
+  return json{{"answer", r.options.front()}, {"by", "dry run"}, {"action", r.action}, {"details", r.details}};
+}
+
+json DryLab::call_now(const json&, DryContext& context) {
+  if (start_unix_s_ == 0) {
+    start_unix_s_ = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+  }
+  const double t = start_unix_s_ + context.lab_now_s;
+  return json{{"utc", iso8601_utc(std::chrono::system_clock::time_point(std::chrono::duration_cast<std::chrono::system_clock::duration>(
+                          std::chrono::duration<double>(t))))},
+              {"unix", t}};
 }
 
 }  // namespace colorlab::campaigns

@@ -2,37 +2,37 @@
 
 #include <algorithm>
 #include <cctype>
-
-#include "colorlab/core/error.hpp"
+#include <utility>
 
 namespace colorlab::campaigns {
 
 using nlohmann::json;
 
-json KeptBlob::to_json() const {
-  return json{{"sha256", sha256}, {"name", name}, {"kind", kind}, {"media_type", media_type}, {"size", size}, {"meta", meta}};
+json blob_json(const KeptBlob& b) {
+  return json{{"sha256", b.sha256}, {"name", b.name}, {"kind", b.kind}, {"media_type", b.media_type}, {"size", b.size}, {"meta", b.meta}};
 }
 
-KeptBlob KeptBlob::from_json(const json& j) {
-  KeptBlob b;
-  try {
-    b.sha256 = j.at("sha256").get<std::string>();
-    b.name = j.at("name").get<std::string>();
-    b.kind = j.at("kind").get<std::string>();
-    b.media_type = j.at("media_type").get<std::string>();
-    b.size = j.at("size").get<std::uint64_t>();
-    if (j.contains("meta") && j["meta"].is_object()) b.meta = j["meta"];
-  } catch (const json::exception& e) {
-    throw Error(ErrorClass::internal, std::string("a blob reference in a call's result is malformed: ") + e.what());
-  }
+KeptBlob KeepLedger::noted(KeptBlob b) {
+  std::lock_guard lock(mutex_);
+  kept_.push_back(b);
   return b;
 }
 
-std::vector<KeptBlob> kept_blobs(const json& call_result) {
-  std::vector<KeptBlob> out;
-  if (!call_result.is_object() || !call_result.contains("blobs") || !call_result["blobs"].is_array()) return out;
-  for (const auto& b : call_result["blobs"]) out.push_back(KeptBlob::from_json(b));
-  return out;
+KeptBlob KeepLedger::keep_bytes(const std::string& name, const std::string& kind, const std::string& media_type,
+                                const json& meta, std::span<const std::uint8_t> bytes) {
+  return noted(keeper_->keep_bytes(name, kind, media_type, meta, bytes));
+}
+
+KeptBlob KeepLedger::keep_file(const std::string& name, const std::string& kind, const std::string& media_type,
+                               const json& meta, const std::filesystem::path& file) {
+  return noted(keeper_->keep_file(name, kind, media_type, meta, file));
+}
+
+KeptBlob KeepLedger::keep_preview(const std::string& name, const KeptBlob& of) { return noted(keeper_->keep_preview(name, of)); }
+
+std::vector<KeptBlob> KeepLedger::take() {
+  std::lock_guard lock(mutex_);
+  return std::exchange(kept_, {});
 }
 
 std::string media_type_of(const std::filesystem::path& file) {
