@@ -127,7 +127,7 @@ void BM_Ls110Step_Direct(benchmark::State& state) {
         auto r = co_await b.meter->measure_luminance();
         json result{{"luminance", r.luminance}, {"unit", r.unit}, {"instrument", b.meter->id()}, {"raw", r.raw_reply}};
         pending.journal.push_back({i, "meter.measure", json::array(), result});
-        pending.measurements.push_back({"reading/" + std::to_string(i), b.meter->id(), "luminance", r.luminance, r.unit,
+        pending.measurements.push_back({"reading/" + std::to_string(i), b.meter->id(), true, "luminance", r.luminance, r.unit,
                                         {{"raw", r.raw_reply}}});
         pending.progress = static_cast<double>(i) / kReadings;
         pending.label = "reading/" + std::to_string(i);
@@ -170,7 +170,7 @@ void BM_LabCall_Direct(benchmark::State& state) {
         }
         json t = co_await b.lab->perform(call, args, control);
         pending.journal.push_back({i, call, args, t});
-        pending.measurements.push_back({"t/" + std::to_string(i), "", "time", t["unix"].get<double>(), "s", nullptr});
+        pending.measurements.push_back({"t/" + std::to_string(i), "", false, "time", t["unix"].get<double>(), "s", nullptr});
       }
       sink.commit(pending);
     });

@@ -38,11 +38,15 @@ function(colorlab_fuzz_parser target name)
   elseif(name STREQUAL "campaign_script" OR name STREQUAL "campaign_params")
     # The declaration sandbox and the `lab` table a script's top level sees; lab_api's analysis
     # functions (characterize, chart_plan, floor_luminance_fit) and the catalogue's sequences come with it.
-    foreach(f lua_sandbox lua_value lab_api script catalogue sequence characterize characterize_lamps chart_plan floor_luminance_fit)
-      list(APPEND sources ${s}/campaigns/src/${f}.cpp)
+    foreach(f lua_sandbox lua_value lab_api script catalogue sequence)
+      list(APPEND sources ${s}/campaigns/engine/src/${f}.cpp)
+    endforeach()
+    foreach(f characterize characterize_lamps chart_plan floor_luminance_fit)
+      list(APPEND sources ${s}/campaigns/procedures/src/${f}.cpp)
     endforeach()
     list(APPEND sources ${s}/analysis/src/chart_layout.cpp ${s}/drivers/core/src/serpentine.cpp)
-    list(APPEND includes ${s}/campaigns/include ${s}/drivers/core/include ${s}/analysis/include)
+    list(APPEND includes ${s}/campaigns/engine/include ${s}/campaigns/lab/include ${s}/campaigns/procedures/include
+         ${s}/drivers/core/include ${s}/analysis/include)
     list(APPEND libs colorlab::analysis PkgConfig::LUA OpenSSL::Crypto nlohmann_json::nlohmann_json)
   elseif(name STREQUAL "hid_socket")
     list(APPEND sources ${s}/drivers/lamps/src/socket_hid_transport.cpp

@@ -44,7 +44,7 @@ endforeach()
 # would be most of this build's time (ASan's allocator still sees its memory).
 add_subdirectory(analysis)
 target_compile_options(colorlab_analysis PRIVATE -O0 -g0)
-set(COLORLAB_FUZZ_PLAIN_SOURCES ${PROJECT_SOURCE_DIR}/campaigns/src/characterize.cpp)
+set(COLORLAB_FUZZ_PLAIN_SOURCES ${PROJECT_SOURCE_DIR}/campaigns/procedures/src/characterize.cpp)
 set_source_files_properties(${COLORLAB_FUZZ_PLAIN_SOURCES} PROPERTIES COMPILE_OPTIONS "-fno-sanitize=all;-O0;-g0")
 
 include(${CMAKE_CURRENT_LIST_DIR}/fuzz_parsers.cmake)

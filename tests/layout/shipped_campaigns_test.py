@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Issue 24: the campaign lists a newcomer reads (README.md's "Shipped" table, docs/campaigns.md's "The campaigns
 colorlab ships" table and its sequences) agree with what ships — campaigns/scripts/, which the daemon's catalogue
-reads as its "shipped" directory (campaigns/src/catalogue.cpp: NAME.lua is campaign NAME, NAME.sequence.lua
+reads as its "shipped" directory (campaigns/engine/src/catalogue.cpp: NAME.lua is campaign NAME, NAME.sequence.lua
 sequence NAME) — names and the instruments each `needs`. A script added, renamed or removed without its row fails
 here, naming it."""
 from __future__ import annotations
@@ -15,7 +15,7 @@ SOURCE = Path(sys.argv.pop(1) if len(sys.argv) > 1 else Path(__file__).resolve()
 SCRIPTS = SOURCE / "campaigns" / "scripts"
 SEQUENCE = ".sequence.lua"
 
-# The roles scripts declare in `needs`, in the words the tables use (campaigns/src/roles.cpp's role names).
+# The roles scripts declare in `needs`, in the words the tables use (campaigns/lab/src/roles.cpp's role names).
 ROLE_WORDS = {"luminance_meter": "luminance meter", "spectrophotometer": "spectrophotometer", "table": "table",
               "lamps": "lamps", "dimmer": "dimmer", "camera": "camera"}
 

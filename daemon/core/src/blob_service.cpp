@@ -271,12 +271,4 @@ campaigns::KeptBlob BlobService::keep_preview(const std::string& name, const cam
   return keep_bytes(name, "preview", "image/png", json{{"preview_of", of.sha256}}, png);
 }
 
-std::vector<store::StepBlob> step_blobs(const std::string& call, std::int64_t seq, const json& result) {
-  std::vector<store::StepBlob> out;
-  for (const auto& b : campaigns::kept_blobs(result)) {
-    out.push_back(store::StepBlob{b.sha256, call + "#" + std::to_string(seq) + "/" + b.name, b.kind, b.media_type, b.size, b.meta});
-  }
-  return out;
-}
-
 }  // namespace colorlab::daemon

@@ -54,23 +54,11 @@ class StoreSink final : public campaigns::ExecutionSink {
         snapshot_(std::move(snapshot)),
         replace_serials_(replace_serials) {}
 
+  // The step's records go to the store as the engine made them (colorlab/core/step_records.hpp); the
+  // sink adds only what the store keeps per run: serials learned since, and the lab's time scale.
   void commit(const campaigns::StepCommit& step) override {
-    store::StepRecord s;
-    s.progress = step.progress;
-    s.step = step.label;
-    s.instruments = updated_snapshot();
-    for (const auto& j : step.journal) {
-      s.journal.push_back({j.seq, j.call, j.args, j.result});
-      for (auto& b : step_blobs(j.call, j.seq, j.result)) s.blobs.push_back(std::move(b));
-    }
-    for (const auto& t : step.timings) s.timings.push_back({t.key, t.lab_seconds});
-    s.time_scale = time_scale_;
-    for (const auto& m : step.measurements) {
-      auto instrument = instruments_.find(m.instrument_id);
-      s.measurements.push_back(
-          {m.step, m.instrument_id, instrument && instrument->identity().simulated, m.quantity, m.value, m.unit, m.data});
-    }
-    store_.commit_step(record_, s);
+    store_.commit_step(record_, store::StepRecord{step.journal, step.measurements, step.progress, step.label,
+                                                  updated_snapshot(), step.timings, time_scale_, step.blobs});
   }
   void restored(const json& actions) override {
     store_.append_event("execution", {{"execution_id", record_.id}, {"run_id", record_.run_id}, {"restored", actions}});

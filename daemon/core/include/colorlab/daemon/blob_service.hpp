@@ -69,7 +69,4 @@ class BlobService final : public campaigns::FrameKeeper {
   std::atomic<bool> stopping_{false};
 };
 
-// Step rows for the references a lab call's result carries, named "<call>#<seq>/<name>" in the run.
-std::vector<store::StepBlob> step_blobs(const std::string& call, std::int64_t seq, const nlohmann::json& result);
-
 }  // namespace colorlab::daemon

@@ -12,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "colorlab/core/step_records.hpp"
 #include "colorlab/protocol/states.hpp"
 #include "colorlab/store/sqlite.hpp"
 #include "colorlab/store/step_blob.hpp"
@@ -50,18 +51,10 @@ struct ExecutionRecord {
   nlohmann::json to_json() const;
 };
 
-struct JournalRow {
-  std::int64_t seq = 0;
-  std::string call;
-  nlohmann::json args;
-  nlohmann::json result;
-};
-
-// One live lab call's duration in lab seconds per unit, under the key campaigns::TimingKeys gave it.
-struct CallTimingRow {
-  std::string key;
-  double lab_seconds = 0;
-};
+// A step's records are the engine's as it hands them over (colorlab/core/step_records.hpp): the
+// journal entry, the call's timing (lab seconds per unit under the key campaigns::TimingKeys gave it).
+using JournalRow = records::JournalEntry;
+using CallTimingRow = records::CallTiming;
 
 struct LearnedTiming {
   std::int64_t n = 0;
@@ -70,15 +63,7 @@ struct LearnedTiming {
   double time_scale = 1;  // the time scale it was learned at
 };
 
-struct MeasurementRow {
-  std::string step;
-  std::string instrument_id;
-  bool simulated = false;
-  std::string quantity;
-  std::optional<double> value;
-  std::string unit;
-  nlohmann::json data;
-};
+using MeasurementRow = records::Measurement;
 
 // One committed step of a campaign: its journal entries, its measurements and its progress.
 struct StepRecord {

@@ -111,28 +111,27 @@ json keep_now(FrameKeeper& keeper, const KeepRequest& r) {
     json meta = array_meta(*s, "<f4");
     meta["frames"] = s->frames;
     average = keeper.keep_bytes(r.prefix + "average", "average", kArrayMediaType, meta, as_bytes(mean));
-    out.push_back(average->to_json());
+    out.push_back(blob_json(*average));
   }
   if (r.keep.wants("raw")) {
     if (!r.raw_files.empty()) {
       const auto& f = r.raw_files.front();
       raw = keeper.keep_file(r.prefix + f.filename().string(), "raw", media_type_of(f), json{{"frame", 1}, {"file_name", f.filename().string()}}, f);
-      out.push_back(raw->to_json());
+      out.push_back(blob_json(*raw));
     } else if (s && !s->first.empty()) {
       json meta = array_meta(*s, "<u2");
       meta["frame"] = 1;
       raw = keeper.keep_bytes(r.prefix + "first", "raw", kArrayMediaType, meta, as_bytes(s->first));
-      out.push_back(raw->to_json());
+      out.push_back(blob_json(*raw));
     }
   }
   for (const auto& [format, file] : r.processed) {
     if (!r.keep.wants(format)) continue;
-    out.push_back(keeper.keep_file(format + "/" + file.filename().string(), format, media_type_of(file),
-                                   json{{"frame", 1}, {"file_name", file.filename().string()}}, file)
-                      .to_json());
+    out.push_back(blob_json(keeper.keep_file(format + "/" + file.filename().string(), format, media_type_of(file),
+                                             json{{"frame", 1}, {"file_name", file.filename().string()}}, file)));
   }
   if (r.keep.wants("preview") && (average || raw)) {
-    out.push_back(keeper.keep_preview(r.prefix + (average ? "average.png" : "first.png"), average ? *average : *raw).to_json());
+    out.push_back(blob_json(keeper.keep_preview(r.prefix + (average ? "average.png" : "first.png"), average ? *average : *raw)));
   }
   return out;
 }

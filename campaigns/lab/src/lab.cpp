@@ -10,6 +10,7 @@
 
 #include "colorlab/analysis/colorimetry.hpp"
 #include "colorlab/campaigns/chart_photograph.hpp"
+#include "colorlab/campaigns/lab_calls.hpp"
 #include "colorlab/campaigns/floor_photograph.hpp"
 #include "colorlab/campaigns/frame_statistics.hpp"
 #include "colorlab/core/error.hpp"
@@ -19,7 +20,7 @@
 #include "colorlab/drivers/camera/camera_instrument.hpp"
 #include "colorlab/drivers/lab_capabilities.hpp"
 
-#include "roles.hpp"
+#include "colorlab/campaigns/roles.hpp"
 
 namespace colorlab::campaigns {
 
@@ -282,186 +283,229 @@ void Lab::follow_execution(const ExecutionControl& control) {
 
 asio::awaitable<json> Lab::perform(const std::string& call, const json& args, const ExecutionControl& control) {
   follow_execution(control);
-  if (call == "meter.measure") {
-    auto meter = co_await acquire<drivers::LuminanceMeter>("luminance_meter");
-    auto r = co_await meter->measure_luminance();
-    check_dropout(r.luminance, r.unit);
-    check_drift(r.luminance, r.unit);
-    json result{{"luminance", r.luminance}, {"unit", r.unit}, {"instrument", meter->id()}, {"raw", r.raw_reply}};
-    if (resumed_note_) result["resumed_after"] = *std::exchange(resumed_note_, std::nullopt);
-    co_return result;
+  ledger_.take();  // what an attempt that failed kept is no call's
+  const LabCall* c = find_lab_call(call);
+  if (!c || !c->perform) throw Error(ErrorClass::internal, "the lab has no call " + call);
+  json result = co_await (this->*(c->perform))(args, control);
+  co_return result;
+}
+
+FrameKeeper* Lab::call_keeper() { return keeper_ ? &ledger_ : nullptr; }
+
+asio::awaitable<std::shared_ptr<cam::CameraInstrument>> Lab::camera_named_in(const json& options) {
+  // A lab with two cameras (GenICam and DSLR) lets the script say which one: {camera = id or kind}.
+  if (options.is_object() && options.contains("camera")) {
+    auto camera = select_camera(instruments_, options["camera"]);
+    co_await ready(*camera);
+    co_return camera;
   }
-  if (call == "wait_stable") {
-    auto c = StabilityCriterion::from_json(args.empty() ? json::object() : args[0], options_.warmup);
-    json r = co_await wait_stable(c, control);
-    note_stable(r["luminance"].get<double>());
-    if (auto lamps = find_role<drivers::LampController>("lamps")) {
-      for (const auto& l : lamps->lamps_on()) known_warm_.insert(l);
-    }
-    if (resumed_note_) r["resumed_after"] = *std::exchange(resumed_note_, std::nullopt);
-    co_return r;
+  co_return co_await acquire<cam::CameraInstrument>("camera");
+}
+
+asio::awaitable<json> Lab::call_meter_measure(const json&, const ExecutionControl&) {
+  auto meter = co_await acquire<drivers::LuminanceMeter>("luminance_meter");
+  auto r = co_await meter->measure_luminance();
+  check_dropout(r.luminance, r.unit);
+  check_drift(r.luminance, r.unit);
+  json result{{"luminance", r.luminance}, {"unit", r.unit}, {"instrument", meter->id()}, {"raw", r.raw_reply}};
+  if (resumed_note_) result["resumed_after"] = *std::exchange(resumed_note_, std::nullopt);
+  co_return result;
+}
+
+asio::awaitable<json> Lab::call_wait_stable(const json& args, const ExecutionControl& control) {
+  auto c = StabilityCriterion::from_json(args.empty() ? json::object() : args[0], options_.warmup);
+  json r = co_await wait_stable(c, control);
+  note_stable(r["luminance"].get<double>());
+  if (auto lamps = find_role<drivers::LampController>("lamps")) {
+    for (const auto& l : lamps->lamps_on()) known_warm_.insert(l);
   }
-  if (call == "lamps.select") {
-    std::vector<std::string> on{args[0].get<std::string>()};
-    co_await switch_lamps(on);
-    json result = json::object();
-    result["lamps_on"] = on;
-    co_return result;
+  if (resumed_note_) r["resumed_after"] = *std::exchange(resumed_note_, std::nullopt);
+  co_return r;
+}
+
+asio::awaitable<json> Lab::call_lamps_select(const json& args, const ExecutionControl&) {
+  std::vector<std::string> on{args[0].get<std::string>()};
+  co_await switch_lamps(on);
+  json result = json::object();
+  result["lamps_on"] = on;
+  co_return result;
+}
+
+asio::awaitable<json> Lab::call_lamps_set(const json& args, const ExecutionControl&) {
+  std::vector<std::string> on;
+  for (const auto& l : args[0]) {
+    if (!l.is_string()) throw Error(ErrorClass::script_error, "lab.lamps.set takes a list of lamp names");
+    on.push_back(l.get<std::string>());
   }
-  if (call == "lamps.set") {
-    std::vector<std::string> on;
-    for (const auto& l : args[0]) {
-      if (!l.is_string()) throw Error(ErrorClass::script_error, "lab.lamps.set takes a list of lamp names");
-      on.push_back(l.get<std::string>());
-    }
-    co_await switch_lamps(on);
-    co_return json{{"lamps_on", on}};
+  co_await switch_lamps(on);
+  co_return json{{"lamps_on", on}};
+}
+
+asio::awaitable<json> Lab::call_lamps_off(const json&, const ExecutionControl&) {
+  std::vector<std::string> none;
+  co_await switch_lamps(none);
+  json result = json::object();
+  result["lamps_on"] = json::array();
+  co_return result;
+}
+
+asio::awaitable<json> Lab::call_lamps_names(const json&, const ExecutionControl&) {
+  auto lamps = role<drivers::LampController>("lamps");
+  co_return json(lamps->lamp_names());
+}
+
+asio::awaitable<json> Lab::call_dimmer_set(const json& args, const ExecutionControl& control) {
+  auto dimmer = co_await acquire<drivers::Dimmer>("dimmer");
+  const std::string channel = "dimmer";
+  co_await dimmer->set_level(channel, args[0].get<double>() / 100.0);
+  dimmer_percent_ = args[0].get<double>();
+  // The driver ramps at its configured rate and settles; a script may ask for more settling.
+  if (args.size() > 1 && args[1].is_object() && args[1].contains("settle_s")) {
+    double settle = args[1]["settle_s"].is_number() ? args[1]["settle_s"].get<double>() : -1;
+    if (!(settle >= 0 && settle <= 3600)) throw Error(ErrorClass::script_error, "lab.dimmer.set: settle_s must be from 0 to 3600");
+    co_await sleep_lab_seconds(settle, control);
   }
-  if (call == "lamps.off") {
-    std::vector<std::string> none;
-    co_await switch_lamps(none);
-    json result = json::object();
-    result["lamps_on"] = json::array();
-    co_return result;
+  co_return json{{"dimmer_percent", args[0]}};
+}
+
+asio::awaitable<json> Lab::call_table_move(const json& args, const ExecutionControl&) {
+  auto table = co_await acquire<drivers::XyTable>("table");
+  co_await table->move_to(args[0].get<double>(), args[1].get<double>());
+  co_return json(nullptr);
+}
+
+asio::awaitable<json> Lab::call_table_home(const json&, const ExecutionControl&) {
+  auto table = co_await acquire<drivers::XyTable>("table");
+  co_await table->home();
+  co_return json(nullptr);
+}
+
+asio::awaitable<json> Lab::call_table_head_up(const json&, const ExecutionControl&) {
+  auto table = co_await acquire<drivers::XyTable>("table");
+  co_await table->head_up();
+  co_return json(nullptr);
+}
+
+asio::awaitable<json> Lab::call_table_head_down(const json&, const ExecutionControl&) {
+  auto table = co_await acquire<drivers::XyTable>("table");
+  co_await table->head_down();
+  co_return json(nullptr);
+}
+
+asio::awaitable<json> Lab::call_table_hold_paper(const json& args, const ExecutionControl&) {
+  auto table = co_await acquire<drivers::XyTable>("table");
+  co_await table->hold_paper(args[0].get<bool>());
+  co_return json(nullptr);
+}
+
+asio::awaitable<json> Lab::call_table_measure_at(const json& args, const ExecutionControl&) {
+  auto table = co_await acquire<drivers::XyTable>("table");
+  auto r = co_await table->move_and_measure(args[0].get<double>(), args[1].get<double>());
+  co_return spectrum_json(r, table->id());
+}
+
+asio::awaitable<json> Lab::call_table_read_patch(const json& args, const ExecutionControl&) {
+  auto table = co_await acquire<drivers::XyTable>("table");
+  drivers::ChartPatchVisit visit;
+  visit.x_mm = args[0].get<double>();
+  visit.y_mm = args[1].get<double>();
+  const json options = args.size() > 2 && args[2].is_object() ? args[2] : json::object();
+  visit.row_start = options.value("row_start", false);
+  visit.row_length = options.value("row_length", 1);
+  visit.index = options.value("index", 0);
+  if (visit.row_length < 1 || visit.row_length > 1000) {
+    throw Error(ErrorClass::script_error, "lab.table.read_patch: row_length must be from 1 to 1000");
   }
-  if (call == "lamps.names") {
-    auto lamps = role<drivers::LampController>("lamps");
-    co_return json(lamps->lamp_names());
+  auto r = co_await table->read_chart_patch(visit);
+  json j = spectrum_json(r, table->id());
+  // How long the white calibration lasts from here: shows where the table recalibrated.
+  for (const auto& c : table->calibration()) {
+    if (c.valid && c.readings_left) j["calibration_readings_left"] = *c.readings_left;
   }
-  if (call == "dimmer.set") {
-    auto dimmer = co_await acquire<drivers::Dimmer>("dimmer");
-    const std::string channel = "dimmer";
-    co_await dimmer->set_level(channel, args[0].get<double>() / 100.0);
-    dimmer_percent_ = args[0].get<double>();
-    // The driver ramps at its configured rate and settles; a script may ask for more settling.
-    if (args.size() > 1 && args[1].is_object() && args[1].contains("settle_s")) {
-      double settle = args[1]["settle_s"].is_number() ? args[1]["settle_s"].get<double>() : -1;
-      if (!(settle >= 0 && settle <= 3600)) throw Error(ErrorClass::script_error, "lab.dimmer.set: settle_s must be from 0 to 3600");
-      co_await sleep_lab_seconds(settle, control);
-    }
-    co_return json{{"dimmer_percent", args[0]}};
+  co_return j;
+}
+
+asio::awaitable<json> Lab::call_spectro_mode(const json& args, const ExecutionControl&) {
+  auto spectro = co_await acquire<drivers::Spectrometer>("spectrophotometer");
+  co_await spectro->set_mode(mode_from(args[0].get<std::string>()));
+  co_return json(nullptr);
+}
+
+asio::awaitable<json> Lab::call_spectro_calibrate(const json&, const ExecutionControl&) {
+  auto spectro = co_await acquire<drivers::Spectrometer>("spectrophotometer");
+  co_await spectro->calibrate();
+  co_return json(nullptr);
+}
+
+asio::awaitable<json> Lab::call_spectro_measure(const json&, const ExecutionControl&) {
+  auto spectro = co_await acquire<drivers::Spectrometer>("spectrophotometer");
+  auto r = co_await spectro->measure();
+  co_return spectrum_json(r, spectro->id());
+}
+
+asio::awaitable<json> Lab::call_camera_configure(const json& args, const ExecutionControl&) {
+  // configure{camera = id or kind} sets the one a later photograph_chart names on a lab with two.
+  auto camera = co_await camera_named_in(args[0]);
+  cam::CameraSettings s;
+  for (const auto& [key, value] : args[0].items()) {
+    if (key == "camera") continue;
+    if (!value.is_number()) throw Error(ErrorClass::script_error, "lab.camera.configure: " + key + " must be a number");
+    if (key == "iso") s.iso = value.get<int>();
+    else if (key == "shutter_s") s.shutter_s = value.get<double>();
+    else if (key == "aperture_f") s.aperture_f = value.get<double>();
+    else if (key == "exposure_us") s.exposure_us = value.get<double>();
+    else if (key == "gain") s.gain = value.get<double>();
+    else throw Error(ErrorClass::script_error, "lab.camera.configure: unknown setting '" + key + "' (iso, shutter_s, aperture_f, exposure_us, gain, camera)");
   }
-  if (call.rfind("table.", 0) == 0) {
-    auto table = co_await acquire<drivers::XyTable>("table");
-    if (call == "table.move") {
-      co_await table->move_to(args[0].get<double>(), args[1].get<double>());
-    } else if (call == "table.home") {
-      co_await table->home();
-    } else if (call == "table.head_up") {
-      co_await table->head_up();
-    } else if (call == "table.head_down") {
-      co_await table->head_down();
-    } else if (call == "table.hold_paper") {
-      co_await table->hold_paper(args[0].get<bool>());
-    } else if (call == "table.measure_at") {
-      auto r = co_await table->move_and_measure(args[0].get<double>(), args[1].get<double>());
-      co_return spectrum_json(r, table->id());
-    } else if (call == "table.read_patch") {
-      drivers::ChartPatchVisit visit;
-      visit.x_mm = args[0].get<double>();
-      visit.y_mm = args[1].get<double>();
-      const json options = args.size() > 2 && args[2].is_object() ? args[2] : json::object();
-      visit.row_start = options.value("row_start", false);
-      visit.row_length = options.value("row_length", 1);
-      visit.index = options.value("index", 0);
-      if (visit.row_length < 1 || visit.row_length > 1000) {
-        throw Error(ErrorClass::script_error, "lab.table.read_patch: row_length must be from 1 to 1000");
-      }
-      auto r = co_await table->read_chart_patch(visit);
-      json j = spectrum_json(r, table->id());
-      // How long the white calibration lasts from here: shows where the table recalibrated.
-      for (const auto& c : table->calibration()) {
-        if (c.valid && c.readings_left) j["calibration_readings_left"] = *c.readings_left;
-      }
-      co_return j;
-    }
-    co_return json(nullptr);
-  }
-  if (call.rfind("spectro.", 0) == 0) {
-    auto spectro = co_await acquire<drivers::Spectrometer>("spectrophotometer");
-    if (call == "spectro.mode") {
-      co_await spectro->set_mode(mode_from(args[0].get<std::string>()));
-    } else if (call == "spectro.calibrate") {
-      co_await spectro->calibrate();
-    } else if (call == "spectro.measure") {
-      auto r = co_await spectro->measure();
-      co_return spectrum_json(r, spectro->id());
-    }
-    co_return json(nullptr);
-  }
-  if (call == "camera.configure" || call == "camera.capture") {
-    // A lab with two cameras: configure{camera = id or kind} sets the one a later photograph_chart names.
-    const bool named = call == "camera.configure" && !args.empty() && args[0].is_object() && args[0].contains("camera");
-    std::shared_ptr<cam::CameraInstrument> camera;
-    if (named) {
-      camera = select_camera(instruments_, args[0]["camera"]);
-      co_await ready(*camera);
-    } else {
-      camera = co_await acquire<cam::CameraInstrument>("camera");
-    }
-    if (call == "camera.capture") {
-      // Named, not a temporary in the co_await: GCC 12 destroys such temporaries twice.
-      json options = args.empty() ? json::object() : args[0];
-      json table = co_await capture_noise_table(*camera, options, keeper_);
-      co_return table;
-    }
-    cam::CameraSettings s;
-    const json& o = args[0];
-    for (const auto& [key, value] : o.items()) {
-      if (key == "camera") continue;
-      if (!value.is_number()) throw Error(ErrorClass::script_error, "lab.camera.configure: " + key + " must be a number");
-      if (key == "iso") s.iso = value.get<int>();
-      else if (key == "shutter_s") s.shutter_s = value.get<double>();
-      else if (key == "aperture_f") s.aperture_f = value.get<double>();
-      else if (key == "exposure_us") s.exposure_us = value.get<double>();
-      else if (key == "gain") s.gain = value.get<double>();
-      else throw Error(ErrorClass::script_error, "lab.camera.configure: unknown setting '" + key + "' (iso, shutter_s, aperture_f, exposure_us, gain, camera)");
-    }
-    auto error = co_await cam::async_configure(camera->camera(), s, asio::use_awaitable);
-    if (error) throw *error;
-    co_return json(nullptr);
-  }
-  if (call == "camera.photograph_chart") {
-    json options = args.empty() ? json::object() : args[0];
-    // A lab with two cameras (GenICam and DSLR) lets the script say which one photographs the chart.
-    std::shared_ptr<cam::CameraInstrument> camera;
-    if (options.is_object() && options.contains("camera")) {
-      camera = select_camera(instruments_, options["camera"]);
-      co_await ready(*camera);
-    } else {
-      camera = co_await acquire<cam::CameraInstrument>("camera");
-    }
-    json photographs = co_await photograph_chart(*camera, options, keeper_);
-    co_return photographs;
-  }
-  if (call == "camera.photograph_floor") {
-    auto camera = co_await acquire<cam::CameraInstrument>("camera");
-    json options = args[0];
-    json photograph = co_await photograph_floor(*camera, options, keeper_);
-    co_return photograph;
-  }
-  if (call == "runs.chart_reference") {
-    if (!runs_) throw Error(ErrorClass::unsupported, "lab.runs.chart_reference: this lab keeps no runs to read");
-    co_return chart_reference(*runs_, args[0].get<std::string>());
-  }
-  if (call == "operator.request") {
-    json answer = co_await operator_request(args[0], control);
-    // Whoever answered may have moved the meter (aiming it is what most requests are about): readings
-    // from here on are not comparable with those before.
-    light_.moved();
-    aimed_since_stable_ = true;
-    co_return answer;
-  }
-  if (call == "wait") {
-    co_await sleep_lab_seconds(args[0].get<double>(), control);
-    co_return json(nullptr);
-  }
-  if (call == "now") {
-    auto now = std::chrono::system_clock::now();
-    co_return json{{"utc", now_iso8601()},
-                   {"unix", std::chrono::duration<double>(now.time_since_epoch()).count()}};
-  }
-  throw Error(ErrorClass::internal, "the lab has no call " + call);
+  auto error = co_await cam::async_configure(camera->camera(), s, asio::use_awaitable);
+  if (error) throw *error;
+  co_return json(nullptr);
+}
+
+asio::awaitable<json> Lab::call_camera_capture(const json& args, const ExecutionControl&) {
+  auto camera = co_await acquire<cam::CameraInstrument>("camera");
+  // Named, not a temporary in the co_await: GCC 12 destroys such temporaries twice.
+  json options = args.empty() ? json::object() : args[0];
+  json table = co_await capture_noise_table(*camera, options, call_keeper());
+  co_return table;
+}
+
+asio::awaitable<json> Lab::call_camera_photograph_chart(const json& args, const ExecutionControl&) {
+  json options = args.empty() ? json::object() : args[0];
+  auto camera = co_await camera_named_in(options);
+  json photographs = co_await photograph_chart(*camera, options, call_keeper());
+  co_return photographs;
+}
+
+asio::awaitable<json> Lab::call_camera_photograph_floor(const json& args, const ExecutionControl&) {
+  auto camera = co_await acquire<cam::CameraInstrument>("camera");
+  json options = args[0];
+  json photograph = co_await photograph_floor(*camera, options, call_keeper());
+  co_return photograph;
+}
+
+asio::awaitable<json> Lab::call_runs_chart_reference(const json& args, const ExecutionControl&) {
+  if (!runs_) throw Error(ErrorClass::unsupported, "lab.runs.chart_reference: this lab keeps no runs to read");
+  co_return chart_reference(*runs_, args[0].get<std::string>());
+}
+
+asio::awaitable<json> Lab::call_operator_request(const json& args, const ExecutionControl& control) {
+  json answer = co_await operator_request(args[0], control);
+  // Whoever answered may have moved the meter (aiming it is what most requests are about): readings
+  // from here on are not comparable with those before.
+  light_.moved();
+  aimed_since_stable_ = true;
+  co_return answer;
+}
+
+asio::awaitable<json> Lab::call_wait(const json& args, const ExecutionControl& control) {
+  co_await sleep_lab_seconds(args[0].get<double>(), control);
+  co_return json(nullptr);
+}
+
+asio::awaitable<json> Lab::call_now(const json&, const ExecutionControl&) {
+  auto now = std::chrono::system_clock::now();
+  co_return json{{"utc", now_iso8601()}, {"unix", std::chrono::duration<double>(now.time_since_epoch()).count()}};
 }
 
 asio::awaitable<json> Lab::restore(const LabState& desired, const ExecutionControl& control) {

@@ -13,15 +13,12 @@
 
 #include <nlohmann/json.hpp>
 
+#include "colorlab/core/step_records.hpp"
+
 namespace colorlab::campaigns {
 
-// One live call's duration: `lab_seconds` per unit (a frame × format for photographs, a frame for
-// captures, the call otherwise), wall time × the lab's time scale, minus waits the script itself
-// asked for (a dimmer's settle_s), which the dry run adds back exactly.
-struct CallTiming {
-  std::string key;
-  double lab_seconds = 0;
-};
+// One live call's duration (colorlab/core/step_records.hpp says what it holds).
+using CallTiming = records::CallTiming;
 
 struct TimingStats {
   std::int64_t n = 0;

@@ -4,8 +4,14 @@
 #include <memory>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "colorlab/campaigns/instrument_set.hpp"
 #include "colorlab/drivers/instrument.hpp"
+
+namespace colorlab::drivers::camera {
+class CameraInstrument;
+}
 
 namespace colorlab::campaigns {
 
@@ -24,5 +30,10 @@ bool kind_offers(const std::string& kind, const std::string& role);
 std::string absent_for(const InstrumentSet& instruments, const std::string& role);
 // Error{not_found}: the campaign needs `role` and no instrument can serve it now.
 [[noreturn]] void refuse_role(const InstrumentSet& instruments, const std::string& role);
+
+// The camera an options table names by instrument id ("dslr") or by kind ("dslr", "genicam");
+// Error(not_found) listing the cameras there are, Error(bad_parameter) for a non-camera id.
+std::shared_ptr<drivers::camera::CameraInstrument> select_camera(const InstrumentSet& instruments,
+                                                                 const nlohmann::json& id_or_kind);
 
 }  // namespace colorlab::campaigns

@@ -12,18 +12,12 @@
 #include <nlohmann/json.hpp>
 
 #include "colorlab/campaigns/frame_keeper.hpp"
-#include "colorlab/campaigns/instrument_set.hpp"
 
 namespace colorlab::drivers::camera {
 class CameraInstrument;
 }
 
 namespace colorlab::campaigns {
-
-// The camera an options table names by instrument id ("dslr") or by kind ("dslr", "genicam");
-// Error(not_found) listing the cameras there are, Error(bad_parameter) for a non-camera id.
-std::shared_ptr<drivers::camera::CameraInstrument> select_camera(const InstrumentSet& instruments,
-                                                                 const nlohmann::json& id_or_kind);
 
 // options: {frames = 25 (1..256), chart = "sg" | "cc24", formats = {"raw", "tiff16", "tiff8", "jpeg"},
 // sample_fraction = 0.6, min_confidence = 0.6, camera = id (used by the caller to choose),

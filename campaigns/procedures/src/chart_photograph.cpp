@@ -239,27 +239,6 @@ asio::thread_pool& chart_worker() {
 
 }  // namespace
 
-std::shared_ptr<cam::CameraInstrument> select_camera(const InstrumentSet& instruments, const json& id_or_kind) {
-  if (!id_or_kind.is_string() || id_or_kind.get<std::string>().empty()) {
-    throw Error(ErrorClass::bad_parameter, "lab.camera.photograph_chart: camera must be an instrument id or a kind (dslr, genicam)");
-  }
-  const std::string want = id_or_kind.get<std::string>();
-  if (auto i = instruments.find(want)) {
-    if (auto c = std::dynamic_pointer_cast<cam::CameraInstrument>(i)) return c;
-    throw Error(ErrorClass::bad_parameter, "instrument '" + want + "' is not a camera", "name a camera's id or kind");
-  }
-  std::string cameras;
-  for (const auto& i : instruments.all()) {
-    auto c = std::dynamic_pointer_cast<cam::CameraInstrument>(i);
-    if (!c) continue;
-    if (cam::to_string(c->camera().identity().kind) == want) return c;
-    cameras += (cameras.empty() ? "" : ", ") + c->id() + " (" + std::string(cam::to_string(c->camera().identity().kind)) + ")";
-  }
-  throw Error(ErrorClass::not_found, "no camera has the id or kind '" + want + "'",
-              cameras.empty() ? "add a camera to colorlabd's configuration, or run the simulated lab"
-                              : "the configured cameras are " + cameras);
-}
-
 asio::awaitable<json> photograph_chart(cam::CameraInstrument& instrument, const json& options, FrameKeeper* keeper) {
   const PhotographOptions p = parse(options);
   auto& camera = instrument.camera();

@@ -24,35 +24,16 @@
 #include "colorlab/campaigns/lab.hpp"
 #include "colorlab/campaigns/script.hpp"
 #include "colorlab/core/error.hpp"
+#include "colorlab/core/step_records.hpp"
 
 namespace colorlab::campaigns {
 
-struct JournalEntry {
-  std::int64_t seq = 0;  // 0-based position of the call in the script's run
-  std::string call;      // "meter.measure", "lamps.select", ...
-  nlohmann::json args;   // the call's arguments as given
-  nlohmann::json result;
-};
-
-struct RecordedMeasurement {
-  std::string step;  // unique within the run
-  std::string instrument_id;
-  std::string quantity;
-  std::optional<double> value;
-  std::string unit;
-  nlohmann::json data;
-};
-
-// One committed step: everything since the previous commit, stored in one transaction.
-struct StepCommit {
-  std::vector<JournalEntry> journal;
-  std::vector<RecordedMeasurement> measurements;
-  double progress = 0;
-  std::string label;
-  // How long each live call took (none for replayed ones, nor for calls that were suspended):
-  // what the dry run estimates from.
-  std::vector<CallTiming> timings;
-};
+// The step's records are the store's too (colorlab/core/step_records.hpp): the engine hands them over as they are.
+using JournalEntry = records::JournalEntry;
+using RecordedMeasurement = records::Measurement;
+// One committed step: the journal, the measurements, the progress, the live calls' timings and the
+// blobs the calls kept (typed, named in the run), stored in one transaction.
+using StepCommit = records::Step;
 
 // The daemon's side of one execution.
 class ExecutionSink {

@@ -6,6 +6,7 @@
 #include <boost/asio/use_awaitable.hpp>
 
 #include "colorlab/campaigns/lab.hpp"
+#include "colorlab/campaigns/roles.hpp"
 #include "colorlab/core/error.hpp"
 #include "colorlab/core/log.hpp"
 #include "colorlab/drivers/lab_capabilities.hpp"
@@ -18,15 +19,11 @@ using drivers::Capability;
 
 namespace {
 
-// The capability a call needs, for finding the instrument to bring back.
+// The capability a call needs (its role's, from the registry), for finding the instrument to bring back.
 std::optional<Capability> capability_for(const std::string& call) {
-  if (call.rfind("meter.", 0) == 0 || call == "wait_stable") return Capability::luminance;
-  if (call.rfind("table.", 0) == 0) return Capability::xy_table;
-  if (call.rfind("spectro.", 0) == 0) return Capability::reflectance_spectrum;
-  if (call.rfind("lamps.", 0) == 0) return Capability::lamp_switching;
-  if (call.rfind("dimmer.", 0) == 0) return Capability::dimmer;
-  if (call.rfind("camera.", 0) == 0) return Capability::camera;
-  return std::nullopt;
+  const LabCall* c = find_lab_call(call);
+  if (!c || c->role.empty()) return std::nullopt;
+  return capability_of(std::string(c->role));
 }
 
 bool is_lamp_condition(const Error& e) { return e.info().device_code.rfind("lamp:", 0) == 0; }

@@ -22,77 +22,6 @@ using nlohmann::json;
 
 namespace {
 
-struct CallSpec {
-  CallKind kind;
-  std::vector<std::string> args;  // json types: "string", "number", "boolean", "list", "table"; "?" suffix = optional
-};
-
-const std::map<std::string, CallSpec>& call_specs() {
-  static const std::map<std::string, CallSpec> specs = {
-      {"lamps.select", {CallKind::effect, {"string"}}},
-      {"lamps.set", {CallKind::effect, {"list"}}},
-      {"lamps.off", {CallKind::effect, {}}},
-      {"lamps.names", {CallKind::reading, {}}},
-      {"dimmer.set", {CallKind::effect, {"number", "table?"}}},
-      {"table.move", {CallKind::effect, {"number", "number"}}},
-      {"table.home", {CallKind::effect, {}}},
-      {"table.head_up", {CallKind::effect, {}}},
-      {"table.head_down", {CallKind::effect, {}}},
-      {"table.hold_paper", {CallKind::effect, {"boolean"}}},
-      {"table.measure_at", {CallKind::reading, {"number", "number"}}},
-      {"table.read_patch", {CallKind::reading, {"number", "number", "table?"}}},
-      {"operator.request", {CallKind::reading, {"table"}}},
-      {"spectro.mode", {CallKind::effect, {"string"}}},
-      {"spectro.calibrate", {CallKind::effect, {}}},
-      {"spectro.measure", {CallKind::reading, {}}},
-      {"meter.measure", {CallKind::reading, {}}},
-      {"camera.configure", {CallKind::effect, {"table"}}},
-      {"camera.capture", {CallKind::reading, {"table?"}}},
-      {"camera.photograph_chart", {CallKind::reading, {"table?"}}},
-      {"camera.photograph_floor", {CallKind::reading, {"table"}}},
-      {"runs.chart_reference", {CallKind::reading, {"string"}}},
-      {"wait", {CallKind::effect, {"number"}}},
-      {"wait_stable", {CallKind::reading, {"table?"}}},
-      {"now", {CallKind::reading, {}}},
-      {"checkpoint", {CallKind::control, {}}},
-  };
-  return specs;
-}
-
-std::string json_kind(const json& v) {
-  if (v.is_null()) return "nil";
-  if (v.is_string()) return "string";
-  if (v.is_number()) return "number";
-  if (v.is_boolean()) return "boolean";
-  if (v.is_array()) return "list";
-  return "table";
-}
-
-// Empty string = fine; otherwise what is wrong, in the script author's terms.
-std::string check_args(const std::string& call, const json& args) {
-  const auto& spec = call_specs().at(call).args;
-  if (args.size() > spec.size()) {
-    return "lab." + call + " takes " + std::to_string(spec.size()) + " argument(s), got " + std::to_string(args.size());
-  }
-  for (std::size_t i = 0; i < spec.size(); ++i) {
-    std::string want = spec[i];
-    bool optional = !want.empty() && want.back() == '?';
-    if (optional) want.pop_back();
-    json v = i < args.size() ? args[i] : json(nullptr);
-    std::string got = json_kind(v);
-    if (got == "nil" && optional) continue;
-    bool ok = got == want || (want == "list" && got == "table" && v.empty()) || (want == "table" && got == "list" && v.empty());
-    if (!ok) return "bad argument #" + std::to_string(i + 1) + " to lab." + call + " (" + want + " expected, got " + got + ")";
-  }
-  if (call == "dimmer.set" && !(args[0].get<double>() >= 0 && args[0].get<double>() <= 100)) {
-    return "lab.dimmer.set takes a level in percent from 0 to 100, got " + args[0].dump();
-  }
-  if (call == "wait" && !(args[0].get<double>() >= 0 && args[0].get<double>() <= 86400)) {
-    return "lab.wait takes seconds from 0 to 86400, got " + args[0].dump();
-  }
-  return {};
-}
-
 LabCallSink* sink_of(lua_State* L) { return static_cast<LabCallSink*>(lua_touserdata(L, lua_upvalueindex(1))); }
 
 // Raises the message on top of the stack as a Lua error with the calling line in front. Only call
@@ -135,7 +64,7 @@ int yielding_call(lua_State* L) {
     int n = lua_gettop(L);
     for (int i = 1; i <= n; ++i) args.push_back(to_json(L, i, "argument #" + std::to_string(i) + " to lab." + call));
     while (!args.empty() && args.back().is_null()) args.erase(args.end() - 1);
-    std::string problem = check_args(call, args);
+    std::string problem = check_lab_args(lab_call(call), args);
     if (!problem.empty()) throw Error(ErrorClass::script_error, problem);
     sink->request(call, std::move(args));
   });
@@ -409,16 +338,11 @@ void claim_step(std::set<std::string>& recorded, const std::string& step) {
   }
 }
 
-CallKind kind_of(const std::string& call) {
-  auto it = call_specs().find(call);
-  if (it == call_specs().end()) throw Error(ErrorClass::internal, "unknown lab call " + call);
-  return it->second.kind;
-}
-
 void install_lab_api(lua_State* L, LabCallSink* sink) {
   lua_newtable(L);  // lab
   std::map<std::string, std::vector<std::string>> groups;
-  for (const auto& [call, spec] : call_specs()) {
+  for (const auto& c : lab_calls()) {
+    const std::string call(c.name);
     auto dot = call.find('.');
     if (dot == std::string::npos) {
       set_function(L, call.c_str(), yielding_call, sink, call.c_str());

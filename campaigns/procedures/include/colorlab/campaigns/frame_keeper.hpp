@@ -4,29 +4,26 @@
 // with its content-addressed blob store, so the engine stays free of files and SQLite.
 //
 // A kept blob's file is durable when keep_* returns; the row that makes it part of the run is
-// written with the step that made the lab call, from the references in the call's result
-// (`blobs`, see kept_blobs()), so a replayed call brings its references back from the journal.
+// written with the step that made the lab call: the lab hands the typed references it kept during
+// the call (KeepLedger) to the engine, which commits them with the call's journal entry. The call's
+// result carries them as JSON too (`blobs`), for the script and for a replay.
 #include <cstdint>
 #include <filesystem>
+#include <mutex>
 #include <span>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "colorlab/core/step_records.hpp"
+
 namespace colorlab::campaigns {
 
-struct KeptBlob {
-  std::string sha256;
-  std::string name;  // within the call; the run's name is "<call>#<seq>/<name>"
-  std::string kind;  // raw, average, tiff16, tiff8, jpeg, preview
-  std::string media_type;
-  std::uint64_t size = 0;
-  nlohmann::json meta = nlohmann::json::object();
-
-  nlohmann::json to_json() const;
-  static KeptBlob from_json(const nlohmann::json& j);
-};
+// A kept blob's reference, `name` within the call (the run's name is "<call>#<seq>/<name>").
+using KeptBlob = records::BlobRef;
+// The reference as a call's result carries it (its "blobs" array), for the script and the journal.
+nlohmann::json blob_json(const KeptBlob& b);
 
 // The media type of the float/integer arrays colorlab writes: raw little-endian samples, row-major,
 // described by meta {dtype = "<f4" | "<u2", shape = [h, w] | [h, w, c], cfa = "RGGB" | …}.
@@ -45,8 +42,29 @@ class FrameKeeper {
   virtual KeptBlob keep_preview(const std::string& name, const KeptBlob& of) = 0;
 };
 
-// The references a lab call's result carries (its "blobs" array); empty when it has none.
-std::vector<KeptBlob> kept_blobs(const nlohmann::json& call_result);
+// A keeper in front of another that notes what went through it: the lab keeps a call's frames
+// through one and hands the references to the engine when the call is done. Thread-safe, as the
+// keeper behind it.
+class KeepLedger final : public FrameKeeper {
+ public:
+  void set_keeper(FrameKeeper* keeper) { keeper_ = keeper; }
+  FrameKeeper* keeper() const { return keeper_; }
+  KeptBlob keep_bytes(const std::string& name, const std::string& kind, const std::string& media_type,
+                      const nlohmann::json& meta, std::span<const std::uint8_t> bytes) override;
+  KeptBlob keep_file(const std::string& name, const std::string& kind, const std::string& media_type,
+                     const nlohmann::json& meta, const std::filesystem::path& file) override;
+  KeptBlob keep_preview(const std::string& name, const KeptBlob& of) override;
+  // What was kept since the last take, in the order it was kept; forgets it.
+  std::vector<KeptBlob> take();
+
+ private:
+  KeptBlob noted(KeptBlob b);
+
+  FrameKeeper* keeper_ = nullptr;
+  std::mutex mutex_;
+  std::vector<KeptBlob> kept_;
+};
+
 // The media type of a camera file by its extension (image/x-adobe-dng, image/jpeg, …).
 std::string media_type_of(const std::filesystem::path& file);
 

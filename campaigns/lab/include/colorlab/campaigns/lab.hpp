@@ -19,11 +19,16 @@
 #include "colorlab/campaigns/control.hpp"
 #include "colorlab/campaigns/frame_keeper.hpp"
 #include "colorlab/campaigns/instrument_set.hpp"
+#include "colorlab/campaigns/lab_calls.hpp"
 #include "colorlab/campaigns/lab_state.hpp"
 #include "colorlab/campaigns/light_reference.hpp"
 #include "colorlab/campaigns/operator_desk.hpp"
 #include "colorlab/campaigns/run_reader.hpp"
 #include "colorlab/core/error.hpp"
+
+namespace colorlab::drivers::camera {
+class CameraInstrument;
+}
 
 namespace colorlab::campaigns {
 
@@ -71,7 +76,8 @@ class Lab {
 
   // Throws Error{not_found} naming the first role no configured instrument offers.
   void check_needs(const std::vector<std::string>& roles) const;
-  // One lab call, live. Long waits end early with Error{aborted} when `control` asks.
+  // One lab call, live, through its row in the registry (lab_calls.hpp). Long waits end early with
+  // Error{aborted} when `control` asks.
   boost::asio::awaitable<nlohmann::json> perform(const std::string& call, const nlohmann::json& args,
                                                  const ExecutionControl& control);
   // Why a failed call should suspend the execution rather than fail it ("lamp", "instrument"), or
@@ -100,8 +106,13 @@ class Lab {
   // Where lab.runs.* reads earlier runs (the daemon's store); without one those calls fail.
   void set_run_reader(RunReader* runs) { runs_ = runs; }
   // Where frames worth keeping go (the daemon's blob store); without one nothing is kept.
-  void set_frame_keeper(FrameKeeper* keeper) { keeper_ = keeper; }
+  void set_frame_keeper(FrameKeeper* keeper) {
+    keeper_ = keeper;
+    ledger_.set_keeper(keeper);
+  }
   FrameKeeper* frame_keeper() const { return keeper_; }
+  // The blobs the last perform() kept, in the order kept (typed, for the step that journals the call); forgets them.
+  std::vector<KeptBlob> take_kept() { return ledger_.take(); }
   // What a dry run of a campaign on this lab needs to know of it.
   const OperatorHands* hands() const { return hands_; }
   RunReader* run_reader() const { return runs_; }
@@ -111,6 +122,38 @@ class Lab {
   double time_scale() const { return options_.time_scale; }
 
  private:
+  // The calls' handlers, one per call: lab_calls.cpp's rows name them.
+  friend const std::vector<LabCall>& lab_calls();
+  boost::asio::awaitable<nlohmann::json> call_meter_measure(const nlohmann::json& args, const ExecutionControl& control);
+  boost::asio::awaitable<nlohmann::json> call_wait_stable(const nlohmann::json& args, const ExecutionControl& control);
+  boost::asio::awaitable<nlohmann::json> call_lamps_select(const nlohmann::json& args, const ExecutionControl& control);
+  boost::asio::awaitable<nlohmann::json> call_lamps_set(const nlohmann::json& args, const ExecutionControl& control);
+  boost::asio::awaitable<nlohmann::json> call_lamps_off(const nlohmann::json& args, const ExecutionControl& control);
+  boost::asio::awaitable<nlohmann::json> call_lamps_names(const nlohmann::json& args, const ExecutionControl& control);
+  boost::asio::awaitable<nlohmann::json> call_dimmer_set(const nlohmann::json& args, const ExecutionControl& control);
+  boost::asio::awaitable<nlohmann::json> call_table_move(const nlohmann::json& args, const ExecutionControl& control);
+  boost::asio::awaitable<nlohmann::json> call_table_home(const nlohmann::json& args, const ExecutionControl& control);
+  boost::asio::awaitable<nlohmann::json> call_table_head_up(const nlohmann::json& args, const ExecutionControl& control);
+  boost::asio::awaitable<nlohmann::json> call_table_head_down(const nlohmann::json& args, const ExecutionControl& control);
+  boost::asio::awaitable<nlohmann::json> call_table_hold_paper(const nlohmann::json& args, const ExecutionControl& control);
+  boost::asio::awaitable<nlohmann::json> call_table_measure_at(const nlohmann::json& args, const ExecutionControl& control);
+  boost::asio::awaitable<nlohmann::json> call_table_read_patch(const nlohmann::json& args, const ExecutionControl& control);
+  boost::asio::awaitable<nlohmann::json> call_spectro_mode(const nlohmann::json& args, const ExecutionControl& control);
+  boost::asio::awaitable<nlohmann::json> call_spectro_calibrate(const nlohmann::json& args, const ExecutionControl& control);
+  boost::asio::awaitable<nlohmann::json> call_spectro_measure(const nlohmann::json& args, const ExecutionControl& control);
+  boost::asio::awaitable<nlohmann::json> call_camera_configure(const nlohmann::json& args, const ExecutionControl& control);
+  boost::asio::awaitable<nlohmann::json> call_camera_capture(const nlohmann::json& args, const ExecutionControl& control);
+  boost::asio::awaitable<nlohmann::json> call_camera_photograph_chart(const nlohmann::json& args, const ExecutionControl& control);
+  boost::asio::awaitable<nlohmann::json> call_camera_photograph_floor(const nlohmann::json& args, const ExecutionControl& control);
+  boost::asio::awaitable<nlohmann::json> call_runs_chart_reference(const nlohmann::json& args, const ExecutionControl& control);
+  boost::asio::awaitable<nlohmann::json> call_operator_request(const nlohmann::json& args, const ExecutionControl& control);
+  boost::asio::awaitable<nlohmann::json> call_wait(const nlohmann::json& args, const ExecutionControl& control);
+  boost::asio::awaitable<nlohmann::json> call_now(const nlohmann::json& args, const ExecutionControl& control);
+  // The keeper a call keeps its frames through (notes them for take_kept()), or nullptr.
+  FrameKeeper* call_keeper();
+  // The camera an options table names ({camera = id or kind}), else the one serving the role; connected.
+  boost::asio::awaitable<std::shared_ptr<drivers::camera::CameraInstrument>> camera_named_in(const nlohmann::json& options);
+
   // The last stable reading and the light it was taken under: the yardstick for a lamp dropout.
   struct StableLight {
     double luminance = 0;
@@ -166,6 +209,8 @@ class Lab {
   OperatorHands* hands_ = nullptr;
   RunReader* runs_ = nullptr;
   FrameKeeper* keeper_ = nullptr;
+  // In front of keeper_ for the calls: notes what each call kept.
+  KeepLedger ledger_;
 };
 
 }  // namespace colorlab::campaigns

@@ -2,12 +2,15 @@
 // The `lab` table a campaign script sees: instruments in lab terms, plus record, progress, log,
 // checkpoint and the analysis library. Calls that touch an instrument or take time yield the
 // script's coroutine with a request the engine carries out (or answers from the journal on
-// replay); the rest run at once. Arguments are checked here so an error names the script line.
+// replay); the rest run at once. The yielding calls and their arguments are the registry's
+// (lab_calls.hpp); arguments are checked here so an error names the script line.
 #include <functional>
 #include <set>
 #include <string>
 
 #include <nlohmann/json.hpp>
+
+#include "colorlab/campaigns/lab_calls.hpp"
 
 struct lua_State;
 
@@ -33,11 +36,6 @@ class LabCallSink {
 // A sink's record(): throws Error{script_error} when the script recorded `step` before in this run
 // (each lab.record needs its own step key), otherwise remembers it.
 void claim_step(std::set<std::string>& recorded, const std::string& step);
-
-// Kinds of yielding calls: an effect changes the lab (and is replayed into the desired state), a
-// reading returns a value (replayed from the journal), control only marks a safe point.
-enum class CallKind { effect, reading, control };
-CallKind kind_of(const std::string& call);
 
 // Sets the global `lab` in L. With sink == nullptr (reading a script's declaration) every call
 // raises "only inside run()".
