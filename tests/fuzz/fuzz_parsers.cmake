@@ -36,18 +36,17 @@ function(colorlab_fuzz_parser target name)
     # and an "unreachable" in its Unicode whitespace table (issues #190, #295; PR #305).
     list(APPEND libs colorlab::protocol colorlab_asio nlohmann_json::nlohmann_json PkgConfig::TOMLPP)
   elseif(name STREQUAL "campaign_script" OR name STREQUAL "campaign_params")
-    # The declaration sandbox and the `lab` table a script's top level sees; lab_api's analysis
-    # functions (characterize, chart_plan, floor_luminance_fit) and the catalogue's sequences come with it.
+    # The declaration sandbox and the `lab` table a script's top level sees, with the catalogue's
+    # sequences: the engine's sources, fuzzed. The table is built from the lab's registry of calls
+    # (lab_calls.hpp), whose rows name the live lab's and the dry run's handlers, and lab_api's analysis
+    # functions (characterize, chart_plan, floor_luminance_fit) are procedures: both come linked, as
+    # colorlab_campaign_lab (procedures with it), built plain in the libFuzzer build (fuzz_targets.cmake).
     foreach(f lua_sandbox lua_value lab_api script catalogue sequence)
       list(APPEND sources ${s}/campaigns/engine/src/${f}.cpp)
     endforeach()
-    foreach(f characterize characterize_lamps chart_plan floor_luminance_fit)
-      list(APPEND sources ${s}/campaigns/procedures/src/${f}.cpp)
-    endforeach()
-    list(APPEND sources ${s}/analysis/src/chart_layout.cpp ${s}/drivers/core/src/serpentine.cpp)
-    list(APPEND includes ${s}/campaigns/engine/include ${s}/campaigns/lab/include ${s}/campaigns/procedures/include
-         ${s}/drivers/core/include ${s}/analysis/include)
-    list(APPEND libs colorlab::analysis PkgConfig::LUA OpenSSL::Crypto nlohmann_json::nlohmann_json)
+    list(APPEND includes ${s}/campaigns/engine/include)
+    list(APPEND libs colorlab::campaign_lab colorlab::campaign_procedures colorlab::analysis PkgConfig::LUA
+         OpenSSL::Crypto nlohmann_json::nlohmann_json)
   elseif(name STREQUAL "hid_socket")
     list(APPEND sources ${s}/drivers/lamps/src/socket_hid_transport.cpp
          ${s}/drivers/core/src/unix_line_client.cpp)
