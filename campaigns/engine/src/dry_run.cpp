@@ -76,11 +76,7 @@ class DryRun final : public LabCallSink {
   void progress(double, const std::string&) override {}
   void log(const std::string&) override {}
   bool compute(const std::string& what, std::function<json()>& job) override {
-    if (!setup_.compute) return false;
-    compute_what_ = what;
-    compute_job_ = std::move(job);
-    has_compute_ = true;
-    return true;
+    return handed_.take(setup_.compute, what, job);
   }
 
  private:
@@ -119,40 +115,20 @@ class DryRun final : public LabCallSink {
   // What the script yielded with: nothing (a slice of a long computation), a checkpoint, or a lab
   // call answered by the model. How many values to resume it with; nullopt where the dry run stops.
   asio::awaitable<std::optional<int>> after_yield() {
-    if (has_compute_) co_return co_await compute_off_thread();
+    if (handed_.pending()) {
+      // An analysis on the daemon's worker pool: its time is the script's own, as if inline.
+      const auto started = std::chrono::steady_clock::now();
+      auto resumed_with = handed_.run(setup_.compute, thread_);
+      const int values = co_await std::move(resumed_with);
+      script_wall_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+      co_return values;
+    }
     if (sandbox_->take_slice_yield() && !requested_) {
       // A long stretch of the script's own computation: on the daemon, let it serve meanwhile.
       if (setup_.compute) co_await asio::post(co_await asio::this_coro::executor, asio::use_awaitable);
       co_return 0;
     }
     co_return answer_call();
-  }
-
-  // An analysis on the daemon's worker pool: its time is the script's own, as if inline. The script
-  // resumes with the result and true, or the job's error message and false.
-  asio::awaitable<std::optional<int>> compute_off_thread() {
-    has_compute_ = false;
-    auto job = std::move(compute_job_);
-    std::optional<std::string> failure;
-    json computed;
-    const auto started = std::chrono::steady_clock::now();
-    try {
-      // The awaitable first, then co_await it: no temporaries in the co_await expression (GCC 12).
-      auto pending = setup_.compute(compute_what_, std::move(job));
-      computed = co_await std::move(pending);
-    } catch (const Error& e) {
-      failure = e.info().message;
-    } catch (const std::exception& e) {
-      failure = e.what();
-    }
-    script_wall_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-    if (failure) {
-      lua_pushstring(thread_, failure->c_str());
-    } else {
-      push_json(thread_, computed);
-    }
-    lua_pushboolean(thread_, failure ? 0 : 1);
-    co_return 2;
   }
 
   // A checkpoint, or a lab call answered by the model.
@@ -337,10 +313,7 @@ class DryRun final : public LabCallSink {
   LuaSandbox* sandbox_ = nullptr;  // while run_script runs
   lua_State* thread_ = nullptr;
   std::optional<std::pair<std::string, json>> requested_;  // the lab call the script yielded with
-  // A computation the script handed over (lab.analysis.characterize) for setup_.compute to run.
-  bool has_compute_ = false;
-  std::string compute_what_;
-  std::function<json()> compute_job_;
+  HandedComputation handed_;  // a computation the script handed over, for setup_.compute to run
 
   TimingKeys keys_;
   std::vector<DryProblem> problems_;

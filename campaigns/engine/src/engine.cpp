@@ -103,11 +103,7 @@ class ScriptRun final : public LabCallSink {
   }
   void log(const std::string& text) override { log::info(script_.name, text); }
   bool compute(const std::string& what, std::function<json()>& job) override {
-    if (!setup_.compute) return false;
-    compute_what_ = what;
-    compute_job_ = std::move(job);
-    has_compute_ = true;
-    return true;
+    return handed_.take(setup_.compute, what, job);
   }
 
  private:
@@ -119,7 +115,11 @@ class ScriptRun final : public LabCallSink {
   // The script yielded: a slice of a long computation (resume it with nothing), or a lab call (resume
   // it with the answer). nullopt when the run ends here.
   asio::awaitable<std::optional<int>> after_yield() {
-    if (has_compute_) co_return co_await compute_off_thread();
+    if (handed_.pending()) {
+      // The daemon serves while the worker pool runs it.
+      auto resumed_with = handed_.run(setup_.compute, thread_);
+      co_return co_await std::move(resumed_with);
+    }
     if (sandbox_->take_slice_yield() && !requested_) {
       // A long computation between lab calls: let the daemon serve, then go on.
       co_await asio::post(co_await asio::this_coro::executor, asio::use_awaitable);
@@ -139,32 +139,6 @@ class ScriptRun final : public LabCallSink {
     if (!result) co_return std::nullopt;
     push_json(thread_, *result);
     co_return 1;
-  }
-
-  // An analysis off this thread (the daemon's worker pool): the daemon serves while it runs. Not a
-  // lab call: nothing is journaled, and a replay computes it again. The script resumes with the
-  // result and true, or the job's error message and false (lab_api's finish_computed raises it).
-  asio::awaitable<std::optional<int>> compute_off_thread() {
-    has_compute_ = false;
-    auto job = std::move(compute_job_);
-    std::optional<std::string> failure;
-    json computed;
-    try {
-      // The awaitable first, then co_await it: no temporaries in the co_await expression (GCC 12).
-      auto pending = setup_.compute(compute_what_, std::move(job));
-      computed = co_await std::move(pending);
-    } catch (const Error& e) {
-      failure = e.info().message;
-    } catch (const std::exception& e) {
-      failure = e.what();
-    }
-    if (failure) {
-      lua_pushstring(thread_, failure->c_str());
-    } else {
-      push_json(thread_, computed);
-    }
-    lua_pushboolean(thread_, failure ? 0 : 1);
-    co_return 2;
   }
 
   // While the replay lasts, the journal answers (no instrument moves); the first call past it turns
@@ -417,10 +391,7 @@ class ScriptRun final : public LabCallSink {
   std::unique_ptr<LuaSandbox> sandbox_;
   lua_State* thread_ = nullptr;
   std::optional<PendingCall> requested_;  // what the script yielded with
-  // A computation the script handed over (lab.analysis.characterize) for setup_.compute to run.
-  bool has_compute_ = false;
-  std::string compute_what_;
-  std::function<json()> compute_job_;
+  HandedComputation handed_;  // a computation the script handed over, for setup_.compute to run
 
   // The replay: where in the journal, the lab state it implies, what the calls' timing keys follow.
   bool live_;

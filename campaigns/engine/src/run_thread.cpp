@@ -1,5 +1,7 @@
 #include "run_thread.hpp"
 
+#include <optional>
+
 #include <lua5.4/lua.hpp>
 
 #include "colorlab/campaigns/lua_value.hpp"
@@ -39,6 +41,37 @@ lua_State* start_run_thread(LuaSandbox& sandbox, const CampaignScript& script, c
   push_json(thread, params);
   sandbox.set_yielding_thread(thread);
   return thread;
+}
+
+bool HandedComputation::take(const Runner& runner, const std::string& what, std::function<nlohmann::json()>& job) {
+  if (!runner) return false;
+  what_ = what;
+  job_ = std::move(job);
+  pending_ = true;
+  return true;
+}
+
+boost::asio::awaitable<int> HandedComputation::run(const Runner& runner, lua_State* thread) {
+  pending_ = false;
+  auto job = std::move(job_);
+  std::optional<std::string> failure;
+  nlohmann::json computed;
+  try {
+    // The awaitable first, then co_await it: no temporaries in the co_await expression (GCC 12).
+    auto awaiting = runner(what_, std::move(job));
+    computed = co_await std::move(awaiting);
+  } catch (const Error& e) {
+    failure = e.info().message;
+  } catch (const std::exception& e) {
+    failure = e.what();
+  }
+  if (failure) {
+    lua_pushstring(thread, failure->c_str());
+  } else {
+    push_json(thread, computed);
+  }
+  lua_pushboolean(thread, failure ? 0 : 1);
+  co_return 2;
 }
 
 }  // namespace colorlab::campaigns
