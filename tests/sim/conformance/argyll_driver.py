@@ -53,6 +53,7 @@ class Session:
             os.execvpe("unshare", ["unshare", "-m", "--propagation", "private", "sh", "-c", NAMESPACE_SCRIPT,
                                    "sh"] + argv, env)
         self.out = ""
+        self.transcript = ""  # everything the tool printed: tells whether it reacted to a key
         self.log = log
 
     def expect(self, pattern, timeout):
@@ -79,6 +80,7 @@ class Session:
                     raise EOFError("tool exited; last output: %r" % self.out[-800:])
                 self.log.write(data)
                 self.out += data
+                self.transcript += data
 
     def send(self, keys):
         os.write(self.fd, keys.encode())
@@ -100,6 +102,35 @@ class Session:
         return None
 
 
+def lines_answered(sock_path):
+    return control(sock_path, {"cmd": "truth"})["spectrolino"]["lines_answered"]
+
+
+# Argyll prints a prompt, then empties the console's input, then waits for a key (instappsup.c:
+# printf; empty_con_chars(); next_con_char()). A key that lands between the prompt and the emptying is
+# thrown away and the tool waits for ever: on a loaded machine that window is wide. So a key is pressed
+# again, but only while the tool has provably not acted on it: it printed nothing and sent the
+# instrument no line since the key went in (an acted-on key always does one or the other).
+QUIET_BEFORE_PRESSING_AGAIN = 5.0
+
+
+def press(s, keys, pattern, timeout, control_sock):
+    deadline = time.time() + timeout
+    while True:
+        printed, answered = len(s.transcript), lines_answered(control_sock)
+        s.send(keys)
+        while True:
+            try:
+                return s.expect(pattern, max(0.1, min(QUIET_BEFORE_PRESSING_AGAIN, deadline - time.time())))
+            except TimeoutError:
+                if time.time() >= deadline:
+                    raise
+                # The terminal's echo of the key itself is not a reaction.
+                reaction = s.transcript[printed:].translate({ord(c): None for c in keys + "\r\n "})
+                if not reaction and lines_answered(control_sock) == answered:
+                    break  # the key was lost: press it again
+
+
 def tool_argv(a, argv):
     if not a.trace:
         return argv
@@ -116,13 +147,11 @@ def run_spotread(a, log):
     result["device"] = m.group(1)
     result["serial"] = m.group(2)
     # Calibration prompt for a stand-alone instrument: the head is already on the tile.
-    s.expect(r"white reference.*?(hit any key|continue)", 60)
-    s.send(" ")
-    s.expect(r"Place instrument on spot to be measured", 60)
+    s.expect(r"white reference.*?(hit any key|continue).*?abort: ", 60)
+    press(s, " ", r"Place instrument on spot to be measured", 60, a.control)
     result["calibrated"] = True
     control(a.control, {"cmd": "place", "target": "patch", "patch": a.patch})
-    s.send(" ")
-    m = s.expect(r"Result is XYZ: *([-\d.]+) +([-\d.]+) +([-\d.]+)", 60)
+    m = press(s, " ", r"Result is XYZ: *([-\d.]+) +([-\d.]+) +([-\d.]+)", 60, a.control)
     result["xyz"] = [float(m.group(i)) for i in (1, 2, 3)]
     truth = control(a.control, {"cmd": "truth"})
     result["last_spectrum"] = truth["spectrolino"].get("last_spectrum")
@@ -192,19 +221,18 @@ def run_chartread(a, log):
     result["table"] = m.group(1)
     s.expect(r"place sheet 1 of 1 on table.*?hit return", 60)
     times["sheet_prompt"] = time.time()
-    s.send("\r")
+    pending = "\r"
     located = []
     for i in range(len(by_name) if by_name else len(in_order)):
-        m = s.expect(r"locate patch (\S+) with the sight", 60)
+        m = press(s, pending, r"locate patch (\S+) with the sight", 60, a.control)
         located.append(m.group(1))
         if by_name and m.group(1) not in by_name:
             raise EOFError("chartread asks for patch %s; --locate gives %s" % (m.group(1), sorted(by_name)))
         xy = by_name[m.group(1)] if by_name else in_order[i]
         control(a.control, {"cmd": "place", "x_mm": xy[0], "y_mm": xy[1]})
-        s.send("\r")
     result["located"] = located
     times["located"] = time.time()
-    s.expect(r"Sheet 1 of 1 read OK", a.read_timeout)
+    press(s, pending, r"Sheet 1 of 1 read OK", a.read_timeout, a.control)
     times["read_ok"] = time.time()
     result["exit"] = s.wait(30)
     times["exit"] = time.time()
