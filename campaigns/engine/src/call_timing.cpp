@@ -2,18 +2,11 @@
 
 #include <algorithm>
 
+#include "colorlab/campaigns/lab_calls.hpp"
+
 namespace colorlab::campaigns {
 
 using nlohmann::json;
-
-namespace {
-
-const json& options_arg(const json& args, std::size_t index) {
-  static const json none = json::object();
-  return args.is_array() && args.size() > index && args[index].is_object() ? args[index] : none;
-}
-
-}  // namespace
 
 std::set<std::string> TimingKeys::cold_lamps() const {
   std::set<std::string> cold;
@@ -22,51 +15,57 @@ std::set<std::string> TimingKeys::cold_lamps() const {
 }
 
 std::string TimingKeys::key(const std::string& call, const json& args) const {
-  if (call == "wait_stable") {
+  const LabCall* row = find_lab_call(call);
+  if (!row) return call;
+  if (row->timing.lamps == LampEffect::settle) {
     // A lamp just lit warms up for minutes; lamps already stable only fill one stability window.
     auto cold = cold_lamps();
-    if (cold.empty()) return "wait_stable warm";
-    std::string k = "wait_stable cold";
+    if (cold.empty()) return call + " warm";
+    std::string k = call + " cold";
     for (const auto& l : cold) k += " " + l;
     return k;
   }
-  if (call == "operator.request") {
-    const json& spec = options_arg(args, 0);
-    return "operator.request " + (spec.contains("action") && spec["action"].is_string() ? spec["action"].get<std::string>() : "?");
-  }
-  if (call == "camera.photograph_chart") return "camera.photograph_chart per frame and format";
-  if (call == "camera.capture") return "camera.capture per frame";
-  if (call == "camera.photograph_floor") return "camera.photograph_floor per frame";
+  if (row->timing.key_detail) return call + " " + row->timing.key_detail(args);
   return call;
 }
 
 double TimingKeys::units(const std::string& call, const json& args) {
-  const json& o = options_arg(args, 0);
-  auto number = [&](const char* name, double fallback) {
-    return o.contains(name) && o[name].is_number() ? std::max(1.0, o[name].get<double>()) : fallback;
-  };
-  if (call == "camera.photograph_chart") {
-    double formats = o.contains("formats") && o["formats"].is_array() && !o["formats"].empty()
-                         ? static_cast<double>(o["formats"].size())
-                         : 4.0;  // photograph_chart's default: raw, tiff16, tiff8, jpeg
-    return number("frames", 25.0) * formats;
-  }
-  if (call == "camera.capture") return number("frames", 1.0);
-  if (call == "camera.photograph_floor") return number("frames", 8.0);  // photograph_floor's default
-  return 1.0;
+  const LabCall* row = find_lab_call(call);
+  return row && row->timing.units ? row->timing.units(args) : 1.0;
 }
 
 double TimingKeys::asked_wait_s(const std::string& call, const json& args) {
-  if (call == "wait" && args.is_array() && !args.empty() && args[0].is_number()) return args[0].get<double>();
-  if (call == "dimmer.set") {
-    const json& o = options_arg(args, 1);
-    if (o.contains("settle_s") && o["settle_s"].is_number()) return std::max(0.0, o["settle_s"].get<double>());
+  const LabCall* row = find_lab_call(call);
+  return row && row->timing.asked_wait_s ? row->timing.asked_wait_s(args) : 0.0;
+}
+
+double TimingKeys::nominal_s(const std::string& key, double lamp_warmup_s, double stability_window_s) {
+  const LabCall* row = find_lab_call(key.substr(0, key.find(' ')));
+  if (!row) return 0.0;
+  if (row->timing.lamps == LampEffect::settle) {
+    return key.size() > row->name.size() && key.compare(row->name.size(), std::string::npos, " warm") == 0 ? stability_window_s
+                                                                                                           : lamp_warmup_s;
   }
-  return 0.0;
+  return row->timing.nominal_s;
+}
+
+bool TimingKeys::warms_up(const std::string& call, const std::string& key) {
+  const LabCall* row = find_lab_call(call);
+  return row && row->timing.lamps == LampEffect::settle && key != call + " warm";
 }
 
 void TimingKeys::follow(const std::string& call, const json& args, const json& result) {
-  auto relight = [&](std::set<std::string> on) {
+  const LabCall* row = find_lab_call(call);
+  if (!row) return;
+  if (row->timing.lamps == LampEffect::relight) {
+    std::set<std::string> on;
+    if (result.is_object() && result.contains("lamps_on") && result["lamps_on"].is_array()) {
+      for (const auto& l : result["lamps_on"]) {
+        if (l.is_string()) on.insert(l.get<std::string>());
+      }
+    } else if (!args.empty() && args[0].is_string()) {
+      on.insert(args[0].get<std::string>());  // lamps.select named its one lamp
+    }
     // A lamp switched off forgets its warm-up; one that stays lit keeps it.
     std::set<std::string> still_warm;
     for (const auto& l : on) {
@@ -74,18 +73,7 @@ void TimingKeys::follow(const std::string& call, const json& args, const json& r
     }
     lit_ = std::move(on);
     warm_ = std::move(still_warm);
-  };
-  if (call == "lamps.select" || call == "lamps.set" || call == "lamps.off") {
-    std::set<std::string> on;
-    if (result.is_object() && result.contains("lamps_on") && result["lamps_on"].is_array()) {
-      for (const auto& l : result["lamps_on"]) {
-        if (l.is_string()) on.insert(l.get<std::string>());
-      }
-    } else if (call == "lamps.select" && !args.empty() && args[0].is_string()) {
-      on.insert(args[0].get<std::string>());
-    }
-    relight(std::move(on));
-  } else if (call == "wait_stable") {
+  } else if (row->timing.lamps == LampEffect::settle) {
     warm_ = lit_;
   }
 }

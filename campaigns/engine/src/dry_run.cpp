@@ -19,6 +19,7 @@
 
 #include "colorlab/campaigns/dry_lab.hpp"
 #include "colorlab/campaigns/lab_api.hpp"
+#include "colorlab/campaigns/lab_calls.hpp"
 #include "colorlab/campaigns/lua_sandbox.hpp"
 #include "colorlab/campaigns/lua_value.hpp"
 #include "colorlab/core/error.hpp"
@@ -153,7 +154,8 @@ class DryRun final : public LabCallSink {
     } catch (const Error& e) {
       return stop_at(call, "call", e.info().message + (e.info().hint.empty() ? "" : " (" + e.info().hint + ")"));
     }
-    if (call == "wait_stable" && result.is_object()) result["waited_s"] = *seconds;
+    const LabCall* row = find_lab_call(call);
+    if (row && row->timing.lamps == LampEffect::settle && result.is_object()) result["waited_s"] = *seconds;
     lab_s_ += *seconds;
     keys_.follow(call, args, result);
     journal_bytes_ += call.size() + args.dump().size() + result.dump().size();
@@ -201,7 +203,7 @@ class DryRun final : public LabCallSink {
     const double call_s = per_unit * TimingKeys::units(call, args);
     seconds += call_s;
     if (cost.source != "measured") assumed_s_ += call_s;
-    if (call == "wait_stable" && key != "wait_stable warm") ++warmups_;
+    if (TimingKeys::warms_up(call, key)) ++warmups_;
     cost.lab_seconds += seconds;
     return seconds;
   }
@@ -333,25 +335,11 @@ class DryRun final : public LabCallSink {
 }  // namespace
 
 double nominal_lab_seconds(const std::string& key, const LabOptions& options) {
-  // Assumed figures for calls this lab has never timed, on the long side (an estimate that is too
-  // short ruins a night, one too long only starts it earlier). Argyll's timeouts bound the
-  // Spectrolino's (measure ≤ 12 s, move ≤ 10 s); the rest are a few exchanges on a serial line.
-  if (key.rfind("wait_stable cold", 0) == 0) return options.lamp_warmup_s;
-  if (key == "wait_stable warm") {
-    const auto& c = options.warmup;
-    return c.window_s + (c.window_s / std::max(c.interval_s, 1e-3) + 1) * nominal_lab_seconds("meter.measure", options);
-  }
-  if (key == "meter.measure") return 1.0;
-  if (key == "table.read_patch" || key == "table.measure_at" || key == "spectro.measure") return 3.0;
-  if (key == "spectro.calibrate") return 6.0;
-  if (key == "table.move" || key == "table.home") return 3.0;
-  if (key.rfind("table.", 0) == 0) return 0.5;
-  if (key.rfind("lamps.", 0) == 0 || key == "spectro.mode") return 0.2;
-  if (key == "dimmer.set") return 0.5;
-  if (key == "camera.configure") return 0.5;
-  if (key.rfind("camera.", 0) == 0) return 1.5;  // per frame (and format): exposure, transfer, decode
-  if (key.rfind("operator.request", 0) == 0) return 1.0;  // the simulated lab's hands; a person: the timeout
-  return 0.0;  // wait (its time is exact), now, lamps.names, runs.*, checkpoint
+  // A stability window is readings of the luminance meter until the window is full.
+  const auto& c = options.warmup;
+  const double window_s =
+      c.window_s + (c.window_s / std::max(c.interval_s, 1e-3) + 1) * TimingKeys::nominal_s("meter.measure", 0, 0);
+  return TimingKeys::nominal_s(key, options.lamp_warmup_s, window_s);
 }
 
 json dry_run_campaign(const DryRunSetup& setup) {

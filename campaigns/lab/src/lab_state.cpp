@@ -1,60 +1,89 @@
 #include "colorlab/campaigns/lab_state.hpp"
 
+#include "colorlab/campaigns/lab_calls.hpp"
+
 namespace colorlab::campaigns {
 
 using nlohmann::json;
 
 void LabState::apply(const std::string& call, const json& args, const json& result) {
-  if (call == "lamps.select") {
-    lamps_on = std::vector<std::string>{args[0].get<std::string>()};
-  } else if (call == "lamps.set") {
-    std::vector<std::string> on;
-    for (const auto& l : args[0]) on.push_back(l.get<std::string>());
-    lamps_on = on;
-  } else if (call == "lamps.off") {
-    lamps_on = std::vector<std::string>{};
-  } else if (call == "dimmer.set") {
-    dimmer_percent = args[0].get<double>();
-  } else if (call == "table.move") {
-    table_used = true;
-    table_xy = std::make_pair(args[0].get<double>(), args[1].get<double>());
-  } else if (call == "table.home") {
-    table_used = true;
-    table_xy = std::make_pair(0.0, 0.0);
-    head_down = false;
-  } else if (call == "table.head_up") {
-    table_used = true;
-    head_down = false;
-  } else if (call == "table.head_down") {
-    table_used = true;
-    head_down = true;
-  } else if (call == "table.hold_paper") {
-    table_used = true;
-    paper_held = args[0].get<bool>();
-  } else if (call == "operator.request") {
-    if (result.is_object() && result.value("by", std::string()) == "simulator") {
-      done_by_hands[result.value("action", std::string())] = result.value("details", json::object());
-    }
-  } else if (call == "table.measure_at" || call == "table.read_patch") {
-    // Move, lower, measure, raise: the head ends up over the patch.
-    table_used = true;
-    table_xy = std::make_pair(args[0].get<double>(), args[1].get<double>());
-    head_down = false;
-  } else if (call == "spectro.mode") {
-    spectro_mode = args[0].get<std::string>();
-    spectro_calibrated = false;  // a calibration is per mode
-  } else if (call == "spectro.calibrate") {
-    spectro_calibrated = true;
-    // The Spectrolino on a table calibrates on the tile: the head is no longer where it was.
-    if (table_used) {
-      table_xy.reset();
-      head_down = false;
-    }
-  } else if (call == "camera.configure") {
-    if (camera_settings.is_null()) camera_settings = json::object();
-    camera_settings.update(args[0]);
+  const LabCall* row = find_lab_call(call);
+  if (row && row->state_effect) row->state_effect(*this, args, result);
+}
+
+namespace lab_state_effects {
+
+void lamps_select(LabState& s, const json& args, const json&) { s.lamps_on = std::vector<std::string>{args[0].get<std::string>()}; }
+
+void lamps_set(LabState& s, const json& args, const json&) {
+  std::vector<std::string> on;
+  for (const auto& l : args[0]) on.push_back(l.get<std::string>());
+  s.lamps_on = on;
+}
+
+void lamps_off(LabState& s, const json&, const json&) { s.lamps_on = std::vector<std::string>{}; }
+
+void dimmer_set(LabState& s, const json& args, const json&) { s.dimmer_percent = args[0].get<double>(); }
+
+void table_move(LabState& s, const json& args, const json&) {
+  s.table_used = true;
+  s.table_xy = std::make_pair(args[0].get<double>(), args[1].get<double>());
+}
+
+void table_home(LabState& s, const json&, const json&) {
+  s.table_used = true;
+  s.table_xy = std::make_pair(0.0, 0.0);
+  s.head_down = false;
+}
+
+void table_head_up(LabState& s, const json&, const json&) {
+  s.table_used = true;
+  s.head_down = false;
+}
+
+void table_head_down(LabState& s, const json&, const json&) {
+  s.table_used = true;
+  s.head_down = true;
+}
+
+void table_hold_paper(LabState& s, const json& args, const json&) {
+  s.table_used = true;
+  s.paper_held = args[0].get<bool>();
+}
+
+void table_measured_at(LabState& s, const json& args, const json&) {
+  // The head ends up raised over the patch.
+  s.table_used = true;
+  s.table_xy = std::make_pair(args[0].get<double>(), args[1].get<double>());
+  s.head_down = false;
+}
+
+void operator_request(LabState& s, const json&, const json& result) {
+  if (result.is_object() && result.value("by", std::string()) == "simulator") {
+    s.done_by_hands[result.value("action", std::string())] = result.value("details", json::object());
   }
 }
+
+void spectro_mode(LabState& s, const json& args, const json&) {
+  s.spectro_mode = args[0].get<std::string>();
+  s.spectro_calibrated = false;  // a calibration is per mode
+}
+
+void spectro_calibrate(LabState& s, const json&, const json&) {
+  s.spectro_calibrated = true;
+  // The Spectrolino on a table calibrates on the tile: the head is no longer where it was.
+  if (s.table_used) {
+    s.table_xy.reset();
+    s.head_down = false;
+  }
+}
+
+void camera_configure(LabState& s, const json& args, const json&) {
+  if (s.camera_settings.is_null()) s.camera_settings = json::object();
+  s.camera_settings.update(args[0]);
+}
+
+}  // namespace lab_state_effects
 
 json LabState::to_json() const {
   json j = json::object();

@@ -29,7 +29,8 @@ struct TimingStats {
 using TimingBook = std::map<std::string, TimingStats>;
 
 // Follows a script's calls (live and replayed) and names the timing key of each; both the engine
-// (to learn) and the dry run (to estimate) use it, so they cannot disagree on what a key means.
+// (to learn) and the dry run (to estimate) use it, so they cannot disagree on what a key means. What
+// each call's key, units and waits are is its row's CallTimingRule (lab_calls.hpp).
 class TimingKeys {
  public:
   // The key a call is timed under, known before the call is made.
@@ -39,6 +40,11 @@ class TimingKeys {
   // Lab seconds of the call that the script asked for outright (lab.wait, a dimmer's settle_s):
   // not learned, always added exactly.
   static double asked_wait_s(const std::string& call, const nlohmann::json& args);
+  // Assumed lab seconds per unit for a key never timed on this lab: the row's nominal figure; a lamp
+  // warm-up for a cold stability wait, one stability window for a warm one.
+  static double nominal_s(const std::string& key, double lamp_warmup_s, double stability_window_s);
+  // Whether the call under this key waits for a lamp to warm up (a stability wait with a cold lamp).
+  static bool warms_up(const std::string& call, const std::string& key);
   // After a completed call: which lamps are lit, and which of them have been stable since.
   void follow(const std::string& call, const nlohmann::json& args, const nlohmann::json& result);
   // Lamps lit since the last stable wait (they still warm up): the next wait_stable waits for them.
