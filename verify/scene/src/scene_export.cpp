@@ -3,12 +3,12 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <numbers>
 #include <optional>
 #include <string>
 
-#include "colorlab/analysis/chart_layout.hpp"
 #include "colorlab/analysis/standard_data.hpp"
 #include "colorlab/core/error.hpp"
 
@@ -103,18 +103,57 @@ json spectrum(double first, double step, const std::vector<double>& v) {
   return {{"first_nm", first}, {"step_nm", step}, {"values", v}};
 }
 
+// The charts a chart-read reads (campaigns/scripts/chart-read.lua): the patch grid, ids in the run's order.
+// Kept here rather than taken from analysis/'s chart locator, which is an optional OpenCV target.
+struct Layout {
+  std::string name;
+  int columns = 0, rows = 0;
+  double patch_fraction = 0;  // patch side / pitch
+  std::vector<std::string> ids;
+  std::vector<int> column, row;
+  std::optional<int> index_of(const std::string& id) const {
+    for (std::size_t i = 0; i < ids.size(); ++i)
+      if (ids[i] == id) return static_cast<int>(i);
+    return std::nullopt;
+  }
+};
+
+Layout layout_of(const std::string& chart, const std::string& run) {
+  Layout l;
+  const std::string c = upper(chart);
+  if (c == "SG" || c == "SG140") {
+    // ColorChecker SG: columns A..N, rows 1..10, 15 mm patches at a 19 mm pitch; file order A1, A2, …, B1, …
+    l = {"ColorChecker SG", 14, 10, 15.0 / 19.0, {}, {}, {}};
+    for (int col = 0; col < 14; ++col)
+      for (int r = 0; r < 10; ++r) {
+        l.ids.push_back(std::string(1, static_cast<char>('A' + col)) + std::to_string(r + 1));
+        l.column.push_back(col), l.row.push_back(r);
+      }
+  } else if (c == "CC24" || c == "24") {
+    l = {"ColorChecker 24", 6, 4, 0.8, {}, {}, {}};
+    for (int r = 0; r < 4; ++r)
+      for (int col = 0; col < 6; ++col) {
+        l.ids.push_back(std::to_string(r * 6 + col + 1));
+        l.column.push_back(col), l.row.push_back(r);
+      }
+  } else {
+    malformed(run, "chart \"" + chart + "\" is neither sg nor cc24");
+  }
+  return l;
+}
+
 // The chart: placement from the cabinet, each patch's spectrum exactly as the chart-read stored it.
 json chart_part(const CabinetGeometry& cab, const json& doc, double& first_nm, double& step_nm, std::size_t& bands) {
   const std::string id = run_id(doc);
   const json params = doc["run"].value("params", json::object());
   const std::string chart = params.value("chart", std::string("sg"));
   const double pitch = params.value("pitch_mm", 19.0);
-  const auto& layout = analysis::chart_layout(analysis::chart_type_from_string(chart));
-  const double size = layout.patch_size * pitch;
-  // The patch grid is centred on the board (as on an SG); grid units → board mm from its top-left corner.
-  const double x0 = (chart_w_mm - layout.grid_width() * pitch) / 2, y0 = (chart_h_mm - layout.grid_height() * pitch) / 2;
+  const Layout layout = layout_of(chart, id);
+  const double size = layout.patch_fraction * pitch;
+  // The patch grid is centred on the board (as on an SG): patch centres at ((c − (columns−1)/2)·pitch,
+  // (r − (rows−1)/2)·pitch) from the board's centre, y down the board.
   json patches = json::array();
-  std::vector<bool> seen(static_cast<std::size_t>(layout.size()), false);
+  std::vector<bool> seen(layout.ids.size(), false);
   bool grid_known = false;
   for (const auto& m : doc["measurements"]) {
     if (m.value("quantity", std::string()) != "reflectance_spectrum") continue;
@@ -133,12 +172,13 @@ json chart_part(const CabinetGeometry& cab, const json& doc, double& first_nm, d
     } else if (f != first_nm || s != step_nm || values.size() != bands) {
       malformed(id, "patch " + pid + " is on another wavelength grid than the others");
     }
-    const double bx = x0 + layout.centre_x(*idx) * pitch, by = y0 + layout.centre_y(*idx) * pitch;
-    const double fx = cab.chart_center_x_mm - chart_w_mm / 2 + bx, fy = cab.chart_center_y_mm + chart_h_mm / 2 - by;
+    const auto k = static_cast<std::size_t>(*idx);
+    const double bx = (layout.column[k] - (layout.columns - 1) / 2.0) * pitch, by = (layout.row[k] - (layout.rows - 1) / 2.0) * pitch;
+    const double fx = cab.chart_center_x_mm + bx, fy = cab.chart_center_y_mm - by;
     patches.push_back({{"id", pid}, {"index", *idx}, {"center_m", {fx * mm, fy * mm}}, {"size_m", size * mm},
                        {"reflectance", spectrum(f, s, values)}});
   }
-  for (int i = 0; i < layout.size(); ++i)
+  for (int i = 0; i < static_cast<int>(layout.ids.size()); ++i)
     if (!seen[static_cast<std::size_t>(i)]) malformed(id, "patch " + layout.ids[static_cast<std::size_t>(i)] + " was not read");
   std::sort(patches.begin(), patches.end(), [](const json& a, const json& b) { return a["index"] < b["index"]; });
   return {{"name", layout.name},
@@ -254,7 +294,10 @@ json export_scene(const CabinetGeometry& cab, const std::vector<json>& runs, con
       luminance = e->luminance_cd_m2;
       level = {{"source", "configured"}, {"how", "the lab configuration's [[cabinet.emitter]] luminance_cd_m2 at 100 %"}};
     } else {
-      bad("no LS-110 readings of " + lamp + " at " + std::to_string(o.dimmer_percent) + " % and no configured luminance",
+      char level_text[32];
+      std::snprintf(level_text, sizeof level_text, "%g", o.dimmer_percent);
+      bad("no LS-110 readings of " + lamp + " at " + level_text + " % and no configured luminance" +
+              (o.dimmer_percent != 100.0 && e->luminance_cd_m2 > 0 ? " at that level" : ""),
           "give a cabinet-grid run that measured it, or its emitter's luminance_cd_m2 in [cabinet] (at 100 %)");
     }
     // Spectral radiance L(λ) = k·S(λ) with 683·∫L ȳ dλ equal to the emitter's luminance.
