@@ -41,6 +41,9 @@ packages=(
   # colorlab-ship (fleet/): libpq for the central PostgreSQL; its tests start a throwaway PostgreSQL 15 and a
   # one-replica OpenStack Swift with s3api (the bookworm S3 server that checks SigV4 and payload hashes)
   libpq-dev postgresql-15 postgresql-client-15 swift swift-proxy swift-object swift-container swift-account memcached
+  # the measured scene rendered by a renderer nobody here wrote (tests/verify/scene): Blender 3.4's Cycles, and
+  # OpenImageIO's Python reader for its OpenEXR output
+  blender python3-openimageio
 )
 
 missing=()

@@ -212,6 +212,7 @@ Lab::Lab(boost::asio::io_context& io, LabConfig config) : impl_(std::make_unique
   sc.chart_file = d.config.chart_file;
   for (const auto& name : d.config.lamps_on) sc.lamps_on_at_start.push_back(lamp_from_string(name));
   sc.dimmer_percent_at_start = d.config.dimmer_percent;
+  if (d.config.geometric_floor) sc.geometric_cabinet = d.config.cabinet;
   d.scene = std::make_unique<Scene>(sc, d.clock);
 
   if (d.config.ls110.enabled) {

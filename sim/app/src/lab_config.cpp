@@ -7,6 +7,7 @@
 #include "colorlab/core/toml_json.hpp"
 
 #include "colorlab/core/error.hpp"
+#include "colorlab/verify/cabinet_toml.hpp"
 
 namespace colorlab::sim {
 
@@ -163,6 +164,10 @@ LabConfig load_lab_config(const std::filesystem::path& file) {
       auto v = node.value<std::string>();
       if (!v) bad(file, node, "control_socket must be a path");
       c.control_socket = *v;
+    } else if (k == "cabinet") {
+      auto t = node.as_table();
+      if (!t) bad(file, node, "[cabinet] must be a table");
+      c.cabinet = verify::cabinet_from_toml(*t, file);
     } else if (k == "scene") {
       auto t = node.as_table();
       if (!t) bad(file, node, "[scene] must be a table");
@@ -181,6 +186,11 @@ LabConfig load_lab_config(const std::filesystem::path& file) {
           auto v = sn.value<double>();
           if (!v || *v < 0 || *v > 100) bad(file, sn, "dimmer must be 0..100");
           c.dimmer_percent = *v;
+        } else if (s == "floor_field") {
+          auto v = sn.value<std::string>();
+          if (!v || (*v != "section-6.2" && *v != "geometric"))
+            bad(file, sn, "scene.floor_field must be \"section-6.2\" or \"geometric\"");
+          c.geometric_floor = *v == "geometric";
         } else if (s == "chart_file") {
           auto v = sn.value<std::string>();
           if (!v) bad(file, sn, "chart_file must be a path");

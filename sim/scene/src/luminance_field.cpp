@@ -35,9 +35,18 @@ LuminanceField::LuminanceField(Lamp lamp, std::uint64_t seed) {
   for (auto& b : bumps_) b = {ux(rng), uy(rng), us(rng), ua(rng)};
 }
 
+LuminanceField::LuminanceField(const verify::CabinetEmitter* emitter, double height_mm, double floor_reflectance)
+    : geometric_(true), height_mm_(height_mm), floor_reflectance_(floor_reflectance) {
+  if (emitter) emitter_ = *emitter;
+}
+
 double LuminanceField::at(double x_mm, double y_mm, double dimmer_percent) const {
   const double out = dimmer_output(dimmer_percent);
   if (out <= 0.0) return 0.0;
+  if (geometric_) {
+    if (!emitter_) return 0.0;
+    return out * floor_reflectance_ * emitter_->luminance_cd_m2 * verify::form_factor(*emitter_, height_mm_, x_mm, y_mm);
+  }
   const double u = (x_mm - cabinet_width_mm / 2) / (cabinet_width_mm / 2);
   const double v = y_mm / grid_depth_mm;
   // Dimmed tubes emit more evenly along their length, so the relative shape flattens a little.

@@ -4,8 +4,10 @@
 // percent-level bumps so that different seeds give different but equally plausible cabinets.
 #include <array>
 #include <cstdint>
+#include <optional>
 
 #include "colorlab/sim/scene.hpp"
+#include "colorlab/verify/cabinet.hpp"
 
 namespace colorlab::sim::detail {
 
@@ -15,6 +17,9 @@ double dimmer_output(double percent);
 class LuminanceField {
  public:
   LuminanceField(Lamp lamp, std::uint64_t seed);
+  // The geometric cabinet's field: the floor lit directly by the lamp's Lambertian emitter (the analytic form
+  // factor), ρ·L·F; no emitter (nullptr) gives a lamp that lights nothing.
+  LuminanceField(const verify::CabinetEmitter* emitter, double height_mm, double floor_reflectance);
   // cd/m² on the grey floor at (x, y) mm with this lamp alone, fully warm.
   double at(double x_mm, double y_mm, double dimmer_percent) const;
 
@@ -29,6 +34,9 @@ class LuminanceField {
   double centre_y_ = 0;   // depth of the brightest line as a fraction of the grid depth (0 = front)
   double flatten_ = 0;    // how much the relative shape flattens as the dimmer goes down
   std::array<Bump, 3> bumps_{};
+  bool geometric_ = false;
+  std::optional<verify::CabinetEmitter> emitter_;
+  double height_mm_ = 0, floor_reflectance_ = 0;
 };
 
 }  // namespace colorlab::sim::detail

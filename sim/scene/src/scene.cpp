@@ -103,6 +103,25 @@ Scene::Scene(SceneConfig config, std::shared_ptr<const SimClock> clock) : impl_(
     throw Error(ErrorClass::bad_parameter, "SceneConfig.dimmer_percent_at_start must be within 0..100");
   if (!(config.warmup_tau_s > 0.0) || !(config.warmup_start_fraction > 0.0 && config.warmup_start_fraction <= 1.0))
     throw Error(ErrorClass::bad_parameter, "SceneConfig warm-up: tau must be > 0 and start fraction in (0, 1]");
+  if (const auto& cab = config.geometric_cabinet) {
+    verify::validate(*cab);
+    if (cab->floor_reflectance != floor_reflectance())
+      throw Error(ErrorClass::bad_parameter, "geometric cabinet: floor_reflectance must be the simulated floor's 0.3",
+                  "the camera model and every instrument see a 0.30 grey floor; leave floor_reflectance out");
+    if (cab->width_mm != cabinet_width_mm || cab->depth_mm != cabinet_depth_mm ||
+        cab->grid_pitch_x_mm != floor_spot_pitch_x_mm || cab->grid_pitch_y_mm != floor_spot_pitch_y_mm)
+      throw Error(ErrorClass::bad_parameter,
+                  "geometric cabinet: the simulated floor is 1200 × 600 mm with its LS-110 grid at 60 × 54 mm",
+                  "leave width_mm, depth_mm and grid_pitch_mm out (the height and the emitters may change)");
+    for (const auto& e : cab->emitters)
+      if (!(e.luminance_cd_m2 > 0.0))
+        throw Error(ErrorClass::bad_parameter, "geometric cabinet: emitter " + e.lamp + " needs its luminance_cd_m2 (> 0)",
+                    "the simulated lamp's brightness comes from it");
+  }
+  if (const auto& cab = config.geometric_cabinet) {
+    config.chart_center_x_mm = cab->chart_center_x_mm;
+    config.chart_center_y_mm = cab->chart_center_y_mm;
+  }
   auto& m = *impl_;
   m.config = std::move(config);
   m.clock = std::move(clock);
@@ -113,7 +132,10 @@ Scene::Scene(SceneConfig config, std::shared_ptr<const SimClock> clock) : impl_(
     m.lamp_spd[i] = detail::load_lamp_spectrum(l);
     m.lamp_on_grid[i] = m.lamp_spd[i].resampled(radiance_start_nm, radiance_step_nm, radiance_samples);
     m.lamp_y[i] = detail::photopic_integral(m.lamp_spd[i], y_bar);
-    m.fields.emplace_back(l, m.config.seed);
+    if (const auto& cab = m.config.geometric_cabinet)
+      m.fields.emplace_back(verify::emitter_of(*cab, std::string(to_string(l))), cab->height_mm, cab->floor_reflectance);
+    else
+      m.fields.emplace_back(l, m.config.seed);
   }
   m.dimmer = m.config.dimmer_percent_at_start;
   for (Lamp l : m.config.lamps_on_at_start) {

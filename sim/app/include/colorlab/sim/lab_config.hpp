@@ -12,6 +12,7 @@
 #include "colorlab/sim/camera/camera_model.hpp"
 #include "colorlab/sim/dmx_sim.hpp"
 #include "colorlab/sim/spectrolino_model.hpp"
+#include "colorlab/verify/cabinet.hpp"
 
 namespace colorlab::sim {
 
@@ -85,6 +86,10 @@ struct LabConfig {
   std::vector<std::string> lamps_on{"D65"};
   double dimmer_percent = 100.0;
   std::optional<std::filesystem::path> chart_file;
+  // [scene] floor_field: "section-6.2" (default, the dissertation's measured shape) or "geometric" (the
+  // [cabinet]'s emitters light the floor by their form factor; docs/verify.md, "The measured scene").
+  bool geometric_floor = false;
+  verify::CabinetGeometry cabinet = verify::default_cabinet();  // [cabinet]
   std::optional<std::filesystem::path> control_socket;  // default: a fresh path under $XDG_RUNTIME_DIR or /tmp
   Ls110SimConfig ls110;
   SpectrolinoLabConfig spectrolino;

@@ -19,6 +19,7 @@
 
 #include "colorlab/sim/clock.hpp"
 #include "colorlab/sim/spectrum.hpp"
+#include "colorlab/verify/cabinet.hpp"
 
 namespace colorlab::sim {
 
@@ -65,6 +66,13 @@ struct SceneConfig {
   // Lamps already warm at construction (switched on long ago), e.g. {Lamp::d65}.
   std::vector<Lamp> lamps_on_at_start;
   double dimmer_percent_at_start = 100.0;
+  // Opt-in: a cabinet whose floor light comes from its geometry (each lamp's rectangular Lambertian emitter,
+  // direct light only, black walls: the analytic form factor of verify::form_factor) instead of the
+  // §6.2-shaped field the dissertation's tables rest on. Its floor_reflectance must be the simulated floor's
+  // 0.30 and every emitter's luminance known (> 0); a lamp without an emitter lights nothing. The chart
+  // lies at the cabinet's chart_center_mm (it replaces chart_center_x/y_mm); the floor keeps its 1200 × 600 mm
+  // and its grid. docs/verify.md, "The measured scene".
+  std::optional<verify::CabinetGeometry> geometric_cabinet;
 };
 
 // A lamp whose light output drifts (docs/simulator.md, "Cabinet" faults). From `start_s` (simulated seconds)

@@ -1,0 +1,87 @@
+#include "scene_command.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "client_support.hpp"
+#include "colorlab/core/error.hpp"
+#include "colorlab/verify/cabinet_toml.hpp"
+#include "colorlab/verify/scene_export.hpp"
+
+namespace colorlab::cli {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct SceneOptions {
+  std::vector<std::string> runs;
+  std::string output;
+  std::string lab;
+  std::vector<std::string> lamps;
+  double dimmer = 100.0;
+};
+
+// A run is its id (fetched as the daemon's JSON export) or a file holding that export, so a scene can be made
+// where the daemon is not, from `colorlab export RUN -f json` files.
+json load_run(const GlobalOptions& g, const std::string& run) {
+  std::error_code ec;
+  if (fs::is_regular_file(run, ec)) {
+    std::ifstream f(run, std::ios::binary);
+    std::stringstream ss;
+    ss << f.rdbuf();
+    try {
+      return json::parse(ss.str());
+    } catch (const json::exception& e) {
+      throw Error(ErrorClass::bad_data, run + ": not JSON (" + e.what() + ")", "give a file from colorlab export RUN -f json");
+    }
+  }
+  check_id(run, "a run id or a run's JSON export file", "colorlab runs lists them");
+  const auto r = fetch_bytes(g, "/v1/runs/" + run + "/export?format=json");
+  return json::parse(r.body);
+}
+
+}  // namespace
+
+void add_scene_command(CLI::App& app, GlobalOptions& global) {
+  auto o = std::make_shared<SceneOptions>();
+  auto* cmd = app.add_subcommand(
+      "scene",
+      "Export the measured scene for a renderer: DIR/scene.json (cabinet, lamps, chart spectra, camera, LS-110 "
+      "scale) and DIR/build_scene.py (Blender: blender -b --factory-startup -noaudio -P DIR/build_scene.py)");
+  cmd->add_option("runs", o->runs, "a chart-read run and, for the lamps' levels, a cabinet-grid run (ids or JSON export files)")
+      ->required();
+  cmd->add_option("-o,--output", o->output, "directory to write (created)")->required();
+  cmd->add_option("--lab", o->lab, "TOML file whose [cabinet] table describes the cabinet (default: the built-in cabinet)");
+  cmd->add_option("--lamp", o->lamps, "lamp to light (repeatable; default: those the cabinet-grid run measured)");
+  cmd->add_option("--dimmer", o->dimmer, "dimmer level whose LS-110 readings set the lamps' levels (%)")
+      ->check(CLI::Range(0.0, 100.0))
+      ->capture_default_str();
+  cmd->callback([&global, o] {
+    const verify::CabinetGeometry cabinet = o->lab.empty() ? verify::default_cabinet() : verify::cabinet_from_file(o->lab);
+    std::vector<json> runs;
+    for (const auto& r : o->runs) runs.push_back(load_run(global, r));
+    const json scene = verify::export_scene(cabinet, runs, {o->lamps, o->dimmer});
+    verify::write_scene(scene, o->output);
+    json lamps = json::array();
+    for (const auto& l : scene["lamps"]) lamps.push_back({{"name", l["name"]}, {"luminance_cd_m2", l["luminance_cd_m2"]},
+                                                           {"level", l["level"]["source"]}});
+    json done{{"directory", o->output}, {"files", {"scene.json", "build_scene.py"}}, {"lamps", lamps},
+              {"patches", scene["chart"]["patches"].size()}};
+    print(global, done, [](const json& j) {
+      std::string s = "wrote " + j["directory"].get<std::string>() + "/scene.json and build_scene.py (" +
+                      std::to_string(j["patches"].get<std::size_t>()) + " patches";
+      for (const auto& l : j["lamps"])
+        s += ", " + l["name"].get<std::string>() + " " + std::to_string(l["luminance_cd_m2"].get<double>()) + " cd/m² (" +
+             l["level"].get<std::string>() + ")";
+      return s + ")\nrender: blender -b --factory-startup -noaudio -P " + j["directory"].get<std::string>() +
+             "/build_scene.py -- --mode bands\n";
+    });
+  });
+}
+
+}  // namespace colorlab::cli
