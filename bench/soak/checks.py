@@ -53,25 +53,33 @@ def _slope(x, y) -> float | None:
 
 
 def growth(csv_path: Path, *, time_scale: float) -> dict:
+    """Per series and night: median, high-water mark (max) and the last sample. ``flat_spread_pct``: the spread of
+    the later nights' high-water marks against their mean — the "flat within 10 % after the first night" figure.
+    ``per_night`` is the slope of those marks per simulated night, ``per_wall_hour`` the slope of every sample after
+    night 1 against wall time. For the store: bytes per measurement row kept at each night's end."""
     df = pd.read_csv(csv_path)
     out: dict = {"time_scale": time_scale, "samples": int(len(df)), "wall_hours": float(df["wall_s"].max() / 3600),
                  "series": {}}
-    nights = sorted(n for n in df["night"].unique() if n >= 1)
+    nights = sorted(int(n) for n in df["night"].unique() if n >= 1)
+    after = df["night"] >= 2
     for s in SERIES:
         if s not in df:
             continue
         col = pd.to_numeric(df[s], errors="coerce")
-        medians = {int(n): float(col[df["night"] == n].median()) for n in nights}
-        first = medians.get(1)
-        after = df["night"] >= 2
-        later = [v for n, v in medians.items() if n >= 2]
-        entry = {"median_by_night": medians,
-                 "per_night": _slope([n for n in medians if n >= 2], later) if len(later) >= 2 else None,
-                 "per_wall_hour": (lambda v: None if v is None else v * 3600)(_slope(df["wall_s"][after], col[after])),
-                 "max_after_night_1": float(col[after].max()) if after.any() else None,
-                 "min_after_night_1": float(col[after].min()) if after.any() else None}
-        if first and later:
-            entry["spread_after_night_1_pct"] = 100.0 * (max(later) - min(later)) / first
-            entry["max_vs_night_1_pct"] = 100.0 * (max(later) - first) / first
+        by = {n: col[df["night"] == n] for n in nights}
+        entry = {"median_by_night": {n: float(v.median()) for n, v in by.items()},
+                 "max_by_night": {n: float(v.max()) for n, v in by.items()},
+                 "end_by_night": {n: float(v.iloc[-1]) for n, v in by.items()}}
+        later = [v for n, v in entry["max_by_night"].items() if n >= 2]
+        entry["per_night"] = _slope([n for n in nights if n >= 2], later) if len(later) >= 2 else None
+        slope = _slope(df["wall_s"][after], col[after])
+        entry["per_wall_hour"] = None if slope is None else slope * 3600
+        if later and np.mean(later):
+            entry["flat_spread_pct"] = float(100.0 * (max(later) - min(later)) / np.mean(later))
         out["series"][s] = entry
+    rows = entry_rows = {n: float(pd.to_numeric(df["measurements"], errors="coerce")[df["night"] == n].iloc[-1])
+                         for n in nights}
+    for s in ("db_bytes", "blob_bytes"):
+        ends = out["series"][s]["end_by_night"]
+        out["series"][s]["bytes_per_row_by_night"] = {n: ends[n] / rows[n] for n in nights if entry_rows[n]}
     return out

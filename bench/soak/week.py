@@ -83,7 +83,7 @@ def main(argv=None) -> int:
             write_json(a.out / "nights.json", {"meta": meta, "nights": nights})
             print(f"soak: night {n} {result['state']} in {result['wall_s']} s; rows "
                   f"{sum(v['rows'] for v in result['ledger'].values())}", flush=True)
-        soak.sampler.night = len(nights) + 1  # after the last night: the idle tail
+        soak.sampler.night = -1  # after the last night: the idle tail, in no night's figures
         wait_followers_caught_up(soak)
         probes = soak.finish()
     finally:
