@@ -68,22 +68,39 @@ class SoakNight(unittest.TestCase):
         self.fail(f"the daemon did not become idle {what} within {WAIT_S} s: {q}")
 
     def kill_mid_grid(self, queued: dict) -> dict:
-        """kill -9 once the grid's execution has committed two steps and is still running (bounded wait)."""
+        """kill -9 once the grid's execution has committed two steps and is still running (bounded waits). Once its
+        execution is known only it is polled: one request per look keeps the window between looks short."""
         deadline = time.monotonic() + WAIT_S
+        item = {}
+        while time.monotonic() < deadline and not item.get("execution_id"):
+            item = self.lab.call("GET", f"/v1/queue/{queued['items'][1]}")
+            time.sleep(0.02)
+        self.assertTrue(item.get("execution_id"), f"the grid did not start within {WAIT_S} s: {item}")
         ex = {}
         while time.monotonic() < deadline:
-            doc = status(self.lab, queued)
-            grid = doc["items"][1]
-            if grid.get("execution_id"):
-                ex = self.lab.call("GET", f"/v1/executions/{grid['execution_id']}")
-                if ex["status"] in colorlab.TERMINAL:
-                    self.fail(f"the grid ended before it could be killed mid-run: {ex}")
-                if ex.get("steps_committed", 0) >= 2:
-                    kill = self.lab.kill_and_restart({"execution_id": ex["id"], "steps_committed":
-                                                      ex["steps_committed"], "status": ex["status"]})
-                    return kill
-            time.sleep(0.02)
+            ex = self.lab.call("GET", f"/v1/executions/{item['execution_id']}")
+            if ex["status"] in colorlab.TERMINAL:
+                self.fail(f"the grid ended before it could be killed mid-run: {ex}")
+            if ex.get("steps_committed", 0) >= 2:
+                return self.lab.kill_and_restart({"execution_id": ex["id"], "steps_committed": ex["steps_committed"],
+                                                  "status": ex["status"]})
+            time.sleep(0.01)
         self.fail(f"the grid did not commit two steps within {WAIT_S} s: {ex}\n{self.lab.daemon.log_text()}")
+
+    def settles_within(self, base: dict) -> dict:
+        """The restarted daemon, idle, back within the first one's idle figures (bounded wait: a keep-alive socket
+        the page has just opened may take a moment to close)."""
+        deadline = time.monotonic() + 60
+        while True:
+            with self.lab.lock:
+                now = proc_stats(self.lab.pid)
+            if now["threads"] <= base["threads"] and now["fds"] <= base["fds"] + BROWSER_CONNECTIONS:
+                return now
+            if time.monotonic() > deadline:
+                self.fail(f"idle after the killed night: {now['threads']} threads, {now['fds']} descriptors; idle "
+                          f"after the reference night: {base['threads']} threads, {base['fds']} descriptors "
+                          f"(+{BROWSER_CONNECTIONS} allowed for the page's sockets)")
+            time.sleep(0.5)
 
     def test_a_short_night_killed_mid_run(self):
         started = time.monotonic()
@@ -114,9 +131,8 @@ class SoakNight(unittest.TestCase):
             self.assertEqual(grid["rows"], len(grid_keys(GRID)))
 
         # Back to the baseline: the restarted daemon, idle, holds no more than the first did after the same work.
-        after = self.idle("after the killed night")
-        self.assertLessEqual(after["threads"], base["threads"], f"threads: {after} after, {base} before")
-        self.assertLessEqual(after["fds"], base["fds"] + BROWSER_CONNECTIONS, f"descriptors: {after} vs {base}")
+        self.idle("after the killed night")
+        after = self.settles_within(base)
 
         # Every event once to each follower, across the kill.
         wait_followers_caught_up(self.soak)
