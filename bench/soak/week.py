@@ -72,7 +72,8 @@ def main(argv=None) -> int:
                 break
             kill_at = []
             if n in killed:
-                span = nights[0]["wall_s"]
+                # Over the shortest unkilled night so far: a moment past a night's end would be no kill at all.
+                span = min(x["wall_s"] for x in nights if not x["kills"])
                 kill_at = sorted(round(rng.uniform(0.05, 0.9) * span, 1) for _ in range(a.kills_per_night))
             soak.sampler.night = n
             queued = enqueue(soak.lab, sequence=a.sequence, small=a.small)
