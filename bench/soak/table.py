@@ -47,7 +47,10 @@ def main(out: Path) -> int:
     print("|---|---|---|---|---|---|")
     by = {c["night"]: c for c in s["checks"]["nights"]}
     for n in nights:
-        kills = ", ".join(f"{k['at_s']:.0f} s: {k.get('item') or 'between items'}" for k in n["kills"]) or "–"
+        kills = ", ".join(f"{k['at_s']:.0f} s: {k.get('item') or 'between items'}"
+                          + (f" ({k['execution_step']})" if k.get("execution_step") else "") for k in n["kills"]) or "–"
+        if n.get("missed_kills"):
+            kills += "; drawn but after the night's end: " + ", ".join(f"{t:.0f} s" for t in n["missed_kills"])
         c = by.get(n["night"], {})
         print(f"| {n['night']} | {n['wall_s']:.0f} s | {kills} | {n['state']} | {c.get('rows')} | "
               f"{c.get('runs_equal_to_night_1')} of {c.get('runs')} |")
