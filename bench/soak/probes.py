@@ -10,7 +10,8 @@ import time
 
 import requests
 
-import colorlab
+import lab  # noqa: F401,E402  (puts the repository's Python client on the path)
+import colorlab  # noqa: E402
 
 ROUTES = ("/v1", "/v1/runs", "/v1/control", "/v1/queue")
 
@@ -32,6 +33,7 @@ class ApiPoller(threading.Thread):
         self.stop_flag = threading.Event()
         self._lock = threading.Lock()
         self._times: list[float] = []
+        self._by_route: dict[str, list[float]] = {r: [] for r in ROUTES}
         self._failed = 0
         self.rounds = 0
 
@@ -53,17 +55,19 @@ class ApiPoller(threading.Thread):
                 with self._lock:
                     if ok:
                         self._times.append(ms)
+                        self._by_route[route].append(ms)
                     else:
                         self._failed += 1
             self.rounds += 1
             self.stop_flag.wait(max(0.0, self.interval - (time.monotonic() - started)))
         session.close()
 
-    def take(self) -> tuple[list[float], int]:
+    def take(self) -> tuple[list[float], int, dict[str, list[float]]]:
+        """The answer times (ms) since the last take, all routes and per route, and the refused requests."""
         with self._lock:
-            times, failed = self._times, self._failed
-            self._times, self._failed = [], 0
-        return times, failed
+            times, failed, by_route = self._times, self._failed, self._by_route
+            self._times, self._failed, self._by_route = [], 0, {r: [] for r in ROUTES}
+        return times, failed, by_route
 
     def stop(self) -> None:
         self.stop_flag.set()

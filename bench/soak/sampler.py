@@ -13,12 +13,15 @@ import time
 from datetime import datetime, timezone
 from pathlib import Path
 
-from probes import p99
+from probes import ROUTES, p99
+
+# One p99 column per polled route: which route a slow sample came from.
+ROUTE_COLUMNS = tuple("api_p99_ms_" + (r.removeprefix("/v1/") if r != "/v1" else "root") for r in ROUTES)
 
 COLUMNS = ("sample", "wall_s", "utc", "night", "daemon_pid", "daemon_starts", "rss_kb", "fds", "threads",
            "db_bytes", "wal_bytes", "blob_bytes", "blob_files", "measurements", "runs",
            "js_heap_used", "js_heap_total", "dom_nodes", "js_listeners", "page_conn",
-           "api_requests", "api_p99_ms", "api_max_ms", "api_failed",
+           "api_requests", "api_p99_ms", "api_max_ms", "api_failed", *ROUTE_COLUMNS,
            "events_a", "events_b", "load1")
 
 
@@ -75,7 +78,7 @@ class Sampler(threading.Thread):
         self._file.flush()
 
     def sample(self) -> dict:
-        times, failed = self.poller.take()
+        times, failed, by_route = self.poller.take()
         with self.lab.lock:
             pid, starts = self.lab.pid, self.lab.starts
             row = {"daemon_pid": pid, "daemon_starts": starts, **proc_stats(pid)}
@@ -89,6 +92,8 @@ class Sampler(threading.Thread):
         row.update(api_requests=len(times), api_failed=failed,
                    api_p99_ms=None if not times else round(p99(times), 2),
                    api_max_ms=None if not times else round(max(times), 2))
+        for route, column in zip(ROUTES, ROUTE_COLUMNS):
+            row[column] = None if not by_route[route] else round(p99(by_route[route]), 2)
         row["events_a"], row["events_b"] = (f.count for f in self.followers)
         row["load1"] = os.getloadavg()[0]
         row.update(sample=len(self.rows) + 1, wall_s=round(time.monotonic() - self.t0, 1), night=self.night,
