@@ -77,9 +77,8 @@ def growth(csv_path: Path, *, time_scale: float) -> dict:
         if later and np.mean(later):
             entry["flat_spread_pct"] = float(100.0 * (max(later) - min(later)) / np.mean(later))
         out["series"][s] = entry
-    rows = entry_rows = {n: float(pd.to_numeric(df["measurements"], errors="coerce")[df["night"] == n].iloc[-1])
-                         for n in nights}
+    rows = {n: float(pd.to_numeric(df["measurements"], errors="coerce")[df["night"] == n].iloc[-1]) for n in nights}
     for s in ("db_bytes", "blob_bytes"):
         ends = out["series"][s]["end_by_night"]
-        out["series"][s]["bytes_per_row_by_night"] = {n: ends[n] / rows[n] for n in nights if entry_rows[n]}
+        out["series"][s]["bytes_per_row_by_night"] = {n: ends[n] / rows[n] for n in nights if rows[n]}
     return out
