@@ -32,7 +32,13 @@ def plot(csv_path: Path, png: Path, title: str = "") -> None:
     fig, axes = plt.subplots(5, 2, figsize=(12, 15), sharex=True)
     for ax, (col, name, scale, unit) in zip(axes.flat, PANELS):
         y = pd.to_numeric(df[col], errors="coerce") * scale
-        ax.plot(minutes, y, marker=".", lw=1)
+        ax.plot(minutes, y, marker=".", lw=1, label="all routes" if col == "api_p99_ms" else None)
+        if col == "api_p99_ms":  # per route, where the soak timed them apart
+            for route in [c for c in df.columns if c.startswith("api_p99_ms_")]:
+                ax.plot(minutes, pd.to_numeric(df[route], errors="coerce"), lw=0.8,
+                        label=route.removeprefix("api_p99_ms_"))
+            if len(ax.get_lines()) > 1:
+                ax.legend(fontsize=7, loc="upper left")
         ax.set_title(name, fontsize=10)
         ax.set_ylabel(unit)
         ax.set_ylim(bottom=0, top=max(1e-9, float(y.max()) * 1.15) if y.notna().any() else 1)
