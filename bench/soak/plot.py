@@ -39,6 +39,9 @@ def plot(csv_path: Path, png: Path, title: str = "") -> None:
                         label=route.removeprefix("api_p99_ms_"))
             if len(ax.get_lines()) > 1:
                 ax.legend(fontsize=7, loc="upper left")
+                top = max(float(pd.to_numeric(df[c], errors="coerce").max()) for c in df.columns
+                          if c.startswith("api_p99_ms"))
+                ax.set_ylim(0, top * 1.15)
         ax.set_title(name, fontsize=10)
         ax.set_ylabel(unit)
         ax.set_ylim(bottom=0, top=max(1e-9, float(y.max()) * 1.15) if y.notna().any() else 1)
