@@ -1,5 +1,6 @@
 #pragma once
-// The daemon's persistent state. One writer connection, used from the daemon's event loop only.
+// The daemon's persistent state. One writer connection, used from the daemon's event loop only — and a
+// second (SecondWriter, below) on the step committer's thread, for campaign steps' commits (issue 27).
 // Settings follow daemon-design-notes §6.2: WAL, synchronous=FULL (a committed measurement
 // survives power loss), busy_timeout, foreign keys, quick_check at open.
 #include <cstdint>
