@@ -54,7 +54,7 @@ READ_ROUTES = ["/v1", "/v1/instruments", "/v1/runs", "/v1/runs/{id}", "/v1/contr
 TERMINAL = ("finished_ok", "finished_error", "aborted", "interrupted")
 
 
-def start_daemon(build, state, scale):
+def start_daemon(build, state, scale, log_path=None):
     os.makedirs(os.path.join(state, "s", "campaigns"), exist_ok=True)
     with open(os.path.join(state, "s", "campaigns", "probe-ask.lua"), "w") as f:
         f.write(PROBE_ASK)
@@ -62,7 +62,7 @@ def start_daemon(build, state, scale):
     with open(cfg, "w") as f:
         # The probe's clients start, answer, pause and resume over loopback TCP, as a lab's own console would.
         f.write(f"[simulator]\nenabled = true\ntime_scale = {scale}\nseed = 1\n[access]\nloopback_scope = \"control\"\n")
-    log = open(os.path.join(state, "colorlabd.log"), "w")
+    log = open(log_path or os.path.join(state, "colorlabd.log"), "w")
     proc = subprocess.Popen([os.path.join(build, "bin", "colorlabd"), "--config", cfg, "--state",
                              os.path.join(state, "s"), "--listen", "127.0.0.1:0"],
                             stdout=subprocess.DEVNULL, stderr=log)
@@ -202,9 +202,11 @@ def main():
     ap.add_argument("--time-scale", type=float, default=50)
     ap.add_argument("--idle-s", type=float, default=60)
     ap.add_argument("--json", help="write the figures here too")
+    ap.add_argument("--log", help="keep the daemon's log here (its io-thread lines attribute slow answers: "
+                                  "COLORLAB_IO_LAG_MS=5 in the environment adds the lag monitor's)")
     a = ap.parse_args()
     with tempfile.TemporaryDirectory(prefix="latency-probe-") as state:
-        proc, url = start_daemon(a.build, state, a.time_scale)
+        proc, url = start_daemon(a.build, state, a.time_scale, a.log)
         try:
             ended = answered_execution(url)
             idle = probe(url, lambda: time.sleep(a.idle_s), "idle", ended)

@@ -4,6 +4,7 @@
 
 #include <unistd.h>
 
+#include <cstdlib>
 #include <fstream>
 
 #include <boost/asio/co_spawn.hpp>
@@ -28,7 +29,9 @@
 #include "colorlab/daemon/read_connections.hpp"
 #include "colorlab/daemon/report_service.hpp"
 #include "colorlab/daemon/executions.hpp"
+#include "colorlab/daemon/io_watch.hpp"
 #include "colorlab/daemon/simulator_hands.hpp"
+#include "colorlab/daemon/step_committer.hpp"
 #include "colorlab/daemon/night_queue.hpp"
 #include "colorlab/daemon/notifier.hpp"
 #include "colorlab/daemon/store_run_reader.hpp"
@@ -55,6 +58,7 @@ struct Daemon::Impl {
   std::unique_ptr<SimulatorHands> hands;
   std::unique_ptr<StoreRunReader> run_reader;  // lab.runs.* (characterize-camera's reference)
   std::unique_ptr<WorkerPool> workers;  // fits and dry runs' analyses (worker_pool.hpp); outlives executions
+  std::unique_ptr<StepCommitter> committer;  // steps' commits off the io thread (step_committer.hpp); outlives executions
   std::unique_ptr<Notifier> notices;  // [notify]: tells the operator (notifier.hpp); outlives executions
   std::unique_ptr<Executions> executions;
   std::unique_ptr<NightQueue> queue;
@@ -67,6 +71,7 @@ struct Daemon::Impl {
   std::unique_ptr<drivers::DiscoveryMonitor> monitor;
   std::vector<std::shared_ptr<drivers::Instrument>> connect_at_start;
   SystemdNotifier notifier{io};
+  IoLagMonitor lag{io.get_executor()};  // COLORLAB_IO_LAG_MS: how late the io thread answers (io_watch.hpp)
 
   void on_discovery_change(const drivers::DiscoveryChange& change);
 };
@@ -183,8 +188,14 @@ Daemon::Daemon(DaemonConfig config) : impl_(std::make_unique<Impl>()) {
   });
   // Fits, analyses and dry runs' analyses: off the io thread (worker_pool.hpp).
   d.workers = std::make_unique<WorkerPool>(d.io.get_executor(), with_test_hooks(WorkerPoolOptions{}));
+  d.committer = std::make_unique<StepCommitter>(d.io.get_executor(), d.config.database_path());
   ExecutionOptions execution_options;
   execution_options.workers = d.workers.get();
+  // The latency probe's A/B switch (bench/service/latency_probe.py): the same binary committing on the io
+  // thread as before, for a before/after in one run. Never for a lab: durability is the same, latency is not.
+  if (const char* on_io = std::getenv("COLORLAB_BENCH_COMMIT_ON_IO_THREAD"); !on_io || std::string(on_io) != "1") {
+    execution_options.committer = d.committer.get();
+  }
   execution_options.crash_loop = {cc.max_resume_attempts, cc.crash_loop_backoff_s, cc.crash_loop_backoff_max_s,
                                   cc.crash_loop_retries};
   execution_options.state_dir = d.config.state_dir;
@@ -239,7 +250,13 @@ Daemon::Daemon(DaemonConfig config) : impl_(std::make_unique<Impl>()) {
     } else {
       // `req` and `routed` live in this coroutine's frame until the main thread has answered.
       answer = co_await asio::co_spawn(
-          io, [api, &req, &routed]() -> asio::awaitable<http::HttpResponse> { co_return handle_api(*api, req, routed); },
+          io,
+          [api, &req, &routed]() -> asio::awaitable<http::HttpResponse> {
+            NamedIoStage stage(routed.route ? "route " + std::string(routed.route->method) + " " +
+                                                  std::string(routed.route->pattern)
+                                            : std::string("route (none)"));
+            co_return handle_api(*api, req, routed);
+          },
           asio::use_awaitable);
     }
     if (!answer.later) co_return answer;
@@ -304,6 +321,7 @@ int Daemon::run() {
     if (ec) return;
     log::info("colorlabd", "signal " + std::to_string(sig) + ": stopping at the running steps' next safe point");
     d.notifier.stopping();
+    d.lag.stop();
     d.server->stop();
     d.monitor->stop();
     d.queue->shutdown();  // starts nothing more; stays started in the store for the next daemon
@@ -330,6 +348,7 @@ int Daemon::run() {
   write_endpoint_file();
   d.notifier.ready("serving on " + where);
   d.notifier.start_watchdog();
+  d.lag.start();
   log::info("colorlabd", "serving the v1 API on " + where + (d.sim ? " (simulated lab)" : ""));
   d.io.run();
   return 0;

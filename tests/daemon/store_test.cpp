@@ -414,3 +414,40 @@ TEST(Store, ExecutionsPageNewestFirstFilteredByStatusesAndCampaign) {
   EXPECT_EQ(exact.items.front().to_json(), store.execution(all.front())->to_json());
   EXPECT_THROW(store.executions(3, std::string("abc")), Error);
 }
+
+// Issue 27: a step committed through a second writer's connection (the daemon's committer thread) is the same
+// whole step, ordered with the first writer's events by SQLite's write lock; a read snapshot on the first
+// connection does not see it until the snapshot ends (an event stream's snapshot agrees with its seq).
+TEST(Store, ASecondWriterCommitsWholeStepsInEventOrderAndAReadSnapshotKeepsItsView) {
+  TempDir dir;
+  Store store(dir / "colorlab.db");
+  Store second(dir / "colorlab.db", Store::SecondWriter{});
+  auto e = scripted_execution(store);
+  StepRecord step;
+  step.journal.push_back({0, "meter.measure", json::array(), {{"luminance", 245.5}}});
+  step.measurements.push_back({"reading/0", "ls110", true, "luminance", 245.5, "cd/m2", nullptr});
+  step.progress = 0.5;
+  step.step = "reading/0";
+  const std::int64_t before = store.last_event_seq();
+  {
+    Store::ReadSnapshot view(store);
+    EXPECT_EQ(store.last_event_seq(), before);
+    second.commit_step(e, step);
+    // Committed and durable on the other connection, not seen inside the snapshot.
+    EXPECT_EQ(store.last_event_seq(), before);
+    EXPECT_EQ(store.measurements(e.run_id).size(), 0u);
+  }
+  EXPECT_EQ(store.measurements(e.run_id).size(), 1u);
+  EXPECT_EQ(store.execution(e.id)->steps_committed, 1);
+  const std::int64_t step_event = store.last_event_seq();
+  EXPECT_GT(step_event, before);
+  // The first writer's next event comes after the second writer's step.
+  store.append_event("execution", {{"execution_id", e.id}, {"requested", "pause"}});
+  const auto events = store.events(before, 100, std::nullopt);
+  ASSERT_EQ(events.size(), 2u);
+  EXPECT_EQ(events[0].topic, "progress");
+  EXPECT_EQ(events[1].topic, "execution");
+  // A repeated step is refused whole there too.
+  EXPECT_THROW(second.commit_step(e, step), colorlab::Error);
+  EXPECT_EQ(store.measurements(e.run_id).size(), 1u);
+}

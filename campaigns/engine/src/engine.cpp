@@ -210,7 +210,7 @@ class ScriptRun final : public LabCallSink {
     for (;;) {
       std::optional<Error> refused;
       try {
-        flush();
+        co_await flush_awaiting();
       } catch (const Error& e) {
         if (e.cls() != ErrorClass::io_error) throw;
         refused = e;
@@ -372,6 +372,16 @@ class ScriptRun final : public LabCallSink {
     pending_.progress = progress_;
     pending_.label = label_;
     sink_.commit(pending_);
+    pending_ = StepCommit{};
+    progress_changed_ = false;
+  }
+
+  // flush() without holding the daemon's io thread while the step is made durable.
+  asio::awaitable<void> flush_awaiting() {
+    if (pending_.journal.empty() && pending_.measurements.empty() && !progress_changed_) co_return;
+    pending_.progress = progress_;
+    pending_.label = label_;
+    co_await sink_.commit_awaiting(pending_);
     pending_ = StepCommit{};
     progress_changed_ = false;
   }

@@ -15,7 +15,9 @@
 #include "colorlab/core/log.hpp"
 #include "colorlab/daemon/blob_service.hpp"
 #include "colorlab/daemon/campaign_request.hpp"
+#include "colorlab/daemon/io_watch.hpp"
 #include "colorlab/daemon/notifier.hpp"
+#include "colorlab/daemon/step_committer.hpp"
 #include "colorlab/daemon/worker_pool.hpp"
 #include "colorlab/protocol/problem.hpp"
 
@@ -43,8 +45,10 @@ class StoreSink final : public campaigns::ExecutionSink {
   using SuspendedListener = std::function<void(const std::string&, const json&, const json&)>;
   StoreSink(store::Store& store, const store::ExecutionRecord& record, const campaigns::InstrumentSet& instruments,
             std::function<void(const std::string&)> status, json snapshot, bool replace_serials,
-            std::optional<std::string>& suspension, double time_scale, SuspendedListener on_suspended)
-      : suspension_(suspension),
+            std::optional<std::string>& suspension, double time_scale, SuspendedListener on_suspended,
+            StepCommitter* committer)
+      : committer_(committer),
+        suspension_(suspension),
         on_suspended_(std::move(on_suspended)),
         time_scale_(time_scale),
         store_(store),
@@ -57,8 +61,16 @@ class StoreSink final : public campaigns::ExecutionSink {
   // The step's records go to the store as the engine made them (colorlab/core/step_records.hpp); the
   // sink adds only what the store keeps per run: serials learned since, and the lab's time scale.
   void commit(const campaigns::StepCommit& step) override {
-    store_.commit_step(record_, store::StepRecord{step.journal, step.measurements, step.progress, step.label,
-                                                  updated_snapshot(), step.timings, time_scale_, step.blobs});
+    IoStage stage("commit step");
+    store_.commit_step(record_, records_of(step));
+  }
+  // Before each live call: on the committer's thread, the io thread serving meanwhile (step_committer.hpp).
+  asio::awaitable<void> commit_awaiting(const campaigns::StepCommit& step) override {
+    if (!committer_) {
+      commit(step);
+      co_return;
+    }
+    co_await committer_->commit(record_, records_of(step));
   }
   void restored(const json& actions) override {
     store_.append_event("execution", {{"execution_id", record_.id}, {"run_id", record_.run_id}, {"restored", actions}});
@@ -97,6 +109,11 @@ class StoreSink final : public campaigns::ExecutionSink {
   // and named its serial. Serials learned since are written with the next step, so a resume can
   // tell whether the same unit is still there. A recorded serial is replaced only once an operator
   // has accepted another unit.
+  store::StepRecord records_of(const campaigns::StepCommit& step) {
+    return store::StepRecord{step.journal, step.measurements, step.progress, step.label,
+                             updated_snapshot(),  step.timings, time_scale_, step.blobs};
+  }
+
   std::optional<json> updated_snapshot() {
     if (!snapshot_.is_array()) return std::nullopt;
     bool changed = false;
@@ -115,6 +132,7 @@ class StoreSink final : public campaigns::ExecutionSink {
     return snapshot_;
   }
 
+  StepCommitter* committer_ = nullptr;
   std::optional<std::string>& suspension_;
   SuspendedListener on_suspended_;
   double time_scale_ = 1;
@@ -358,6 +376,7 @@ void Executions::launch(store::ExecutionRecord record, std::shared_ptr<const cam
         campaigns::RunOutcome outcome;
         bool storage_suspended = false;
         try {
+          std::optional<IoStage> starting(std::in_place, "execution start");
           json how = resumed ? json{{"resumed", true}} : json(nullptr);
           if (resumed && resumed_by.is_object()) how["resumed_by"] = resumed_by;
           store_.set_execution_status(record, ExecutionStatus::running, resumed ? "resumed from step '" + record.step + "'" : "",
@@ -389,7 +408,9 @@ void Executions::launch(store::ExecutionRecord record, std::shared_ptr<const cam
           StoreSink sink(store_, record, instruments_, status_text_, snapshot, resumed && accept_units, active->suspension,
                          lab_.time_scale(), [this, &record](const std::string& reason, const json& problem, const json& doc) {
                            notify("suspended", record, reason, problem, doc);
-                         });
+                         },
+                         options_.committer);
+          starting.reset();
           outcome = co_await campaigns::run_campaign_script(std::move(setup), lab_, sink, active->control);
         } catch (const Error& e) {
           outcome.kind = campaigns::RunOutcome::Kind::failed;
@@ -404,6 +425,7 @@ void Executions::launch(store::ExecutionRecord record, std::shared_ptr<const cam
           outcome.error = Error(ErrorClass::internal, e.what());
         }
         try {
+          IoStage ending("execution end");
           auto current = store_.execution(record.id);
           std::string step = current ? current->step : record.step;
           using Kind = campaigns::RunOutcome::Kind;

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include <sqlite3.h>
+
 #include "colorlab/core/error.hpp"
 #include "colorlab/core/ids.hpp"
 #include "colorlab/core/log.hpp"
@@ -124,6 +126,31 @@ Store::Store(const fs::path& database_path, ReadOnly) {
   db_.exec("PRAGMA busy_timeout = 5000");
   db_.exec("PRAGMA query_only = ON");
   db_.exec("PRAGMA temp_store = MEMORY");
+}
+
+Store::Store(const fs::path& database_path, SecondWriter) {
+  db_ = Database(database_path.string(), false);
+  db_.exec("PRAGMA busy_timeout = " + std::to_string(kBusyTimeoutMs));
+  db_.exec("PRAGMA synchronous = FULL");
+  db_.exec("PRAGMA foreign_keys = ON");
+  apply_wal_policy(db_);
+  db_.exec("PRAGMA temp_store = MEMORY");
+}
+
+Store::ReadSnapshot::ReadSnapshot(Store& store) : db_(store.db_) {
+  // Inside a transaction already (a caller's): its snapshot is the one read.
+  if (sqlite3_get_autocommit(db_.handle()) == 0) return;
+  db_.exec("BEGIN DEFERRED");
+  open_ = true;
+}
+
+Store::ReadSnapshot::~ReadSnapshot() {
+  if (!open_) return;
+  try {
+    db_.exec("COMMIT");
+  } catch (const Error& e) {
+    log::warning("store", std::string("cannot end a read snapshot: ") + e.what());
+  }
 }
 
 Store::Created Store::create_execution(const NewRun& run) {

@@ -11,6 +11,10 @@
 // COLORLAB_FAULT_CONTROL  a file the test rewrites (atomically, by rename) to switch faults at run time:
 //                         absent or "off": none; "ENOSPC" or "EIO", optionally followed by a path relative
 //                         to the directory ("ENOSPC blobs") to fail only what lies under it.
+//                         "HOLD" (optionally with a path, as above): nothing fails, but an fsync or fdatasync
+//                         of a file there waits — with "<control>.held" created — until the control file
+//                         says something else (or 120 s pass): a commit held in its sync, for as long as a
+//                         test needs to look at what the process still does meanwhile (issue 27).
 // The control file is stat()ed on each intercepted call and re-read only when it changed, so a test's
 // switch takes effect at the next write without the shim costing a read per write.
 #define _GNU_SOURCE
@@ -27,6 +31,7 @@
 #include <sys/syscall.h>
 #include <sys/types.h>
 #include <sys/uio.h>
+#include <time.h>
 #include <unistd.h>
 
 static pthread_once_t g_once = PTHREAD_ONCE_INIT;
@@ -36,6 +41,7 @@ static char g_control[PATH_MAX];  // the control file's path
 static struct stat g_seen;        // the control file as last read
 static int g_seen_valid;
 static int g_errno;               // 0: no fault
+static int g_hold;                // HOLD: syncs in scope wait
 static char g_scope[PATH_MAX * 2];  // the failing subtree (g_dir or below)
 
 static void init(void) {
@@ -54,6 +60,7 @@ static void reload(void) {
   long fd = syscall(SYS_openat, AT_FDCWD, g_control, O_RDONLY | O_CLOEXEC);
   if (fd < 0) {
     __atomic_store_n(&g_errno, 0, __ATOMIC_SEQ_CST);
+    __atomic_store_n(&g_hold, 0, __ATOMIC_SEQ_CST);
     return;
   }
   long n = syscall(SYS_read, (int)fd, text, sizeof text - 1);
@@ -65,6 +72,7 @@ static void reload(void) {
   __atomic_store_n(&g_errno,
                    fields >= 1 && strcmp(word, "ENOSPC") == 0 ? ENOSPC : fields >= 1 && strcmp(word, "EIO") == 0 ? EIO : 0,
                    __ATOMIC_SEQ_CST);
+  __atomic_store_n(&g_hold, fields >= 1 && strcmp(word, "HOLD") == 0, __ATOMIC_SEQ_CST);
   if (fields == 2) {
     snprintf(g_scope, sizeof g_scope, "%s/%s", g_dir, sub);
     size_t len = strlen(g_scope);
@@ -85,6 +93,7 @@ static int active_errno(void) {
   if (pthread_mutex_trylock(&g_mutex) == 0) {
     if (!present) {
       __atomic_store_n(&g_errno, 0, __ATOMIC_SEQ_CST);
+      __atomic_store_n(&g_hold, 0, __ATOMIC_SEQ_CST);
       g_seen_valid = 0;
     } else if (!g_seen_valid || st.st_ino != g_seen.st_ino || st.st_size != g_seen.st_size ||
                st.st_mtim.tv_sec != g_seen.st_mtim.tv_sec || st.st_mtim.tv_nsec != g_seen.st_mtim.tv_nsec) {
@@ -181,11 +190,30 @@ ssize_t pwritev(int fd, const struct iovec* iov, int count, off_t off) {
   FAIL_FD(fd);
   return REAL(pwritev)(fd, iov, count, off);
 }
+// HOLD: the sync waits while the control file says HOLD, polling it every millisecond (at most 120 s, so a
+// test that dies holding never leaves the process stuck for good).
+static void hold_sync(int fd) {
+  (void)active_errno();  // re-reads the control file if it changed
+  if (!__atomic_load_n(&g_hold, __ATOMIC_SEQ_CST) || !fd_in_scope(fd)) return;
+  char held[PATH_MAX + 8];
+  snprintf(held, sizeof held, "%s.held", g_control);
+  long h = syscall(SYS_openat, AT_FDCWD, held, O_WRONLY | O_CREAT | O_CLOEXEC, 0644);
+  if (h >= 0) syscall(SYS_close, (int)h);
+  for (int i = 0; i < 120000; ++i) {
+    (void)active_errno();
+    if (!__atomic_load_n(&g_hold, __ATOMIC_SEQ_CST)) return;
+    struct timespec pause = {0, 1000000};
+    nanosleep(&pause, NULL);
+  }
+}
+
 int fsync(int fd) {
+  hold_sync(fd);
   FAIL_FD(fd);
   return REAL(fsync)(fd);
 }
 int fdatasync(int fd) {
+  hold_sync(fd);
   FAIL_FD(fd);
   return REAL(fdatasync)(fd);
 }

@@ -89,9 +89,15 @@ HttpResponse get_event_stream(ApiContext& ctx, const HttpRequest& req, const Pat
 
   std::string first;
   if (!resumed) {
-    // The writer's view, on the main thread: the snapshot and its seq agree.
-    after = ctx.store.last_event_seq();
-    first = sse(after, "snapshot", snapshot(ctx, after).dump());
+    // The writer's view, on the main thread, read in one snapshot of the database: steps committed
+    // meanwhile on the committer's thread (step_committer.hpp) come after `after`, as events.
+    json state;
+    {
+      store::Store::ReadSnapshot one_view(ctx.store);
+      after = ctx.store.last_event_seq();
+      state = snapshot(ctx, after);
+    }
+    first = sse(after, "snapshot", state.dump());
   }
   HttpResponse r;
   r.content_type = "text/event-stream";

@@ -41,6 +41,13 @@ class ExecutionSink {
   virtual ~ExecutionSink() = default;
   // Durable on return; throws Error{io_error} if the disk refused it (nothing is half-stored).
   virtual void commit(const StepCommit& step) = 0;
+  // The same, durable when it completes: the daemon commits a step before each live call this way, on
+  // a thread of its own, so that its io thread serves meanwhile (issue 27). The step is copied before
+  // the first suspension; the engine does nothing else for this execution until it completes.
+  virtual boost::asio::awaitable<void> commit_awaiting(const StepCommit& step) {
+    commit(step);
+    co_return;
+  }
   // The lab was brought back after a resume (for the event log).
   virtual void restored(const nlohmann::json& actions) = 0;
   // What the execution is doing now, for logs and systemd's STATUS=.

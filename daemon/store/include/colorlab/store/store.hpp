@@ -1,5 +1,6 @@
 #pragma once
-// The daemon's persistent state. One writer connection, used from the daemon's event loop only.
+// The daemon's persistent state. One writer connection, used from the daemon's event loop only — and a
+// second (SecondWriter, below) on the step committer's thread, for campaign steps' commits (issue 27).
 // Settings follow daemon-design-notes §6.2: WAL, synchronous=FULL (a committed measurement
 // survives power loss), busy_timeout, foreign keys, quick_check at open.
 #include <cstdint>
@@ -161,6 +162,12 @@ class Store {
   // (query_only), and in WAL mode never waits for the writer's commits. One per reading thread.
   struct ReadOnly {};
   Store(const std::filesystem::path& database_path, ReadOnly);
+  // A second writer's connection to a database the first Store has opened (migrated and checked): the
+  // same durability (WAL, synchronous=FULL) and WAL bounds, for commit_step() on a thread of its own
+  // (daemon/core step_committer.hpp). SQLite orders the two writers' transactions (BEGIN IMMEDIATE
+  // waits up to the busy timeout), so the event log's seq is still the commit order.
+  struct SecondWriter {};
+  Store(const std::filesystem::path& database_path, SecondWriter);
 
   // Creates a run and its execution in one transaction. With an idempotency key already used,
   // returns the existing execution and created = false (a retried POST must not start a campaign twice).
@@ -216,6 +223,19 @@ class Store {
                                     std::int64_t after_seq, unsigned limit);
   std::int64_t measurement_count(const std::string& run_id);
   std::int64_t last_event_seq();
+  // Reads in one snapshot of the database until it is dropped (a deferred transaction): what a second
+  // writer commits meanwhile is not seen, so e.g. an event stream's snapshot and its seq agree.
+  class ReadSnapshot {
+   public:
+    explicit ReadSnapshot(Store& store);
+    ~ReadSnapshot();
+    ReadSnapshot(const ReadSnapshot&) = delete;
+    ReadSnapshot& operator=(const ReadSnapshot&) = delete;
+
+   private:
+    Database& db_;
+    bool open_ = false;
+  };
   // Newest first; `cursor` is the opaque next_cursor of the previous page.
   RunPage runs(unsigned limit, const std::optional<std::string>& cursor, const RunFilter& filter = {});
   // Newest first (in the order they were created); `cursor` as for runs().

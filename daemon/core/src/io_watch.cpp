@@ -1,0 +1,122 @@
+#include "colorlab/daemon/io_watch.hpp"
+
+#include <cstdio>
+#include <algorithm>
+#include <cstdlib>
+
+#include <boost/asio/steady_timer.hpp>
+
+#include "colorlab/core/log.hpp"
+
+namespace colorlab::daemon {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+long env_ms(const char* name, long fallback) {
+  const char* text = std::getenv(name);
+  if (!text || !*text) return fallback;
+  char* end = nullptr;
+  long v = std::strtol(text, &end, 10);
+  return end && *end == '\0' && v > 0 ? v : fallback;
+}
+
+std::string ms_text(std::chrono::microseconds us) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1f", static_cast<double>(us.count()) / 1000.0);
+  return buf;
+}
+
+}  // namespace
+
+std::chrono::microseconds io_slow_threshold() {
+  static const std::chrono::microseconds threshold = std::chrono::milliseconds(env_ms("COLORLAB_IO_SLOW_MS", 50));
+  return threshold;
+}
+
+IoStage::IoStage(std::string_view stage) : stage_(stage), start_(Clock::now()) {}
+
+IoStage::~IoStage() {
+  const auto took = std::chrono::duration_cast<std::chrono::microseconds>(Clock::now() - start_);
+  if (took <= io_slow_threshold()) return;
+  log::warning("io-thread", "slow stage '" + std::string(stage_) + "' took " + ms_text(took) + " ms (limit " +
+                                ms_text(io_slow_threshold()) + " ms)");
+}
+
+namespace {
+
+// The io thread's own account (Linux /proc/thread-self/schedstat): ns on a CPU, ns runnable but waiting for
+// one. What a late tick's interval holds beyond the two, the thread spent blocked (a disk, a lock).
+struct SchedStat {
+  long long on_cpu_ns = 0, waiting_ns = 0;
+  bool ok = false;
+};
+
+SchedStat read_schedstat() {
+  SchedStat s;
+  if (FILE* f = std::fopen("/proc/thread-self/schedstat", "r")) {
+    s.ok = std::fscanf(f, "%lld %lld", &s.on_cpu_ns, &s.waiting_ns) == 2;
+    std::fclose(f);
+  }
+  return s;
+}
+
+}  // namespace
+
+struct IoLagMonitor::State {
+  explicit State(boost::asio::any_io_executor io) : timer(io) {}
+  boost::asio::steady_timer timer;
+  std::chrono::milliseconds tick{0};
+  Clock::time_point armed, due;
+  SchedStat at_arming;
+  bool stopped = false;
+
+  static void schedule(const std::shared_ptr<State>& self) {
+    self->armed = Clock::now();
+    self->at_arming = read_schedstat();
+    self->due = self->armed + self->tick;
+    self->timer.expires_at(self->due);
+    self->timer.async_wait([weak = std::weak_ptr<State>(self)](boost::system::error_code ec) {
+      auto s = weak.lock();
+      if (ec || !s || s->stopped) return;
+      const auto now = Clock::now();
+      const auto late = std::chrono::duration_cast<std::chrono::microseconds>(now - s->due);
+      if (late > io_slow_threshold()) {
+        std::string split;
+        const SchedStat at_firing = read_schedstat();
+        if (s->at_arming.ok && at_firing.ok) {
+          // Over the whole interval (tick + lateness): working, waiting for a CPU, or blocked.
+          const auto interval = std::chrono::duration_cast<std::chrono::microseconds>(now - s->armed);
+          const std::chrono::microseconds cpu((at_firing.on_cpu_ns - s->at_arming.on_cpu_ns) / 1000);
+          const std::chrono::microseconds queued((at_firing.waiting_ns - s->at_arming.waiting_ns) / 1000);
+          const auto blocked = std::max(std::chrono::microseconds(0), interval - cpu - queued);
+          split = " (of its " + ms_text(interval) + " ms: on a CPU " + ms_text(cpu) + ", waiting for a CPU " +
+                  ms_text(queued) + ", blocked " + ms_text(blocked) + ")";
+        }
+        log::warning("io-thread", "the io thread was busy: a " + std::to_string(s->tick.count()) + " ms tick fired " +
+                                      ms_text(late) + " ms late" + split);
+      }
+      schedule(s);
+    });
+  }
+};
+
+IoLagMonitor::IoLagMonitor(boost::asio::any_io_executor io) : state_(std::make_shared<State>(std::move(io))) {
+  state_->tick = std::chrono::milliseconds(env_ms("COLORLAB_IO_LAG_MS", 0));
+}
+
+IoLagMonitor::~IoLagMonitor() { stop(); }
+
+void IoLagMonitor::start() {
+  if (state_->tick.count() <= 0) return;
+  log::info("io-thread", "watching the io thread's lag every " + std::to_string(state_->tick.count()) + " ms");
+  State::schedule(state_);
+}
+
+void IoLagMonitor::stop() {
+  state_->stopped = true;
+  state_->timer.cancel();
+}
+
+}  // namespace colorlab::daemon
