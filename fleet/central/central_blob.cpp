@@ -78,7 +78,7 @@ HttpResponse get_blob(CentralContext& ctx, const HttpRequest& req, const PathPar
         "bytes " + std::to_string(range.first) + "-" + std::to_string(range.last) + "/" + std::to_string(size);
     r.body = ctx.s3.get_part(key, std::pair(range.first, range.last));
     if (r.body.size() != range.last - range.first + 1) {
-      throw Error(ErrorClass::bad_data, "the bucket answered " + std::to_string(r.body.size()) + " bytes of " + key +
+      throw Error(ErrorClass::io_error, "the bucket answered " + std::to_string(r.body.size()) + " bytes of " + key +
                                             " for a range of " + std::to_string(range.last - range.first + 1));
     }
     return r;
@@ -87,7 +87,7 @@ HttpResponse get_blob(CentralContext& ctx, const HttpRequest& req, const PathPar
   r.body = ctx.s3.get_part(key, std::nullopt);
   // The whole object is checked against its name: central never hands out bytes the bucket let rot.
   if (r.body.size() != size || sha256_hex(r.body) != sha256) {
-    throw Error(ErrorClass::bad_data, "the bucket's object " + key + " does not hash to its name",
+    throw Error(ErrorClass::io_error, "the bucket's object " + key + " does not hash to its name",
                 "re-ship it from a bench that holds it (colorlab-ship uploads a missing or damaged object again)");
   }
   return r;
