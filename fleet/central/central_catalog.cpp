@@ -70,7 +70,9 @@ bool is_run_id(const std::string& s) {
 PgPool::PgPool(std::string conninfo, unsigned max_connections) : conninfo_(std::move(conninfo)), max_(max_connections) {}
 
 PgPool::Lease::~Lease() {
-  if (pg_) pool_->give_back(std::move(pg_), broken_ || std::uncaught_exceptions() > 0);
+  if (!pg_) return;
+  const bool drop = broken_ || !pg_->ok();
+  pool_->give_back(std::move(pg_), drop);
 }
 
 PgPool::Lease PgPool::lease() {
@@ -94,8 +96,8 @@ PgPool::Lease PgPool::lease() {
 }
 
 void PgPool::give_back(std::unique_ptr<Pg> pg, bool broken) {
-  // A request that failed may have left the connection lost or mid-statement: a fresh one is cheap beside a
-  // wrong answer. The connection closes outside the lock.
+  // Every statement here is a single PQexecParams outside any transaction, so a refused one (a 404, a bad
+  // parameter) leaves the connection clean; only a lost one is dropped. It closes outside the lock.
   std::unique_ptr<Pg> drop;
   {
     std::lock_guard lock(mutex_);

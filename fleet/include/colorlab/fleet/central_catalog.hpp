@@ -23,8 +23,8 @@ class PgPool {
  public:
   PgPool(std::string conninfo, unsigned max_connections);
 
-  // One connection for the caller's request; back to the pool when the lease ends, dropped after a lost
-  // connection (Error{no_comms}: the next lease connects again).
+  // One connection for the caller's request; back to the pool when the lease ends, dropped when it was lost
+  // (the next lease connects again: PostgreSQL restarted is a few 502s, not a dead server).
   class Lease {
    public:
     Lease(PgPool& pool, std::unique_ptr<Pg> pg) : pool_(&pool), pg_(std::move(pg)) {}
