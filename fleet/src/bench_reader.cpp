@@ -81,6 +81,24 @@ std::vector<EndedRun> BenchReader::ended_after(std::int64_t position, int limit)
   return out;
 }
 
+Backlog BenchReader::backlog(std::int64_t position) {
+  ReadTx tx(db_);
+  Backlog b;
+  auto count = db_.prepare(
+      "SELECT count(*) FROM event_log WHERE seq > ?1 AND topic = 'execution' AND "
+      "json_extract(payload, '$.run_id') IS NOT NULL AND "
+      "json_extract(payload, '$.status') IN ('finished_ok', 'finished_error', 'aborted', 'interrupted')");
+  count.bind(1, position);
+  if (count.step()) b.runs = count.int64(0);
+  auto first = ended_after(position, 1);
+  if (first.empty()) return b;
+  b.oldest_run_id = first.front().run_id;
+  auto st = db_.prepare("SELECT finished_at FROM runs WHERE id = ?1");
+  st.bind(1, std::string_view(b.oldest_run_id));
+  if (st.step() && !st.is_null(0)) b.oldest_ended_at = st.text(0);
+  return b;
+}
+
 RunBatch BenchReader::read(const std::string& bench_id, const EndedRun& run, std::int64_t position) {
   ReadTx tx(db_);
   RunBatch b;

@@ -102,6 +102,20 @@ CREATE TABLE ship_problems (
   at          timestamptz NOT NULL DEFAULT now()
 );
 )sql",
+    // 2: what colorlab-central reads. Each bench's backlog as its agent last saw it (GET /v1/benches shows the
+    // lag: the oldest ended run not yet shipped and its age); keyset orders for the run list (newest first by
+    // UUIDv7, which orders across benches by creation time) under each filter; measurements by seq.
+    R"sql(
+ALTER TABLE benches
+  ADD COLUMN backlog_runs           integer,      -- ended runs the bench held unshipped at backlog_at
+  ADD COLUMN oldest_unshipped_run   text,         -- the oldest of them (null: none)
+  ADD COLUMN oldest_unshipped_ended timestamptz,  -- when it ended, by the bench's clock
+  ADD COLUMN backlog_at             timestamptz;  -- when the agent last counted (central's clock)
+CREATE INDEX runs_by_bench_id    ON runs (bench_id, id);
+CREATE INDEX runs_by_campaign_id ON runs (campaign, id);
+CREATE INDEX runs_by_status_id   ON runs (status, id);
+CREATE INDEX measurements_by_seq ON measurements (run_id, seq);
+)sql",
 };
 
 constexpr const char* kLock = "SELECT pg_advisory_xact_lock(7336021)";  // "colorlab central schema"

@@ -46,6 +46,8 @@ void Pg::fail(const std::string& what, pg_result* r) {
               lost ? "the connection was lost; the next cycle reconnects" : "");
 }
 
+bool Pg::ok() const { return c_ && PQstatus(c_) == CONNECTION_OK; }
+
 void Pg::exec(const std::string& sql) {
   pg_result* r = PQexec(c_, sql.c_str());
   auto st = PQresultStatus(r);

@@ -143,6 +143,16 @@ Outcome commit_run(Pg& pg, const ShipConfig& c, const RunBatch& b, std::int64_t 
   return Outcome::committed;
 }
 
+// The bench's backlog after `position`, for central's GET /v1/benches. Outside the run transactions: it is a
+// report of the moment, and a cycle that fails before this leaves the previous report (with its backlog_at).
+void record_backlog(Pg& pg, BenchReader& bench, const std::string& bench_id, std::int64_t position) {
+  const Backlog b = bench.backlog(position);
+  pg.query("UPDATE benches SET backlog_runs = $2, oldest_unshipped_run = $3, oldest_unshipped_ended = $4::timestamptz, "
+           "backlog_at = now() WHERE id = $1",
+           {bench_id, std::to_string(b.runs), b.oldest_run_id.empty() ? std::nullopt : std::optional(b.oldest_run_id),
+            b.oldest_ended_at.empty() ? std::nullopt : std::optional(b.oldest_ended_at)});
+}
+
 }  // namespace
 
 void central_init(const ShipConfig& config) {
@@ -198,6 +208,7 @@ CycleReport ship_cycle(const ShipConfig& c) {
                                  ") and central (" + d.central_digest + "); shipping stops before it");
           report.divergences.push_back(d);
           report.position_after = position;
+          record_backlog(pg, bench, c.bench_id, position);
           return report;
         case Outcome::committed:
           position = run.ended_event;
@@ -212,6 +223,7 @@ CycleReport ship_cycle(const ShipConfig& c) {
     }
   }
   report.position_after = position;
+  record_backlog(pg, bench, c.bench_id, position);
   return report;
 }
 

@@ -311,15 +311,15 @@ TEST_F(Fleet, CentralSchemaOfAnotherVersionIsRefusedWithWhatToUpgrade) {
   auto r = ship(config, "central-init");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   auto pg = central();
-  EXPECT_EQ(pg.query("SELECT string_agg(version::text, ',' ORDER BY version) FROM schema_migrations").text(0, 0), "1");
+  EXPECT_EQ(pg.query("SELECT string_agg(version::text, ',' ORDER BY version) FROM schema_migrations").text(0, 0), "1,2");
 
-  pg.exec("INSERT INTO schema_migrations (version) VALUES (2)");
+  pg.exec("INSERT INTO schema_migrations (version) VALUES (3)");
   r = ship(config);
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("upgrade colorlab on this bench"), std::string::npos) << r.err;
 
-  // An older central: colorlab's tables without this build's migration (the only one so far is version 1).
-  pg.exec("DELETE FROM schema_migrations");
+  // An older central: version 1's tables without this build's migration 2.
+  pg.exec("DELETE FROM schema_migrations WHERE version > 1");
   r = ship(config);
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("upgrade the central schema"), std::string::npos) << r.err;

@@ -18,6 +18,13 @@ struct EndedRun {
   std::string status;
 };
 
+// What the bench holds ended but not yet shipped after a position: central shows it as the bench's lag.
+struct Backlog {
+  std::int64_t runs = 0;
+  std::string oldest_run_id;    // empty when runs == 0
+  std::string oldest_ended_at;  // the oldest run's finished_at (ISO 8601, the bench's clock)
+};
+
 struct BlobToShip {
   std::string sha256;
   std::uint64_t size = 0;
@@ -41,6 +48,7 @@ class BenchReader {
   int schema_version();
   // Runs that ended after `position`, oldest first, at most `limit`.
   std::vector<EndedRun> ended_after(std::int64_t position, int limit);
+  Backlog backlog(std::int64_t position);
   // The run's rows and the bench's events (position, run.ended_event], from one snapshot.
   RunBatch read(const std::string& bench_id, const EndedRun& run, std::int64_t position);
   // The digest of the run as the bench holds it now (for `colorlab-ship verify`).

@@ -7,7 +7,7 @@
 namespace colorlab::fleet {
 
 // The schema version this build writes.
-inline constexpr int kCentralSchemaVersion = 1;
+inline constexpr int kCentralSchemaVersion = 2;
 
 // 0 when the database holds no colorlab schema.
 int central_schema_version(Pg& pg);

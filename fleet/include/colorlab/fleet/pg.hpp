@@ -33,6 +33,8 @@ class Pg {
   Pg(const Pg&) = delete;
   Pg& operator=(const Pg&) = delete;
 
+  // Whether the connection is still up (a pool drops one that is not).
+  bool ok() const;
   void exec(const std::string& sql);
   // $1.. parameters as text; std::nullopt is NULL.
   PgResult query(const std::string& sql, const std::vector<std::optional<std::string>>& params = {});

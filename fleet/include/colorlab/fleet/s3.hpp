@@ -2,8 +2,11 @@
 // The few S3 requests shipping needs, path-style, signed with SigV4 by libcurl (CURLOPT_AWS_SIGV4). Every
 // request carries x-amz-content-sha256 with the payload's real hash, so the store itself verifies the bytes
 // (a SigV4 store answers 400 BadDigest on a mismatch). Keys are held only here and never appear in messages.
+#include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
+#include <utility>
 
 namespace colorlab::fleet {
 
@@ -22,6 +25,9 @@ class S3Client {
   // Uploads a file whose SHA-256 is `sha256_hex`; the store refuses it unless the bytes hash to that.
   void put_file(const std::string& key, const std::filesystem::path& file, const std::string& sha256_hex);
   std::string get(const std::string& key);
+  // Bytes first..last (inclusive) of an object, or the whole object without a range: what colorlab-central
+  // streams on. Error{not_found} when the object is missing, otherwise as exists().
+  std::string get_part(const std::string& key, std::optional<std::pair<std::uint64_t, std::uint64_t>> range);
   void create_bucket();
 
  private:
@@ -30,7 +36,7 @@ class S3Client {
     std::string body;
   };
   Reply request(const std::string& method, const std::string& key, const std::filesystem::path* upload,
-                const std::string& payload_sha256);
+                const std::string& payload_sha256, const std::string& extra_header = {});
   [[noreturn]] void refuse(const std::string& what, const Reply& r) const;
   std::string endpoint_, bucket_, region_;
   S3Credentials credentials_;

@@ -1,0 +1,216 @@
+#!/usr/bin/env python3
+"""colorlab-central beside a bench on the same routes, in one run (issue 22, "Speed"):
+
+A throwaway PostgreSQL 15 (fsync on) gets the central schema from `colorlab-ship central-init`, then a catalog of
+BENCHES benches x RUNS runs x MEASUREMENTS measurements (10.2 M by default) written by SQL; bench-1's share is
+written, row for row the same, into a colorlabd state directory (the daemon's own schema, created by starting it
+once). Then wrk -t2 -c32 --latency, alternating bench and central, on
+  - the run listing, 50 runs a page (GET /v1/runs?limit=50), and
+  - one run's measurement page, 500 a page (GET /v1/runs/{id}/measurements?limit=500, a run in the middle).
+Blobs are not part of this bench (the bucket is not started).
+
+Usage: python3 bench/fleet/central_load.py --build build [--runs 2000] [--measurements 1700] [--benches 3]
+       [--seconds 10] [--rounds 2] [--threads 4]
+Run as root (PostgreSQL's initdb runs as the `postgres` user) with wrk installed. Prints one JSON document;
+docs/PERFORMANCE.md records the figures and this command.
+"""
+import argparse
+import json
+import os
+import pwd
+import re
+import shutil
+import signal
+import socket
+import sqlite3
+import subprocess
+import tempfile
+import time
+
+PG_BIN = "/usr/lib/postgresql/15/bin"
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def as_postgres(cmd):
+    return ["runuser", "-u", "postgres", "--"] + cmd if os.geteuid() == 0 else cmd
+
+
+def start_postgres(root):
+    data = os.path.join(root, "pg")
+    os.makedirs(data)
+    if os.geteuid() == 0:
+        shutil.chown(root, "postgres")
+        shutil.chown(data, "postgres")
+    subprocess.run(as_postgres([f"{PG_BIN}/initdb", "-D", data, "-A", "trust", "-U", "postgres"]), check=True,
+                   stdout=subprocess.DEVNULL)
+    port = free_port()
+    subprocess.run(as_postgres([f"{PG_BIN}/pg_ctl", "-D", data, "-w", "-l", os.path.join(data, "log"), "-o",
+                                f"-p {port} -k {data} -c listen_addresses=127.0.0.1 -c max_wal_size=4GB", "start"]),
+                   check=True, stdout=subprocess.DEVNULL)
+    return data, port
+
+
+def psql(port, db, sql):
+    return subprocess.run(["psql", "-h", "127.0.0.1", "-p", str(port), "-U", "postgres", "-d", db, "-v",
+                           "ON_ERROR_STOP=1", "-qAt", "-c", sql], check=True, capture_output=True, text=True).stdout
+
+
+def run_id(bench, i):
+    # UUIDv7-shaped and ordered by (i, bench): the runs of all benches interleave in the listing, as they would.
+    return f"{0x0190000000 + i:010x}"[:8] + "-" + f"{0x0190000000 + i:010x}"[8:] + f"{bench:02x}-7000-8000-{i:012x}"
+
+
+def write_central(port, benches, runs, per_run):
+    for b in range(1, benches + 1):
+        psql(port, "central", f"INSERT INTO benches (id, name, software_version, bench_schema) VALUES "
+                              f"('bench-{b}', 'Bench {b}', 'bench', 1)")
+    # The same rows as write_bench() writes for bench-1; ids as run_id() builds them.
+    ident = ("substr(lpad(to_hex(6710886400 + i), 10, '0'), 1, 8) || '-' || "
+             "substr(lpad(to_hex(6710886400 + i), 10, '0'), 9, 2) || lpad(to_hex(b), 2, '0') || "
+             "'-7000-8000-' || lpad(to_hex(i), 12, '0')")
+    psql(port, "central", f"""
+      INSERT INTO runs (id, bench_id, bench_seq, campaign, params, status, simulated, instruments, created_at,
+                        started_at, finished_at, summary, error, script_sha256, ended_event)
+      SELECT {ident}, 'bench-' || b, i, 'chart-read', '{{"chart":"sg"}}', 'finished_ok', 1, '[]',
+             '2026-11-28T20:00:00.000Z', '2026-11-28T20:00:00.000Z', '2026-11-28T20:10:00.000Z', '{{}}', NULL, NULL, i
+      FROM generate_series(1, {benches}) b, generate_series(1, {runs}) i""")
+    psql(port, "central", f"""
+      INSERT INTO measurements (run_id, step, seq, instrument_id, simulated, quantity, value, unit, data, measured_at)
+      SELECT r.id, 'patch/' || lpad(j::text, 5, '0'), (r.bench_seq - 1) * {per_run} + j, 'meter', 1, 'Y',
+             (((r.bench_seq - 1) * {per_run} + j) % 1000)::float8 / 7.0, 'cd/m2', '{{"xyz":[1.5,2.5,3.5]}}',
+             '2026-11-28T20:05:00.000Z'
+      FROM runs r, generate_series(1, {per_run}) j""")
+    psql(port, "central", "ANALYZE")
+
+
+def write_bench(db_path, runs, per_run):
+    db = sqlite3.connect(db_path)
+    db.execute("PRAGMA synchronous = OFF")
+    with db:
+        db.executemany(
+            "INSERT INTO runs (seq, id, campaign, params, status, simulated, instruments, created_at, started_at, "
+            "finished_at, summary, error) VALUES (?, ?, 'chart-read', '{\"chart\":\"sg\"}', 'finished_ok', 1, '[]', "
+            "'2026-11-28T20:00:00.000Z', '2026-11-28T20:00:00.000Z', '2026-11-28T20:10:00.000Z', '{}', NULL)",
+            ((i, run_id(1, i)) for i in range(1, runs + 1)))
+        db.executemany(
+            "INSERT INTO measurements (run_id, seq, step, instrument_id, simulated, quantity, value, unit, data, "
+            "measured_at) VALUES (?, ?, ?, 'meter', 1, 'Y', ?, 'cd/m2', '{\"xyz\":[1.5,2.5,3.5]}', "
+            "'2026-11-28T20:05:00.000Z')",
+            ((run_id(1, i), (i - 1) * per_run + j, f"patch/{j:05d}", (((i - 1) * per_run + j) % 1000) / 7.0)
+             for i in range(1, runs + 1) for j in range(1, per_run + 1)))
+    db.close()
+
+
+def start_daemon(build, root):
+    state = os.path.join(root, "bench")
+    os.makedirs(state, exist_ok=True)
+    with open(os.path.join(root, "lab.toml"), "w") as f:
+        f.write("[genicam]\nenabled = false\n")
+    with open(os.path.join(root, "colorlabd.toml"), "w") as f:
+        f.write(f"[simulator]\nenabled = true\ntime_scale = 1000\nconfig = \"{os.path.join(root, 'lab.toml')}\"\n")
+    endpoint = os.path.join(state, "colorlabd.endpoint")
+    if os.path.exists(endpoint):
+        os.remove(endpoint)
+    proc = subprocess.Popen([os.path.join(build, "bin", "colorlabd"), "--config", os.path.join(root, "colorlabd.toml"),
+                             "--state", state, "--listen", "127.0.0.1:0"],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    for _ in range(1200):
+        if os.path.exists(endpoint):
+            with open(endpoint) as f:
+                return proc, json.load(f)["url"]
+        time.sleep(0.05)
+    proc.kill()
+    raise SystemExit("colorlabd did not start")
+
+
+def start_central(build, root, port, threads):
+    c = os.path.join(root, "central")
+    os.makedirs(c)
+    for name in ("ak", "sk"):
+        with open(os.path.join(c, name), "w") as f:
+            f.write("unused\n")
+    with open(os.path.join(c, "central.toml"), "w") as f:
+        f.write(f"state_dir = \"{c}/state\"\n[central]\nport = 0\nthreads = {threads}\n"
+                f"postgres = \"host=127.0.0.1 port={port} dbname=central user=postgres\"\n"
+                f"s3_endpoint = \"http://127.0.0.1:9\"\nbucket = \"none\"\naccess_key_file = \"ak\"\nsecret_key_file = \"sk\"\n")
+    proc = subprocess.Popen([os.path.join(build, "bin", "colorlab-central"), "--config", os.path.join(c, "central.toml"),
+                             "serve"], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+    return proc, json.loads(proc.stdout.readline())["url"]
+
+
+def wrk(url, seconds, connections=32, threads=2):
+    out = subprocess.run(["wrk", f"-t{threads}", f"-c{connections}", f"-d{seconds}s", "--latency", url],
+                         capture_output=True, text=True, check=True).stdout
+    rps = float(re.search(r"Requests/sec:\s+([\d.]+)", out).group(1))
+    p99 = re.search(r"99%\s+([\d.]+)(us|ms|s)", out)
+    errors = re.search(r"Non-2xx or 3xx responses:\s+(\d+)", out)
+    return {"requests_per_s": rps, "p99_ms": round(float(p99.group(1)) * {"us": 1e-3, "ms": 1.0, "s": 1e3}[p99.group(2)], 2),
+            "non_2xx": int(errors.group(1)) if errors else 0}
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--build", default="build")
+    ap.add_argument("--benches", type=int, default=3)
+    ap.add_argument("--runs", type=int, default=2000, help="runs per bench")
+    ap.add_argument("--measurements", type=int, default=1700, help="measurements per run")
+    ap.add_argument("--seconds", type=int, default=10)
+    ap.add_argument("--rounds", type=int, default=2)
+    ap.add_argument("--threads", type=int, default=4, help="colorlab-central's HTTP threads")
+    a = ap.parse_args()
+    build = os.path.abspath(a.build)
+    root = tempfile.mkdtemp(prefix="colorlab-central-bench-")
+    os.chmod(root, 0o755)
+    procs, data = [], None
+    try:
+        t0 = time.time()
+        data, port = start_postgres(root)
+        psql(port, "postgres", "CREATE DATABASE central")
+        with open(os.path.join(root, "ship.toml"), "w") as f:
+            f.write(f"state_dir = \"{root}/bench\"\n[ship]\nbench_id = \"bench-1\"\n"
+                    f"postgres = \"host=127.0.0.1 port={port} dbname=central user=postgres\"\n"
+                    f"s3_endpoint = \"http://127.0.0.1:9\"\nbucket = \"none\"\naccess_key_file = \"central/ak\"\n"
+                    f"secret_key_file = \"central/sk\"\n")
+        subprocess.run([os.path.join(build, "bin", "colorlab-ship"), "--config", os.path.join(root, "ship.toml"),
+                        "central-init"], check=True, stdout=subprocess.DEVNULL)
+        write_central(port, a.benches, a.runs, a.measurements)
+        t1 = time.time()
+        daemon, bench_url = start_daemon(build, root)  # creates the bench's schema
+        daemon.send_signal(signal.SIGTERM)
+        daemon.wait(60)
+        write_bench(os.path.join(root, "bench", "colorlab.db"), a.runs, a.measurements)
+        t2 = time.time()
+        daemon, bench_url = start_daemon(build, root)
+        procs.append(daemon)
+        central, central_url = start_central(build, root, port, a.threads)
+        procs.append(central)
+        rows = int(psql(port, "central", "SELECT count(*) FROM measurements"))
+        middle = run_id(1, a.runs // 2)
+        routes = {"run listing, 50 a page": "/v1/runs?limit=50",
+                  "measurement page, 500 a page": f"/v1/runs/{middle}/measurements?limit=500"}
+        results = {name: {"bench": [], "central": []} for name in routes}
+        for _ in range(a.rounds):
+            for name, path in routes.items():
+                for side, url in (("bench", bench_url), ("central", central_url)):
+                    results[name][side].append(wrk(url + path, a.seconds))
+        print(json.dumps({"central_measurements": rows, "benches": a.benches, "runs_per_bench": a.runs,
+                          "bench_measurements": a.runs * a.measurements, "central_threads": a.threads,
+                          "load_seconds": {"central_sql": round(t1 - t0, 1), "bench_sqlite": round(t2 - t1, 1)},
+                          "loadavg_after": os.getloadavg(), "results": results}, indent=1))
+    finally:
+        for p in procs:
+            p.kill()
+            p.wait()
+        if data:
+            subprocess.run(as_postgres([f"{PG_BIN}/pg_ctl", "-D", data, "-m", "immediate", "stop"]),
+                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        shutil.rmtree(root, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    main()
