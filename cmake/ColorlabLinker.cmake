@@ -1,4 +1,4 @@
-# The linker. RelWithDebInfo links ~170 test executables carrying full debug info; GNU ld (bfd) spends most
+# The linker. RelWithDebInfo links 110 executables carrying full debug info; GNU ld (bfd) spends most
 # of a link copying that debug info, which lld (Debian's `lld`, scripts/setup.sh) does several times faster
 # (docs/PERFORMANCE.md, "CI time"). Where the chosen linker is missing, the compiler's default is kept.
 # Debugging is unchanged: the same DWARF ends up in the same executables.
