@@ -57,6 +57,9 @@ foreach(lib colorlab_drivers_core colorlab_drivers_camera colorlab_chart_locate 
   target_compile_options(${lib} PRIVATE -O0 -g0)
 endforeach()
 
+# Each parser source group (fuzz_parsers.cmake) is one object library with these flags, compiled once
+# and linked by every target that needs it.
+set(COLORLAB_FUZZ_GROUP_OPTIONS ${COLORLAB_FUZZ_FLAGS})
 include(${CMAKE_CURRENT_LIST_DIR}/fuzz_parsers.cmake)
 add_custom_target(fuzz_all)
 foreach(name IN LISTS COLORLAB_FUZZ_TARGETS)
