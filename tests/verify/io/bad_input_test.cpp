@@ -52,7 +52,7 @@ void expect(const std::filesystem::path& p, ErrorClass cls, const std::vector<st
   EXPECT_NE(t.message.find(p.filename().string()), std::string::npos) << "the message names no file: " << t.message;
 }
 
-TEST(BadInput, MissingEmptyAndForeignFiles) {
+TEST(VerifyIoBadInput, MissingEmptyAndForeignFiles) {
   TempDir dir;
   EXPECT_EQ(thrown([&] { read_rendering(dir / "none.exr"); }).cls, ErrorClass::io_error);
   write_bytes(dir / "empty.exr", "");
@@ -61,7 +61,7 @@ TEST(BadInput, MissingEmptyAndForeignFiles) {
   expect(dir / "image.exr", ErrorClass::unsupported, {"not an OpenEXR"});
 }
 
-TEST(BadInput, TruncatedOpenExrAnywhere) {
+TEST(VerifyIoBadInput, TruncatedOpenExrAnywhere) {
   TempDir dir;
   std::vector<std::string> bands;
   for (int i = 0; i < 8; ++i) bands.push_back("S0." + std::to_string(400 + 40 * i) + "nm");
@@ -76,7 +76,7 @@ TEST(BadInput, TruncatedOpenExrAnywhere) {
   }
 }
 
-TEST(BadInput, OpenExrWithMissingOrUnknownChannels) {
+TEST(VerifyIoBadInput, OpenExrWithMissingOrUnknownChannels) {
   TempDir dir;
   write_exr(dir / "rg.exr", {"R", "G"}, 4, 4);
   expect(dir / "rg.exr", ErrorClass::bad_data, {"B missing"});
@@ -88,7 +88,7 @@ TEST(BadInput, OpenExrWithMissingOrUnknownChannels) {
   expect(dir / "lum.exr", ErrorClass::unsupported, {"Y"});
 }
 
-TEST(BadInput, SpectralBandNamesThatAreNotTheLayout) {
+TEST(VerifyIoBadInput, SpectralBandNamesThatAreNotTheLayout) {
   TempDir dir;
   write_exr(dir / "dot.exr", {"S0.500nm", "S0.550.5nm"}, 4, 4);
   expect(dir / "dot.exr", ErrorClass::bad_data, {"S0.550.5nm", "JCGT"});
@@ -96,7 +96,7 @@ TEST(BadInput, SpectralBandNamesThatAreNotTheLayout) {
   expect(dir / "dup.exr", ErrorClass::bad_data, {"same band centre"});
 }
 
-TEST(BadInput, ValuesLightCannotHaveAreFoundWithTheirPixelAndChannel) {
+TEST(VerifyIoBadInput, ValuesLightCannotHaveAreFoundWithTheirPixelAndChannel) {
   TempDir dir;
   write_exr(dir / "nan.exr", {"S0.500nm", "S0.600nm"}, 8, 6,
             [](int x, int y, int c) { return x == 3 && y == 2 && c == 1 ? std::numeric_limits<float>::quiet_NaN() : 1.0f; });
@@ -112,7 +112,7 @@ TEST(BadInput, ValuesLightCannotHaveAreFoundWithTheirPixelAndChannel) {
   EXPECT_NO_THROW(read_rendering(dir / "rgbneg.exr"));  // out-of-gamut RGB is negative, legitimately
 }
 
-TEST(BadInput, OverscanDataWindowIsRefusedNotCropped) {
+TEST(VerifyIoBadInput, OverscanDataWindowIsRefusedNotCropped) {
   TempDir dir;
   write_exr(dir / "over.exr", {"R", "G", "B"}, 4, 4, nullptr, Imath::Box2i({-1, 0}, {3, 3}));
   expect(dir / "over.exr", ErrorClass::unsupported, {"display window"});
@@ -124,7 +124,7 @@ std::string rgbe_line_10() {
   return line;
 }
 
-TEST(BadInput, RadianceFilesThatContradictThemselves) {
+TEST(VerifyIoBadInput, RadianceFilesThatContradictThemselves) {
   TempDir dir;
   const std::string head = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 2 +X 10\n";
   write_bytes(dir / "ok.hdr", head + rgbe_line_10() + rgbe_line_10());
@@ -153,7 +153,7 @@ TEST(BadInput, RadianceFilesThatContradictThemselves) {
   expect(dir / "huge.hdr", ErrorClass::bad_data, {"exceeds"});
 }
 
-TEST(BadInput, PfmFilesThatContradictThemselves) {
+TEST(VerifyIoBadInput, PfmFilesThatContradictThemselves) {
   TempDir dir;
   const std::string px(2 * 2 * 3 * 4, '\0');
   write_bytes(dir / "ok.pfm", "PF\n2 2\n-1.0\n" + px);

@@ -26,7 +26,7 @@ std::string pixel(int k) {
   return {static_cast<char>(100 + k), static_cast<char>(50 + k), static_cast<char>(10 + k), static_cast<char>(136)};
 }
 
-TEST(RgbeReader, DecodesToTheCentreOfTheMantissaBinAndDividesOutExposure) {
+TEST(VerifyIoRgbe, DecodesToTheCentreOfTheMantissaBinAndDividesOutExposure) {
   TempDir dir;
   // (128, 64, 32) at exponent 129: Radiance's colr_color gives (m + 0.5) · 2^(129−136).
   write_bytes(dir / "a.hdr", rgbe_header("EXPOSURE=2\nEXPOSURE=0.5\nEXPOSURE=4", "-Y 1 +X 1") +
@@ -42,7 +42,7 @@ TEST(RgbeReader, DecodesToTheCentreOfTheMantissaBinAndDividesOutExposure) {
   EXPECT_FLOAT_EQ(r.pixels[2], 32.5f / 128 / 4);
 }
 
-TEST(RgbeReader, ZeroExponentIsBlackAndPrimariesComeFromTheHeader) {
+TEST(VerifyIoRgbe, ZeroExponentIsBlackAndPrimariesComeFromTheHeader) {
   TempDir dir;
   write_bytes(dir / "b.hdr", rgbe_header("PRIMARIES= 0.7347 0.2653 0.1596 0.8404 0.0366 0.0001 0.3457 0.3585", "-Y 1 +X 1") +
                                  std::string{char(200), char(200), char(200), char(0)});
@@ -54,7 +54,7 @@ TEST(RgbeReader, ZeroExponentIsBlackAndPrimariesComeFromTheHeader) {
 }
 
 // Radiance's resolution string (resolu.c): the first axis is the scanline order; −Y starts at the top, +X at the left.
-TEST(RgbeReader, EveryOrientationPutsPixelsWhereTheResolutionStringSays) {
+TEST(VerifyIoRgbe, EveryOrientationPutsPixelsWhereTheResolutionStringSays) {
   TempDir dir;
   struct Case {
     const char* resolution;
@@ -72,7 +72,7 @@ TEST(RgbeReader, EveryOrientationPutsPixelsWhereTheResolutionStringSays) {
   }
 }
 
-TEST(RgbeReader, NewStyleRunLengthScanlines) {
+TEST(VerifyIoRgbe, NewStyleRunLengthScanlines) {
   TempDir dir;
   // Width 10: R one run of 10 × 7; G ten literals 0..9; B a run of 5 × 3 then 5 literals 20..24; E a run of 10 × 136.
   std::string line{2, 2, 0, 10};
@@ -91,7 +91,7 @@ TEST(RgbeReader, NewStyleRunLengthScanlines) {
     }
 }
 
-TEST(RgbeReader, OldStyleRepeatCodesAndXyze) {
+TEST(VerifyIoRgbe, OldStyleRepeatCodesAndXyze) {
   TempDir dir;
   std::string body = pixel(0) + std::string{1, 1, 1, 3};  // pixel 0, then it again 3 times
   write_bytes(dir / "old.hdr", "#?RADIANCE\nFORMAT=32-bit_rle_xyze\n\n-Y 1 +X 4\n" + body);
@@ -100,7 +100,7 @@ TEST(RgbeReader, OldStyleRepeatCodesAndXyze) {
   for (int x = 0; x < 4; ++x) EXPECT_FLOAT_EQ(r.pixel(x, 0)[1], 50.5f);
 }
 
-TEST(PfmReader, BottomUpRowsInBothByteOrders) {
+TEST(VerifyIoPfm, BottomUpRowsInBothByteOrders) {
   TempDir dir;
   // 2 x 2 grey: stored bottom row first: 1, 2 then top row 3, 4.
   const float v[4] = {1, 2, 3, 4};
@@ -124,7 +124,7 @@ TEST(PfmReader, BottomUpRowsInBothByteOrders) {
   }
 }
 
-TEST(SpectralChannels, NamesFollowTheJcgtLayoutAndParseBack) {
+TEST(VerifyIoSpectralChannels, NamesFollowTheJcgtLayoutAndParseBack) {
   EXPECT_EQ(spectral_channel_name(550.0), "S0.550,000000nm");
   EXPECT_EQ(spectral_channel_name(412.5, true), "T.412,500000nm");
   EXPECT_DOUBLE_EQ(*spectral_channel_wavelength_nm("S0.550,000000nm"), 550.0);
@@ -139,14 +139,14 @@ TEST(SpectralChannels, NamesFollowTheJcgtLayoutAndParseBack) {
   EXPECT_FALSE(spectral_channel_wavelength_nm("S0.,nm"));
 }
 
-TEST(SpectralChannels, BoxesMeetHalfwayBetweenCentres) {
+TEST(VerifyIoSpectralChannels, BoxesMeetHalfwayBetweenCentres) {
   EXPECT_EQ(band_edges_nm({400, 410, 430}), (std::vector<double>{395, 405, 420, 440}));
   EXPECT_EQ(thrown([] { band_edges_nm({400}); }).cls, ErrorClass::bad_data);
   EXPECT_EQ(thrown([] { band_edges_nm({400, 400}); }).cls, ErrorClass::bad_data);
 }
 
 // IEC 61966-2-1 (sRGB), §5.2: the RGB → XYZ matrix to the four decimals the standard prints.
-TEST(ToXyz, Rec709MatrixIsTheSrgbStandardsMatrix) {
+TEST(VerifyIoToXyz, Rec709MatrixIsTheSrgbStandardsMatrix) {
   const double iec[3][3] = {{0.4124, 0.3576, 0.1805}, {0.2126, 0.7152, 0.0722}, {0.0193, 0.1192, 0.9505}};
   const Matrix3 m = rgb_to_xyz_matrix(rec709_chromaticities());
   for (int r = 0; r < 3; ++r)
@@ -158,7 +158,7 @@ TEST(ToXyz, Rec709MatrixIsTheSrgbStandardsMatrix) {
   EXPECT_EQ(thrown([] { rgb_to_xyz_matrix({{{0.2, 0.2}, {0.4, 0.4}, {0.6, 0.6}, {0.3, 0.3}}}); }).cls, ErrorClass::bad_data);
 }
 
-TEST(ToXyz, RgbWhiteHasYOneOrTheFilesWhiteLuminance) {
+TEST(VerifyIoToXyz, RgbWhiteHasYOneOrTheFilesWhiteLuminance) {
   Rendering r;
   r.encoding = Encoding::rgb;
   r.width = r.height = 1;
@@ -186,7 +186,7 @@ Rendering flat_spectrum(double from, double to, double step, float radiance) {
 
 // CIE 15:2004: ∫ȳ(λ) dλ of the 1931 observer over 360–830 nm is 106.857 nm, and the equal-energy spectrum sits at
 // x = y = 1/3, so a flat radiance of 1 W·m⁻²·sr⁻¹·nm⁻¹ is 683 × 106.857 cd/m² with X = Y = Z.
-TEST(ToXyz, FlatSpectralRadianceGivesTheObserversIntegral) {
+TEST(VerifyIoToXyz, FlatSpectralRadianceGivesTheObserversIntegral) {
   Rendering x = to_xyz(flat_spectrum(360, 830, 10, 1.0f));
   EXPECT_EQ(x.units, "cd/m^2");
   EXPECT_NEAR(x.pixels[1], 683.0 * 106.857, 683.0 * 106.857 * 1e-3);
@@ -196,7 +196,7 @@ TEST(ToXyz, FlatSpectralRadianceGivesTheObserversIntegral) {
 }
 
 // ȳ(555 nm) = 1.0000 (CIE 1931 table): a 1 nm band there carries 683 cd/m² per unit spectral radiance.
-TEST(ToXyz, ANarrowBandAt555nmIs683CandelaPerUnitRadiance) {
+TEST(VerifyIoToXyz, ANarrowBandAt555nmIs683CandelaPerUnitRadiance) {
   Rendering r = flat_spectrum(554, 556, 1, 0.0f);
   r.pixels[1] = 1.0f;
   const Rendering x = to_xyz(r);
@@ -205,7 +205,7 @@ TEST(ToXyz, ANarrowBandAt555nmIs683CandelaPerUnitRadiance) {
   EXPECT_EQ(thrown([&] { to_xyz(r); }).cls, ErrorClass::unsupported);
 }
 
-TEST(OwnRoundTrip, SpectralXyzAndRgbComeBackBitExact) {
+TEST(VerifyIoRoundTrip, SpectralXyzAndRgbComeBackBitExact) {
   TempDir dir;
   Rendering s = flat_spectrum(380, 730, 10, 0.0f);  // 36 bands
   s.width = 7;
@@ -254,7 +254,7 @@ TEST(OwnRoundTrip, SpectralXyzAndRgbComeBackBitExact) {
   EXPECT_EQ(xb.pixels, rgb.pixels);
 }
 
-TEST(Assemble, OneBandPerRenderFromGreyRgbImages) {
+TEST(VerifyIoAssemble, OneBandPerRenderFromGreyRgbImages) {
   std::vector<Rendering> bands(3);
   for (int b = 0; b < 3; ++b) {
     bands[b].encoding = Encoding::rgb;

@@ -109,6 +109,8 @@ TEST_F(OiioWrittenFiles, HalfPizRgbWithoutChromaticitiesIsRec709AndSaysSo) {
   EXPECT_FALSE(r.white_luminance_cd_m2);
 }
 
+TEST_F(OiioWrittenFiles, TiledExr) { check_against_truth("rgb_tiled.exr"); }
+
 TEST_F(OiioWrittenFiles, ExrXyz) {
   Rendering r = check_against_truth("xyz.exr");
   EXPECT_EQ(r.encoding, Encoding::xyz);

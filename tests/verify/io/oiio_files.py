@@ -57,6 +57,11 @@ def cmd_write(d):
     data = values(rng, h, w, 3).astype(np.float16).astype(np.float32)
     emit("rgb_half.exr", spec, data)
 
+    spec = oiio.ImageSpec(w, h, 3, "float")  # tiled, 16 x 16 tiles: the edge tiles are partial
+    spec.channelnames = ("R", "G", "B")
+    spec.tile_width, spec.tile_height = 16, 16
+    emit("rgb_tiled.exr", spec, values(rng, h, w, 3))
+
     spec = oiio.ImageSpec(w, h, 3, "float")
     spec.channelnames = ("X", "Y", "Z")
     spec.attribute("compression", "none")
