@@ -1,6 +1,12 @@
 // The readers on files whose every byte the test states (Radiance RGBE orientations, run-length schemes,
 // EXPOSURE, PFM byte orders), the conversions to XYZ against published constants, and our own round trip.
 #include <gtest/gtest.h>
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfMultiPartOutputFile.h>
+#include <ImfOutputPart.h>
+#include <ImfPartType.h>
 
 #include <cmath>
 
@@ -252,6 +258,37 @@ TEST(VerifyIoRoundTrip, SpectralXyzAndRgbComeBackBitExact) {
   Rendering xb = read_rendering(dir / "xyz.exr");
   EXPECT_EQ(xb.encoding, Encoding::xyz);
   EXPECT_EQ(xb.pixels, rgb.pixels);
+}
+
+// A multi-part file with an RGB preview part first and the spectral part second: the spectral part is the rendering.
+TEST(VerifyIoRoundTrip, MultiPartFileYieldsItsSpectralPart) {
+  TempDir dir;
+  const int w = 5, h = 3;
+  std::vector<Imf::Header> headers(2, Imf::Header(w, h));
+  const std::vector<std::vector<std::string>> names = {{"R", "G", "B"}, {"S0.450nm", "S0.550nm", "S0.650nm", "S0.750nm"}};
+  for (int p = 0; p < 2; ++p) {
+    headers[p].setName(p == 0 ? "preview" : "spectral");
+    headers[p].setType(Imf::SCANLINEIMAGE);
+    for (const auto& n : names[p]) headers[p].channels().insert(n, Imf::Channel(Imf::FLOAT));
+  }
+  std::vector<std::vector<float>> data(2);
+  {
+    Imf::MultiPartOutputFile out((dir / "multi.exr").c_str(), headers.data(), 2);
+    for (int p = 0; p < 2; ++p) {
+      const std::size_t c = names[p].size();
+      for (std::size_t i = 0; i < c * w * h; ++i) data[p].push_back(static_cast<float>(p * 1000 + i));
+      Imf::FrameBuffer fb;
+      for (std::size_t k = 0; k < c; ++k)
+        fb.insert(names[p][k], Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(data[p].data() + k), 4 * c, 4 * c * w));
+      Imf::OutputPart part(out, p);
+      part.setFrameBuffer(fb);
+      part.writePixels(h);
+    }
+  }
+  Rendering r = read_rendering(dir / "multi.exr");
+  EXPECT_EQ(r.encoding, Encoding::spectral);
+  EXPECT_EQ(r.wavelengths_nm, (std::vector<double>{450, 550, 650, 750}));
+  EXPECT_EQ(r.pixels, data[1]);
 }
 
 TEST(VerifyIoAssemble, OneBandPerRenderFromGreyRgbImages) {

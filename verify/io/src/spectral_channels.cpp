@@ -18,16 +18,23 @@ const std::regex& band_regex() {
   return re;
 }
 
-double si_prefix(const std::string& p) {
+// The SI prefix as a power of ten (the regex admits only these).
+int si_exponent(const std::string& p) {
   static const struct {
     const char* name;
-    double factor;
-  } table[] = {{"Y", 1e24}, {"Z", 1e21}, {"E", 1e18}, {"P", 1e15}, {"T", 1e12}, {"G", 1e9},  {"M", 1e6},  {"k", 1e3},
-               {"h", 1e2},  {"da", 1e1}, {"d", 1e-1}, {"c", 1e-2}, {"m", 1e-3}, {"u", 1e-6}, {"n", 1e-9}, {"p", 1e-12}};
-  if (p.empty()) return 1.0;
+    int exponent;
+  } table[] = {{"Y", 24}, {"Z", 21}, {"E", 18}, {"P", 15}, {"T", 12}, {"G", 9},  {"M", 6},   {"k", 3},
+               {"h", 2},  {"da", 1}, {"d", -1}, {"c", -2}, {"m", -3}, {"u", -6}, {"n", -9}, {"p", -12}};
   for (const auto& e : table)
-    if (p == e.name) return e.factor;
-  return 0.0;  // unreachable: the regex admits only the table's prefixes
+    if (p == e.name) return e.exponent;
+  return 0;
+}
+
+// v · 10^e with an exactly representable power of ten, so "S0.450nm" is 450 nm exactly, not 450 · 1e-9 · 1e9.
+double times_pow10(double v, int e) {
+  double p = 1.0;
+  for (int i = 0; i < std::abs(e); ++i) p *= 10.0;
+  return e >= 0 ? v * p : v / p;
 }
 
 }  // namespace
@@ -42,12 +49,12 @@ std::optional<double> spectral_channel_wavelength_nm(const std::string& channel,
   char* end = nullptr;
   const double v = std::strtod(value.c_str(), &end);
   if (end == value.c_str() || *end != '\0' || !std::isfinite(v) || v <= 0) return std::nullopt;
-  const double scaled = v * si_prefix(m[4].str());
+  const int e = si_exponent(m[4].str());
   if (m[5].str() == "Hz") {
     constexpr double kSpeedOfLight = 299792458.0;  // m/s, exact (SI)
-    return kSpeedOfLight / scaled * 1e9;
+    return kSpeedOfLight / times_pow10(v, e) * 1e9;
   }
-  return scaled * 1e9;
+  return times_pow10(v, e + 9);
 }
 
 std::string spectral_channel_name(double wavelength_nm, bool reflective) {
