@@ -130,9 +130,10 @@ int main(int argc, char** argv) {
     std::printf("round %d: spectral ours %.3f s, oiiotool %.3f s | rgb ours %.3f s, oiiotool %.3f s | oiiotool 1x1 %.3f s\n", r + 1,
                 a.back(), b.back(), c.back(), d.back(), start.back());
   }
-  std::printf("spectral 36 x 1752 x 1168 (median of %d): ours %.3f s, oiiotool %.3f s (start-up %.3f s): ratio %.2f "
-              "(target >= 0.50), %.2f without oiiotool's start-up\n",
-              rounds, median(a), median(b), median(start), median(b) / median(a), (median(b) - median(start)) / median(a));
+  std::printf(
+      "spectral 36 x 1752 x 1168 (median of %d): ours %.3f s, oiiotool %.3f s (start-up %.3f s): ratio %.2f "
+      "(target >= 0.50), %.2f without oiiotool's start-up\n",
+      rounds, median(a), median(b), median(start), median(b) / median(a), (median(b) - median(start)) / median(a));
   std::printf("rgb 3504 x 2336 (median of %d): ours %.3f s, oiiotool %.3f s\n", rounds, median(c), median(d));
   std::filesystem::remove(spectral);
   std::filesystem::remove(rgb);

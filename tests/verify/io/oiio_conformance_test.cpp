@@ -30,7 +30,8 @@ bool have_oiio() {
 std::string run(const std::string& cmd, const std::filesystem::path& out) {
   const int rc = std::system((cmd + " >" + out.string() + " 2>&1").c_str());
   const std::string text = read_bytes(out);
-  if (rc != 0) ADD_FAILURE() << cmd << " failed (" << rc << "):\n" << text;
+  if (rc != 0) ADD_FAILURE() << cmd << " failed (" << rc << "):\n"
+                             << text;
   return text;
 }
 

@@ -28,9 +28,7 @@ Rendering assemble_spectral(const std::vector<Rendering>& bands, const std::vect
     const Rendering& im = bands[b];
     const std::size_t c = static_cast<std::size_t>(im.channels());
     if (im.width != r.width || im.height != r.height || im.pixels.size() != n * c)
-      throw Error(ErrorClass::bad_data, "band " + std::to_string(b) + " (" + std::to_string(wavelengths_nm[b]) + " nm) is " +
-                                            std::to_string(im.width) + " x " + std::to_string(im.height) + ", band 0 is " +
-                                            std::to_string(r.width) + " x " + std::to_string(r.height),
+      throw Error(ErrorClass::bad_data, "band " + std::to_string(b) + " (" + std::to_string(wavelengths_nm[b]) + " nm) is " + std::to_string(im.width) + " x " + std::to_string(im.height) + ", band 0 is " + std::to_string(r.width) + " x " + std::to_string(r.height),
                   "render every band at the same resolution");
     // A band rendered with grey albedos and a grey light has R = G = B; the mean keeps what the renderer's colour
     // handling would do to them out of the band's value.

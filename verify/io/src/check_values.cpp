@@ -28,7 +28,8 @@ void check_values(const Rendering& image, const std::filesystem::path& file, con
   const std::size_t pixel = first / c;
   const std::size_t x = pixel % static_cast<std::size_t>(image.width), y = pixel / static_cast<std::size_t>(image.width);
   const float v = p[first];
-  const std::string kind = std::isnan(v) ? "NaN" : std::isinf(v) ? (v > 0 ? "+inf" : "-inf") : "negative value " + std::to_string(v);
+  const std::string kind = std::isnan(v) ? "NaN" : std::isinf(v) ? (v > 0 ? "+inf" : "-inf")
+                                                                 : "negative value " + std::to_string(v);
   const std::string channel = first % c < names.size() ? names[first % c] : "#" + std::to_string(first % c);
   bad_data(file,
            kind + " at pixel (" + std::to_string(x) + ", " + std::to_string(y) + ") channel " + channel + " (" +

@@ -46,8 +46,7 @@ std::vector<std::pair<double, std::string>> layer_bands(const Imf::ChannelList& 
     if (name.rfind(prefix, 0) != 0) continue;
     auto nm = spectral_channel_wavelength_nm(name, layer);
     if (!nm)
-      bad_data(file, "channel '" + name + "' is in the spectral layer " + layer +
-                         " but is not a JCGT band name (e.g. " + layer + ".550,000000nm)",
+      bad_data(file, "channel '" + name + "' is in the spectral layer " + layer + " but is not a JCGT band name (e.g. " + layer + ".550,000000nm)",
                "name bands <layer>.<centre with a comma decimal><SI prefix>m or Hz (Fichet et al., JCGT 2021)");
     bands.emplace_back(*nm, name);
   }

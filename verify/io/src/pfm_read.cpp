@@ -37,9 +37,7 @@ Rendering read_pfm(const std::filesystem::path& file, std::string_view bytes) {
   check_dimensions(file, width, height, 3);
   const std::size_t need = static_cast<std::size_t>(width * height * in_ch) * 4;
   if (bytes.size() - pos != need)
-    bad_data(file, "PFM header says " + std::to_string(width) + " x " + std::to_string(height) + " x " + std::to_string(in_ch) +
-                       " floats (" + std::to_string(need) + " bytes), the file holds " + std::to_string(bytes.size() - pos) +
-                       (bytes.size() - pos < need ? ": truncated" : ": inconsistent sizes"),
+    bad_data(file, "PFM header says " + std::to_string(width) + " x " + std::to_string(height) + " x " + std::to_string(in_ch) + " floats (" + std::to_string(need) + " bytes), the file holds " + std::to_string(bytes.size() - pos) + (bytes.size() - pos < need ? ": truncated" : ": inconsistent sizes"),
              bytes.size() - pos < need ? "the file is truncated" : "the header and the data disagree: the file is corrupt");
   const bool little = scale < 0;
   const bool swap = little != (std::endian::native == std::endian::little);

@@ -20,8 +20,7 @@ void check_dimensions(const std::filesystem::path& file, long long width, long l
   // 2^31 floats (8 GiB) is far beyond any rendering this compares; a header claiming more is corrupt or hostile.
   constexpr long long kMaxFloats = 1LL << 31;
   if (width > kMaxFloats || height > kMaxFloats || channels > 4096 || width * height > kMaxFloats / channels)
-    bad_data(file, "image size " + std::to_string(width) + " x " + std::to_string(height) + " x " +
-                       std::to_string(channels) + " channels exceeds 2^31 values",
+    bad_data(file, "image size " + std::to_string(width) + " x " + std::to_string(height) + " x " + std::to_string(channels) + " channels exceeds 2^31 values",
              "a header this large is corrupt; crop or split the rendering");
 }
 

@@ -27,7 +27,7 @@ struct Rendering {
   std::vector<double> wavelengths_nm;  // spectral: each band's centre, ascending; empty otherwise
   // spectral: JCGT's reflective `T.` layer (reflectance, no units) rather than the emissive `S0.` layer.
   bool reflective = false;
-  Chromaticities chromaticities{};     // rgb only
+  Chromaticities chromaticities{};  // rgb only
   bool chromaticities_from_file = false;
   // Radiometric units as the file states them (e.g. JCGT's "W.m^-2.sr^-1.nm^-1" for emissive spectral
   // channels, EXR's whiteLuminance for RGB/XYZ); empty when the file does not say, and then a verification
