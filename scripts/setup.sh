@@ -41,6 +41,8 @@ packages=(
   # colorlab-ship (fleet/): libpq for the central PostgreSQL; its tests start a throwaway PostgreSQL 15 and a
   # one-replica OpenStack Swift with s3api (the bookworm S3 server that checks SigV4 and payload hashes)
   libpq-dev postgresql-15 postgresql-client-15 swift swift-proxy swift-object swift-container swift-account memcached
+  # renderings verified against the lab (verify/io, issue 23): OpenEXR 3.1, and OpenImageIO as the independent reader
+  libopenexr-dev libimath-dev openimageio-tools python3-openimageio
 )
 
 missing=()
