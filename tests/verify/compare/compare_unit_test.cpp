@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "colorlab/core/error.hpp"
+#include "colorlab/verify/compare/stored.hpp"
 #include "colorlab/verify/compare/uncertainty.hpp"
 #include "colorlab/verify/compare/verification.hpp"
 
@@ -102,6 +103,26 @@ TEST(VerifyCompare, BadInputsAreTypedErrors) {
   neg.scale = -1;
   expect_class([&] { compare(r, two_spots(1, 1), neg); }, ErrorClass::bad_parameter);
   expect_class([&] { compare(Rendering{}, two_spots(1, 1)); }, ErrorClass::bad_data);
+}
+
+TEST(VerifyCompare, StoredLikeARunWithAnExitStatus) {
+  const auto r = flat_xyz(50);
+  CompareOptions given;
+  given.scale = 2.0;
+  const auto ok = compare(r, two_spots(100, 100), given);
+  EXPECT_EQ(exit_status(ok), kExitAgrees);
+  const auto bad = compare(r, two_spots(100, 80), given);  // the second spot: rendered 25 % too bright
+  EXPECT_EQ(exit_status(bad), kExitDiffers);
+  const auto s = to_store(bad, "render.exr", {"run-1", "run-2"}, given);
+  ASSERT_EQ(s.measurements.size(), 2u);
+  EXPECT_EQ(s.measurements[1].step, "light_spot/r0c1");
+  EXPECT_NEAR(*s.measurements[1].value, 0.25, 1e-12);
+  EXPECT_EQ(s.measurements[1].data["verdict"], "differs");
+  EXPECT_NE(s.measurements[0].step, s.measurements[1].step);  // steps are unique within a run
+  EXPECT_EQ(s.summary["verdict"], "differs");
+  EXPECT_EQ(s.summary["kinds"]["light_spot"]["renderer_wrong_at"][0]["where"], "r0c1");
+  EXPECT_EQ(s.params["against"].size(), 2u);
+  EXPECT_EQ(s.params["scale"], 2.0);
 }
 
 }  // namespace
