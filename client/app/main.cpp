@@ -14,6 +14,7 @@
 #include "access_commands.hpp"
 #include "locate_commands.hpp"
 #include "doctor_command.hpp"
+#include "verify_command.hpp"
 #ifdef COLORLAB_HAVE_ANALYZE
 #include "colorlab/cli/analyze_command.hpp"
 #endif
@@ -38,6 +39,7 @@ int main(int argc, char** argv) {
   colorlab::cli::add_access_commands(app, global);
   colorlab::cli::add_locate_commands(app, global);
   colorlab::cli::add_doctor_command(app, global);
+  colorlab::cli::add_verify_command(app, global);
 #ifdef COLORLAB_HAVE_ANALYZE
   colorlab::cli::add_analyze_command(app);
 #endif
