@@ -149,6 +149,10 @@ void the_true_floor_agrees_at_95_percent_of_the_spots() {
     std::cout << kind << ": " << t.compared - t.differ << "/" << t.compared << " agree\n";
     EXPECT_GE(agree, 0.95) << kind << "\n" << result["summary"].dump(2);
   }
+  // The margin, printed for the record: the largest distance over its threshold (1 = the band's edge).
+  double worst = 0;
+  for (const auto& c : result["comparisons"]) worst = std::max(worst, c["mahalanobis"].get<double>() / c["threshold"].get<double>());
+  std::cout << "largest distance / threshold: " << worst << "\n";
   for (const auto& s : result["summary"]["scales"]) EXPECT_EQ(s["how"], "given") << s.dump();
   // The exit status is the verdict: 0 exactly when every comparison agrees.
   const bool any = std::any_of(k.begin(), k.end(), [](const auto& e) { return e.second.differ > 0; });
