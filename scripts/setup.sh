@@ -46,6 +46,8 @@ packages=(
   # the measured scene rendered by a renderer nobody here wrote (tests/verify/scene): Blender 3.4's Cycles, and
   # OpenImageIO's Python reader for its OpenEXR output
   blender python3-openimageio
+  # renderings verified against the lab (verify/io, issue 23): OpenEXR 3.1, and OpenImageIO as the independent reader
+  libopenexr-dev libimath-dev openimageio-tools python3-openimageio
 )
 
 missing=()

@@ -15,6 +15,7 @@
 #include "locate_commands.hpp"
 #include "doctor_command.hpp"
 #include "scene_command.hpp"
+#include "verify_command.hpp"
 #ifdef COLORLAB_HAVE_ANALYZE
 #include "colorlab/cli/analyze_command.hpp"
 #endif
@@ -40,6 +41,7 @@ int main(int argc, char** argv) {
   colorlab::cli::add_locate_commands(app, global);
   colorlab::cli::add_doctor_command(app, global);
   colorlab::cli::add_scene_command(app, global);
+  colorlab::cli::add_verify_command(app, global);
 #ifdef COLORLAB_HAVE_ANALYZE
   colorlab::cli::add_analyze_command(app);
 #endif

@@ -15,6 +15,7 @@ from .events import Event
 from .executions import TERMINAL, Execution, Progress
 from .runs import Run
 from .sse import SseEvent, SseParser
+from .verify import VerifyFailed
 
 __version__ = "0.1.0"
 
@@ -23,5 +24,5 @@ __all__ = [
     "ColorlabError", "ConnectionFailed", "IntegrityError", "ExecutionFailed", "ApiError", "BadRequest",
     "Unauthorized", "Forbidden", "NotFound", "MethodNotAllowed", "Conflict", "PayloadTooLarge",
     "UnsupportedMediaType", "RangeNotSatisfiable", "Unprocessable", "ServerError", "InstrumentError",
-    "ServiceUnavailable",
+    "ServiceUnavailable", "VerifyFailed",
 ]

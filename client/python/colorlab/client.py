@@ -12,9 +12,10 @@ from .executions import ExecutionsMixin
 from .exports import ExportsMixin
 from .lab import LabMixin
 from .runs import RunsMixin
+from .verify import VerifyMixin
 
 
-class Client(RunsMixin, BlobsMixin, ExportsMixin, ExecutionsMixin, LabMixin, AccessMixin):
+class Client(RunsMixin, BlobsMixin, ExportsMixin, ExecutionsMixin, LabMixin, AccessMixin, VerifyMixin):
     """``Client(url=None, key=None, cacert=None)``: url from ``COLORLAB_URL`` (else http://127.0.0.1:8765), key
     from ``COLORLAB_API_KEY`` (sent as ``Authorization: Bearer``), ``cacert`` for an https daemon whose
     certificate your system does not trust; or ``socket=``, the daemon's Unix socket, instead of a URL.

@@ -55,6 +55,8 @@ constexpr Route kRoutes[] = {
     {"GET",    "/v1/runs/{id}/export",                 read,    pool,    r::get_run_export},
     {"GET",    "/v1/runs/{id}/report",                 read,    pool,    r::get_run_report},
     {"GET",    "/v1/runs/{id}/blobs",                  read,    pool,    r::get_run_blobs},
+    // A verification compared where the rendering is, stored as a `verify` run: a write, like starting a campaign.
+    {"POST",   "/v1/verifications",                    control, main,    r::post_verification},
     {"GET",    "/v1/blobs/{sha256}",                   read,    pool,    r::get_blob},
     {"GET",    "/v1/blobs/{sha256}/preview.png",       read,    pool,    r::get_blob_preview},
     // Stores nothing: the read scope; the locating is the pool's work, not the main thread's.

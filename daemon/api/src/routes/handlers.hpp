@@ -76,4 +76,7 @@ HttpResponse post_blob_retention(ApiContext& ctx, const HttpRequest& req, const 
 // locate_routes.cpp
 HttpResponse post_locate_chart(ApiContext& ctx, const HttpRequest& req, const PathParams& params);
 
+// verify_routes.cpp: a rendering's verification stored as a run (issue 23).
+HttpResponse post_verification(ApiContext& ctx, const HttpRequest& req, const PathParams& params);
+
 }  // namespace colorlab::daemon::routes

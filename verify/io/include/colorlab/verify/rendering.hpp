@@ -25,7 +25,9 @@ struct Rendering {
   int height = 0;
   Encoding encoding = Encoding::xyz;
   std::vector<double> wavelengths_nm;  // spectral: each band's centre, ascending; empty otherwise
-  Chromaticities chromaticities{};     // rgb only
+  // spectral: JCGT's reflective `T.` layer (reflectance, no units) rather than the emissive `S0.` layer.
+  bool reflective = false;
+  Chromaticities chromaticities{};  // rgb only
   bool chromaticities_from_file = false;
   // Radiometric units as the file states them (e.g. JCGT's "W.m^-2.sr^-1.nm^-1" for emissive spectral
   // channels, EXR's whiteLuminance for RGB/XYZ); empty when the file does not say, and then a verification
@@ -43,8 +45,37 @@ struct Rendering {
   }
 };
 
+// Rec. 709 / sRGB primaries with D65: OpenEXR's default when a file has no `chromaticities`.
+Chromaticities rec709_chromaticities();
+// Radiance's standard primaries (white E), what an RGBE file without PRIMARIES means by its format's definition.
+Chromaticities radiance_chromaticities();
+
 // Reads any supported file by its content (magic bytes), not its extension. Throws colorlab::Error
 // (bad_data with what is wrong and where; io_error; unsupported for a valid file of another kind).
 Rendering read_rendering(const std::filesystem::path& file);
+
+// Each band's extent [edges[i], edges[i+1]] for a spectral rendering: JCGT's box functions meeting halfway between
+// neighbouring centres, the two outer boxes as wide as their inner halves. Throws bad_data for fewer than 2 bands.
+std::vector<double> band_edges_nm(const std::vector<double>& wavelengths_nm);
+
+// JCGT 2021 channel name for a band: "S0.550,000000nm" (emissive) or "T.550,000000nm" (reflective).
+std::string spectral_channel_name(double wavelength_nm, bool reflective = false);
+// The band centre in nm of a JCGT spectral channel of the given layer ("S0" or "T"), nullopt if the name is not one
+// (the proposal's regular expression; m and Hz units with any SI prefix).
+std::optional<double> spectral_channel_wavelength_nm(const std::string& channel, const std::string& layer = "S0");
+
+struct ExrWriteOptions {
+  bool compress = true;  // ZIP (lossless, what Blender and OpenImageIO write by default); false: uncompressed
+};
+// Writes a Rendering as OpenEXR 32-bit float: spectral in the JCGT layout (S0./T. channels, spectralLayoutVersion,
+// emissiveUnits when `units` is set, and R,G,B preview channels in linear Rec. 709 for ordinary viewers), xyz as
+// X,Y,Z, rgb as R,G,B with `chromaticities` (and `whiteLuminance` when known). Throws io_error / bad_parameter.
+void write_openexr(const Rendering& image, const std::filesystem::path& file, const ExrWriteOptions& options = {});
+
+// One spectral Rendering from N single-band images (e.g. one Blender render per band, each RGB with grey albedos
+// so R = G = B): each band's value is the mean of its image's channels. All images must share one size; the
+// result's `units` are `units`. Throws bad_data on a size mismatch, bad_parameter on unsorted/duplicate bands.
+Rendering assemble_spectral(const std::vector<Rendering>& bands, const std::vector<double>& wavelengths_nm,
+                            const std::string& units = "W.m^-2.sr^-1");
 
 }  // namespace colorlab::verify

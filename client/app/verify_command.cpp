@@ -1,0 +1,149 @@
+#include "verify_command.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "client_support.hpp"
+#include "colorlab/client/runs.hpp"
+#include "colorlab/core/error.hpp"
+#include "colorlab/verify/compare/scene_from_runs.hpp"
+#include "colorlab/verify/compare/stored.hpp"
+#include "colorlab/verify/compare/stored_request.hpp"
+#include "colorlab/verify/rendering.hpp"
+
+namespace colorlab::cli {
+
+using nlohmann::json;
+
+namespace {
+
+struct VerifyOptions {
+  std::string rendering;
+  std::vector<std::string> against;
+  std::optional<double> scale;
+  std::string lamp;
+  std::optional<double> dimmer;
+  double corner_accuracy_px = 0.5;
+  bool json = false;
+  bool store = false;
+};
+
+std::string fixed(double x, int digits) {
+  char s[64];
+  std::snprintf(s, sizeof s, "%.*f", digits, x);
+  return s;
+}
+
+// A difference in its kind's unit: ΔE00 for §7.3, percent for the relative ones.
+std::string shown(const std::string& kind, double x) {
+  return kind == "colour_7_3" ? fixed(x, 2) + " ΔE00" : fixed(100 * x, 2) + " %";
+}
+
+std::string human(const json& j) {
+  std::ostringstream out;
+  const json& s = j["summary"];
+  out << j["rendering"].get<std::string>() << " against " << j["against"].dump() << ": "
+      << (s["verdict"] == "agrees" ? "AGREES" : "DIFFERS") << " within the measurement's uncertainty (k = 2)\n";
+  for (const auto& sc : s["scales"])
+    out << "  scale " << sc["kind"].get<std::string>() << ": " << sc["how"].get<std::string>() << " " << sc["factor"].get<double>()
+        << (sc["how"] == "fitted" ? "  (a fitted factor cannot see a uniformly wrong level)" : "") << "\n";
+  for (const auto& [kind, k] : s["kinds"].items()) {
+    out << "  " << kind << ": " << k["agree"].get<int>() << "/" << k["compared"].get<std::size_t>() << " agree ("
+        << fixed(100 * k["agree_fraction"].get<double>(), 1) << " %), median |difference| "
+        << shown(kind, k["median_abs_difference"].get<double>());
+    if (k.contains("worst"))
+      out << ", worst " << k["worst"]["where"].get<std::string>() << " " << shown(kind, k["worst"]["difference"].get<double>())
+          << " (band ±" << shown(kind, k["worst"]["expanded"].get<double>()) << ")";
+    out << "\n";
+    const json& wrong = k["renderer_wrong_at"];
+    if (!wrong.empty()) {
+      out << "    renderer differs at:";
+      std::size_t shown_n = 0;
+      for (const auto& w : wrong) {
+        if (++shown_n > 8) break;
+        out << " " << w["where"].get<std::string>() << " " << shown(kind, w["difference"].get<double>());
+      }
+      if (wrong.size() > 8) out << " … (" << wrong.size() << " in all; --json lists them)";
+      out << "\n";
+    }
+    const json& blind = k["measurement_cannot_tell_at"];
+    if (!blind.empty())
+      out << "    the measurement cannot tell at " << blind.size() << " (band wider than the cannot-tell limit; --json names "
+          << "the dominant source)\n";
+  }
+  if (j.contains("stored_run")) out << "  stored as run " << j["stored_run"].get<std::string>() << "\n";
+  return out.str();
+}
+
+int verify(const GlobalOptions& global, const VerifyOptions& o) {
+  // The file first: a rendering that cannot be read is a local error (exit 1) whatever the daemon says.
+  const verify::Rendering rendering = verify::read_rendering(o.rendering);
+  auto api = make_client(global);
+  std::vector<json> runs;
+  for (const auto& id : o.against) {
+    check_id(id, "a run id", "colorlab runs lists them");
+    runs.push_back(client::fetch_run(api, id));
+  }
+  verify::RunsSceneOptions scene_options;
+  scene_options.corner_accuracy_px = o.corner_accuracy_px;
+  if (!o.lamp.empty() || o.dimmer) {
+    if (o.lamp.empty() || !o.dimmer)
+      throw Error(ErrorClass::bad_parameter, "--lamp and --dimmer go together", "e.g. --lamp D65 --dimmer 100");
+    scene_options.light = verify::LightSelection{o.lamp, *o.dimmer};
+  }
+  const auto scene = verify::scene_from_runs(runs, rendering.width, rendering.height, scene_options);
+  verify::CompareOptions options;
+  options.scale = o.scale;
+  const auto v = verify::compare(rendering, scene, options);
+
+  const std::string name = std::filesystem::path(o.rendering).filename().string();
+  json out = v.to_json();
+  out["rendering"] = name;
+  out["against"] = o.against;
+  out["lamp"] = scene.lamp;
+  out["exit_status"] = verify::exit_status(v);
+  if (o.store) {
+    const json stored = api.post("/v1/verifications", verify::store_request(v, name, o.against, options));
+    out["stored_run"] = stored.at("run_id");
+  }
+  GlobalOptions g = global;
+  g.json = global.json || o.json;
+  print(g, out, human);
+  return verify::exit_status(v);
+}
+
+}  // namespace
+
+void add_verify_command(CLI::App& app, GlobalOptions& global) {
+  auto o = std::make_shared<VerifyOptions>();
+  auto* cmd = app.add_subcommand(
+      "verify",
+      "Compare a rendering (OpenEXR spectral/XYZ/RGB, Radiance .hdr, PFM) with the measured scene of cabinet-grid and "
+      "floor-luminance runs, within the measurement's uncertainty (k = 2). Exit 0 agrees, 4 differs, 1 local error, 2 API refused");
+  cmd->add_option("rendering", o->rendering, "the rendering file, made with the exported camera (the floor photograph's view)")
+      ->required();
+  cmd->add_option("--against", o->against, "run ids: one floor-luminance run (where the floor lies) and optionally one cabinet-grid run")
+      ->required();
+  cmd->add_option("--scale", o->scale,
+                  "renderer unit -> cd/m² (1 for W·m⁻²·sr⁻¹·nm⁻¹ spectral and cd/m² XYZ); omitted: one factor fitted per kind, "
+                  "which cannot see a uniformly wrong level")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--lamp", o->lamp, "the lamp to compare under (default: the floor-luminance run's first)");
+  cmd->add_option("--dimmer", o->dimmer, "its dimmer level in % (with --lamp)")->check(CLI::Range(0.0, 100.0));
+  cmd->add_option("--corner-accuracy-px", o->corner_accuracy_px,
+                  "how well the floor's corners are known on the photograph, one σ in its pixels (the misregistration)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_flag("--json", o->json, "print the whole result: summary, every comparison with its budget, floor_difference");
+  cmd->add_flag("--store", o->store, "store the verification on the daemon as a `verify` run (POST /v1/verifications)");
+  cmd->callback([&global, o] {
+    const int rc = verify(global, *o);
+    if (rc != 0) throw CLI::RuntimeError(rc);
+  });
+}
+
+}  // namespace colorlab::cli

@@ -1,0 +1,74 @@
+"""A rendering verified against the measured scene (issue 23, docs/verify.md "Using it"): ``Client.verify``.
+
+The comparison engine is C++ (verify/compare) and reads the rendering file where it is, so this runs
+``colorlab verify … --json`` against the same daemon (binary found as ``colorlab analyze`` is: ``COLORLAB_BIN``,
+``COLORLAB_BIN_DIR``, beside the installation or the source tree, then PATH) and returns its document.
+"""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+from typing import Sequence
+
+import pandas as pd
+
+from .errors import ColorlabError
+from .runs import run_id
+
+TIMEOUT_S = 300
+EXIT_AGREES, EXIT_DIFFERS = 0, 4
+
+
+class VerifyFailed(ColorlabError):
+    """The verification could not be made: ``exit_status`` 1 (a local error: the file, the runs' content, an
+    option) or 2 (the daemon refused); ``message`` is colorlab's own, with its hint."""
+
+    def __init__(self, exit_status: int, message: str):
+        super().__init__(f"colorlab verify exited {exit_status}: {message}")
+        self.exit_status = exit_status
+        self.message = message
+
+
+class VerifyMixin:
+    def verify(self, path: str | os.PathLike, against: Sequence, scale: float | None = None, *, store: bool = False,
+               lamp: str | None = None, dimmer: float | None = None) -> dict:
+        """``colorlab verify PATH --against RUN… --json``: the rendering beside the runs' measured scene.
+
+        Returns the result document — ``summary`` (``verdict`` "agrees"/"differs", per kind compared/agree/differ,
+        ``scales`` given or fitted), ``comparisons``, ``floor_difference``, ``exit_status`` (0 agrees, 4 differs),
+        ``stored_run`` with ``store=True`` — plus ``table``: the comparisons as a DataFrame (kind, where,
+        difference, expanded, verdict, …). ``scale``: renderer unit → cd/m² (omitted: one factor fitted per kind,
+        which cannot see a uniformly wrong level). Raises ``VerifyFailed`` when no verdict could be made."""
+        from .report.analyze import colorlab_binary  # the one place that knows where the binary is
+
+        runs = [run_id(r) for r in against]
+        if not runs:
+            raise ValueError("against: give at least one run (a floor-luminance run, optionally a cabinet-grid run)")
+        cmd = [str(colorlab_binary())]
+        env = dict(os.environ, LC_ALL="C")
+        if self.conn.socket is not None:
+            cmd += ["--socket", self.conn.socket]
+        else:
+            cmd += ["--url", self.conn.url]
+            if self.conn.verify:
+                cmd += ["--cacert", self.conn.verify]
+        auth = self.conn.session.headers.get("Authorization", "")
+        if auth.startswith("Bearer "):
+            env["COLORLAB_API_KEY"] = auth[len("Bearer "):]  # not on the command line, where ps would show it
+        cmd += ["verify", os.fspath(path), "--against", *runs, "--json"]
+        if scale is not None:
+            cmd += ["--scale", repr(float(scale))]
+        if lamp is not None or dimmer is not None:
+            cmd += ["--lamp", str(lamp), "--dimmer", repr(float(dimmer))]
+        if store:
+            cmd.append("--store")
+        try:
+            p = subprocess.run(cmd, capture_output=True, text=True, timeout=TIMEOUT_S, env=env)
+        except (OSError, subprocess.TimeoutExpired) as e:
+            raise VerifyFailed(1, f"{cmd[0]} could not be run: {e}") from e
+        if p.returncode not in (EXIT_AGREES, EXIT_DIFFERS):
+            raise VerifyFailed(p.returncode, p.stderr.strip().replace("colorlab: ", "", 1))
+        result = json.loads(p.stdout)
+        result["table"] = pd.DataFrame(result.get("comparisons", []))
+        return result

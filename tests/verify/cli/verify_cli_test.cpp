@@ -1,0 +1,270 @@
+// `colorlab verify` end to end (issue 23, docs/verify.md "Using it"): colorlabd with its embedded simulated lab runs
+// a short cabinet-grid and floor-luminance; the test writes an XYZ OpenEXR rendering whose luminance is the
+// simulator's own true floor field (floor_truth: each spot's noiseless luminance, independent of the camera, the
+// meter and the flat field the runs measured through), and the CLI compares it with the runs. Bounds from the issue:
+// a faithful rendering agrees at ≥ 95 % of the spots; a lamp 10 % too bright with the scale given is flagged.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <iostream>
+#include <map>
+#include <stdexcept>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "colorlab/analysis/floor_luminance.hpp"
+#include "colorlab/sim/control_channel.hpp"
+#include "colorlab/verify/rendering.hpp"
+#include "resume_support.hpp"
+
+using namespace colorlab;
+using namespace colorlab::testing;
+using nlohmann::json;
+
+namespace {
+
+constexpr int kRows = 4, kCols = 5;  // 20 spots: both campaigns in a few seconds at time scale 200
+constexpr double kPitchX = 60, kPitchY = 54, kFloorW = 1200, kFloorD = 600;  // the §6.2 grid (docs/simulator.md)
+
+json control(const DaemonProcess& daemon, const json& command) {
+  json endpoint = json::parse(std::ifstream(daemon.state_dir() / "colorlabd.endpoint"));
+  return sim::send_control_command(endpoint.at("simulator_control").get<std::string>(), command);
+}
+
+// The true floor as an image from the photograph's view: each pixel mapped to the floor and given the true
+// luminance of the grid cell it falls in (piecewise constant, so a spot's region, well inside its 60 × 54 mm cell,
+// sees exactly its spot's truth). XYZ with the D65 white's chromaticity; Y in cd/m², so the scale is 1.
+verify::Rendering true_floor(const json& truth, double gain) {
+  std::array<std::array<double, 2>, 4> corners{};
+  for (int i = 0; i < 4; ++i) corners[i] = {truth["floor_corners_px"][i][0].get<double>(), truth["floor_corners_px"][i][1].get<double>()};
+  const analysis::FloorMap map(corners, kFloorW, kFloorD);
+  std::map<std::pair<int, int>, double> lum;
+  for (const auto& s : truth["spots"]) lum[{s["row"].get<int>(), s["col"].get<int>()}] = s["luminance"].get<double>();
+  verify::Rendering r;
+  r.width = truth["width"].get<int>();
+  r.height = truth["height"].get<int>();
+  r.encoding = verify::Encoding::xyz;
+  r.units = "cd/m^2";
+  r.pixels.resize(static_cast<std::size_t>(r.width) * r.height * 3);
+  for (int y = 0; y < r.height; ++y)
+    for (int x = 0; x < r.width; ++x) {
+      const auto f = map.floor_of(x, y);
+      const int col = std::clamp(static_cast<int>(std::floor(f[0] / kPitchX)), 0, 19);
+      const int row = std::clamp(static_cast<int>(std::floor(f[1] / kPitchY)), 0, 7);
+      const double Y = gain * lum.at({row, col});
+      float* p = r.pixels.data() + (static_cast<std::size_t>(y) * r.width + x) * 3;
+      p[0] = static_cast<float>(Y * 0.95047), p[1] = static_cast<float>(Y), p[2] = static_cast<float>(Y * 1.08883);
+    }
+  return r;
+}
+
+struct Kind {
+  int compared = 0, differ = 0;
+};
+
+std::map<std::string, Kind> tally(const json& result) {
+  std::map<std::string, Kind> k;
+  for (const auto& c : result["comparisons"]) {
+    auto& t = k[c["kind"].get<std::string>()];
+    ++t.compared;
+    if (c["verdict"] == "differs") ++t.differ;
+  }
+  return k;
+}
+
+struct Lab {
+  static void start() {
+    dir_ = new TempDir;
+    auto config = write_daemon_config(dir_->path(), 200, 11);
+    daemon_ = new DaemonProcess(dir_->path() / "state", config);
+    auto api = api_for(*daemon_);
+    // run_to_end waits for the campaign, as the other embedded-lab tests do (the instruments come up on their own).
+    // The floor's corners as a bench would measure them on its photograph: the simulator's, as fractions.
+    const json t = control(*daemon_, {{"cmd", "floor_truth"}, {"instrument", "dslr"}});
+    json corners = json::array();
+    for (const auto& c : t["floor_corners_px"]) {
+      corners.push_back((c[0].get<double>() + 0.5) / t["width"].get<double>());
+      corners.push_back((c[1].get<double>() + 0.5) / t["height"].get<double>());
+    }
+    const json light = {{"lamps", {"D65"}}, {"dimmer_levels", {100}}, {"settle_s", 0}, {"rows", kRows}, {"cols", kCols}};
+    json g = light;
+    g["readings"] = 2;
+    grid_ = new std::string(run_to_end(api, "cabinet-grid", g)["id"].get<std::string>());
+    json f = light;
+    f["frames"] = 4;
+    f["corners"] = corners;
+    f["grid_run"] = *grid_;
+    floor_ = new std::string(run_to_end(api, "floor-luminance", f)["id"].get<std::string>());
+    // The truth now: the campaigns left D65 lit at 100 %.
+    truth_ = new json(control(*daemon_, {{"cmd", "floor_truth"}, {"instrument", "dslr"}}));
+    verify::write_openexr(true_floor(*truth_, 1.0), dir_->path() / "faithful.exr");
+    verify::write_openexr(true_floor(*truth_, 1.1), dir_->path() / "brighter.exr");
+    std::ofstream(dir_->path() / "bad.exr") << "v/1 this is no image";
+  }
+  static void stop() {
+    delete daemon_;
+    delete dir_;
+    delete grid_;
+    delete floor_;
+    delete truth_;
+    daemon_ = nullptr, dir_ = nullptr, grid_ = nullptr, floor_ = nullptr, truth_ = nullptr;
+  }
+
+  static RunResult cli(std::vector<std::string> args) {
+    std::vector<std::string> argv{bin_path("colorlab"), "--socket", daemon_->unix_socket()};
+    argv.insert(argv.end(), args.begin(), args.end());
+    return run_command(argv, std::chrono::seconds(60));
+  }
+  static std::vector<std::string> verify_args(const std::string& file) {
+    return {"verify", (dir_->path() / file).string(), "--against", *grid_, *floor_, "--json", "--scale", "1"};
+  }
+
+  static inline TempDir* dir_ = nullptr;
+  static inline DaemonProcess* daemon_ = nullptr;
+  static inline std::string* grid_ = nullptr;
+  static inline std::string* floor_ = nullptr;
+  static inline json* truth_ = nullptr;
+};
+
+// Lab's members, as the checks below name them.
+const auto& dir_ = Lab::dir_;
+const auto& daemon_ = Lab::daemon_;
+const auto& grid_ = Lab::grid_;
+const auto& floor_ = Lab::floor_;
+const auto& truth_ = Lab::truth_;
+RunResult cli(std::vector<std::string> args) { return Lab::cli(std::move(args)); }
+std::vector<std::string> verify_args(const std::string& file) { return Lab::verify_args(file); }
+
+void the_true_floor_agrees_at_95_percent_of_the_spots() {
+  ASSERT_EQ((*truth_)["dimmer"].get<double>(), 100) << truth_->dump();
+  const auto r = cli(verify_args("faithful.exr"));
+  ASSERT_TRUE(r.exit_code == 0 || r.exit_code == 4) << r.exit_code << "\n" << r.err;
+  const json result = json::parse(r.out);
+  const auto k = tally(result);
+  ASSERT_EQ(k.at("light_spot").compared, kRows * kCols);
+  ASSERT_EQ(k.at("light_floor").compared, kRows * kCols);
+  for (const auto& [kind, t] : k) {
+    const double agree = 1.0 - static_cast<double>(t.differ) / t.compared;
+    std::cout << kind << ": " << t.compared - t.differ << "/" << t.compared << " agree\n";
+    EXPECT_GE(agree, 0.95) << kind << "\n" << result["summary"].dump(2);
+  }
+  // The margin, printed for the record: the largest distance over its threshold (1 = the band's edge).
+  double worst = 0;
+  for (const auto& c : result["comparisons"]) worst = std::max(worst, c["mahalanobis"].get<double>() / c["threshold"].get<double>());
+  std::cout << "largest distance / threshold: " << worst << "\n";
+  for (const auto& s : result["summary"]["scales"]) EXPECT_EQ(s["how"], "given") << s.dump();
+  // The exit status is the verdict: 0 exactly when every comparison agrees.
+  const bool any = std::any_of(k.begin(), k.end(), [](const auto& e) { return e.second.differ > 0; });
+  EXPECT_EQ(r.exit_code, any ? 4 : 0);
+  EXPECT_EQ(result["exit_status"], r.exit_code);
+  EXPECT_EQ(result["summary"]["verdict"], any ? "differs" : "agrees");
+}
+
+void a_lamp_ten_percent_too_bright_differs_and_exits_4() {
+  const auto r = cli(verify_args("brighter.exr"));
+  ASSERT_EQ(r.exit_code, 4) << r.err << r.out.substr(0, 2000);
+  const json result = json::parse(r.out);
+  const auto k = tally(result);
+  // 10 % against a band of about 2.5 % (LS-110, drift bound, flat field): every spot and cell flags it.
+  EXPECT_EQ(k.at("light_spot").differ, kRows * kCols) << result["summary"].dump(2);
+  EXPECT_EQ(k.at("light_floor").differ, kRows * kCols) << result["summary"].dump(2);
+  for (const auto& c : result["comparisons"]) EXPECT_GT(c["difference"].get<double>(), 0.05) << c.dump();
+  // Without the scale one fitted factor takes the level up: it must say it was fitted.
+  auto args = verify_args("brighter.exr");
+  args.resize(args.size() - 2);
+  const auto fitted = cli(args);
+  ASSERT_TRUE(fitted.exit_code == 0 || fitted.exit_code == 4) << fitted.err;
+  for (const auto& s : json::parse(fitted.out)["summary"]["scales"]) EXPECT_EQ(s["how"], "fitted") << s.dump();
+}
+
+void bad_inputs_are_typed_errors_with_their_exit_codes() {
+  // Not an image: a local error, exit 1, naming the file.
+  const auto bad = cli(verify_args("bad.exr"));
+  EXPECT_EQ(bad.exit_code, 1) << bad.out << bad.err;
+  EXPECT_NE(bad.err.find("bad.exr"), std::string::npos) << bad.err;
+  EXPECT_TRUE(bad.out.empty()) << bad.out;
+  // A file that is not there: exit 1 before the daemon is asked.
+  const auto missing = cli(verify_args("nowhere.exr"));
+  EXPECT_EQ(missing.exit_code, 1) << missing.err;
+  // A run the daemon does not have: the API refused, exit 2.
+  const auto unknown = cli({"verify", (dir_->path() / "faithful.exr").string(), "--against", "0123456789abcdef", "--json"});
+  EXPECT_EQ(unknown.exit_code, 2) << unknown.err;
+  // Only a cabinet-grid run: nothing says where the floor lies in the view.
+  const auto no_floor = cli({"verify", (dir_->path() / "faithful.exr").string(), "--against", *grid_});
+  EXPECT_EQ(no_floor.exit_code, 1) << no_floor.err;
+  EXPECT_NE(no_floor.err.find("floor-luminance"), std::string::npos) << no_floor.err;
+  // A lamp the runs did not measure.
+  auto args = verify_args("faithful.exr");
+  args.insert(args.end(), {"--lamp", "TL84", "--dimmer", "100"});
+  const auto lamp = cli(args);
+  EXPECT_EQ(lamp.exit_code, 1) << lamp.err;
+  EXPECT_NE(lamp.err.find("TL84"), std::string::npos) << lamp.err;
+}
+
+void store_makes_a_run_readable_through_the_api() {
+  auto args = verify_args("brighter.exr");
+  args.push_back("--store");
+  const auto r = cli(args);
+  ASSERT_EQ(r.exit_code, 4) << r.err;
+  const json result = json::parse(r.out);
+  const std::string id = result.at("stored_run");
+  auto api = api_for(*daemon_);
+  const json run = client::fetch_run(api, id);
+  EXPECT_EQ(run["campaign"], "verify");
+  EXPECT_EQ(run["status"], "finished_ok");
+  EXPECT_EQ(run["params"]["rendering"], "brighter.exr");
+  EXPECT_EQ(run["params"]["against"], json({*grid_, *floor_}));
+  EXPECT_EQ(run["params"]["scale"], 1.0);
+  ASSERT_EQ(run["measurements"].size(), result["comparisons"].size());
+  for (std::size_t i = 0; i < run["measurements"].size(); ++i) {
+    const auto& m = run["measurements"][i];
+    const auto& c = result["comparisons"][i];
+    EXPECT_EQ(m["step"], c["kind"].get<std::string>() + "/" + c["where"].get<std::string>());
+    EXPECT_EQ(m["data"]["verdict"], c["verdict"]);
+  }
+  // A body whose verdict contradicts its own distance is refused, naming the field.
+  json body = {{"rendering", "x.exr"}, {"against", {*grid_}}, {"scale", 1}, {"k", 2}, {"result", result}};
+  body["result"]["comparisons"][0]["verdict"] = "agrees";
+  try {
+    api.post("/v1/verifications", body);
+    ADD_FAILURE() << "a contradicting verdict was stored";
+  } catch (const client::ApiError& e) {
+    EXPECT_EQ(e.problem().status, 400);
+    EXPECT_NE(e.problem().detail.find("comparisons[0].verdict"), std::string::npos) << e.problem().detail;
+  }
+}
+
+}  // namespace
+
+// One daemon and one pair of campaigns for every check (ctest runs each TEST in its own process): the campaigns are
+// the test's cost.
+TEST(VerifyCli, EndToEndAgainstTheSimulatedLab) {
+  try {
+    Lab::start();
+  } catch (const std::exception& e) {
+    Lab::stop();
+    FAIL() << "setting up the lab: " << e.what();
+  }
+  if (HasFatalFailure()) {
+    Lab::stop();
+    return;
+  }
+  {
+    SCOPED_TRACE("the true floor");
+    the_true_floor_agrees_at_95_percent_of_the_spots();
+  }
+  {
+    SCOPED_TRACE("a lamp 10 % too bright");
+    a_lamp_ten_percent_too_bright_differs_and_exits_4();
+  }
+  {
+    SCOPED_TRACE("bad inputs");
+    bad_inputs_are_typed_errors_with_their_exit_codes();
+  }
+  {
+    SCOPED_TRACE("--store");
+    store_makes_a_run_readable_through_the_api();
+  }
+  Lab::stop();
+}

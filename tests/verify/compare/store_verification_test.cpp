@@ -1,0 +1,54 @@
+// A verification stored like a run: read back through the store's own queries, as GET /v1/runs/{id} does.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <filesystem>
+
+#include "store_verification.hpp"
+
+namespace colorlab::verify {
+namespace {
+
+TEST(VerifyStore, ReadBackAsARun) {
+  const auto dir = std::filesystem::temp_directory_path() / ("verify-store-" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  Rendering r;
+  r.width = 20;
+  r.height = 10;
+  r.encoding = Encoding::xyz;
+  r.pixels.assign(20 * 10 * 3, 50.0f);
+  MeasuredScene m;
+  for (int i = 0; i < 2; ++i) {
+    SpotMeasurement s;
+    s.col = i;
+    s.luminance_cd_m2 = i ? 80 : 100;
+    s.reading_sd = 1;
+    s.rendering_region = {2 + 10 * i, 2, 4, 4};
+    m.spots.push_back(s);
+  }
+  CompareOptions o;
+  o.scale = 2.0;
+  const auto v = compare(r, m, o);
+  std::string id;
+  {
+    store::Store st(dir / "colorlab.db");
+    id = store_verification(st, to_store(v, "render.exr", {"run-a"}, o));
+  }
+  store::Store st(dir / "colorlab.db", store::Store::ReadOnly{});
+  const auto run = st.run(id);
+  ASSERT_TRUE(run.has_value());
+  EXPECT_EQ(run->campaign, "verify");
+  EXPECT_EQ(run->status, "finished_ok");
+  EXPECT_EQ(run->summary["verdict"], "differs");
+  EXPECT_EQ(run->params["against"][0], "run-a");
+  const auto rows = st.measurements(id);
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[1].step, "light_spot/r0c1");
+  EXPECT_EQ(rows[1].data["verdict"], "differs");
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace colorlab::verify

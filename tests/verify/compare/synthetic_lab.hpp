@@ -1,0 +1,70 @@
+#pragma once
+// A small lab on paper for the comparison's tests: a chart of smooth reflectances and a floor under one lamp,
+// the truth as a spectral image (what a faithful renderer produces), and a measurement of it drawn with the
+// noise each instrument has — the camera's frame noise, the lamp's drift within its bound, the LS-110's
+// repeatability, the locator's and the floor homography's misregistration, the floor map's flat-field residual —
+// plus the characterization and the black box fitted, on every draw, from their own noisy training photograph.
+// The truth never comes from the code under test: it is the physics written here.
+#include <random>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "colorlab/verify/compare/verification.hpp"
+
+namespace colorlab::verify::testing {
+
+struct Sources {  // which noises the draw makes (and the engine is told of)
+  bool frame_noise = true;
+  bool drift = true;
+  bool ls110 = true;
+  bool misregistration = true;
+  bool floor_map = true;
+  bool characterization = true;  // false: §7.3/§7.4 mappings are exact (the true curves)
+};
+
+struct Defects {
+  int patch = -1;              // this patch's reflectance scaled so it is ~3 ΔE00 off under the lamp
+  double patch_factor = 1.0;
+  double lamp_factor = 1.0;    // the whole rendering brighter
+  std::string lamp_spd;        // the rendering lit by this CIE illuminant (same luminance) instead of the lamp
+  double floor_factor = 1.0;   // the floor's reflectance in the region below
+  int floor_rows = 3, floor_cols = 4;  // the region: rows [0, 3) × cols [0, 4)
+};
+
+class SyntheticLab {
+ public:
+  SyntheticLab();
+  static constexpr int kPatches = 140;  // 14 × 10, as the SG
+  static constexpr int kRows = 8, kCols = 10;  // the cabinet grid's left half
+
+  // The spectral rendering a renderer that gets the physics right (or with the planted defects) produces, in
+  // W·m⁻²·sr⁻¹·nm⁻¹: with the given scale 1 its luminance is in cd/m².
+  Rendering render(const Defects& d = {}) const;
+  // One draw of the whole measurement of the (faithful) scene.
+  MeasuredScene measure(std::mt19937_64& rng, const Sources& s) const;
+  // The reflectance factor that puts `patch` `de00` away from itself under the lamp.
+  double factor_for_de00(int patch, double de00) const;
+  // ΔE00 between the faithful and the defective rendering of each patch (the defect's true size, §7.3's way).
+  std::vector<double> true_de00(const Defects& d) const;
+
+  bool floor_region(int row, int col, const Defects& d) const { return row < d.floor_rows && col < d.floor_cols; }
+
+ private:
+  std::vector<double> wl_;                 // 400..700 nm, 10 nm
+  Eigen::MatrixXd refl_;                   // patches × bands
+  Eigen::RowVectorXd lamp_;                // the cabinet lamp (CIE F2 = the cabinet's CWF) × κ: radiance of the white
+  Eigen::Matrix3Xd camera_;                // true sensitivities × band width, counts per radiance
+  Eigen::Matrix3Xd cmf_;                   // 683 · CIE 1931 × band width
+  analysis::Xyz white_;                    // XYZ (cd/m²) of the perfect diffuser
+  std::vector<PixelRect> patch_regions_;
+  std::vector<PixelRect> spot_regions_;    // kRows × kCols
+  int width_ = 0, height_ = 0;
+
+  double floor_field(double x, double y) const;  // relative illumination of the floor at a pixel centre
+  double floor_mean(const PixelRect& g, double dx, double dy) const;
+  Eigen::RowVectorXd lamp_named(const std::string& name) const;
+};
+
+}  // namespace colorlab::verify::testing

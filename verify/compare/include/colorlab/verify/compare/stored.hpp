@@ -1,0 +1,34 @@
+#pragma once
+// A verification stored like a run (issue 23): campaign "verify", its parameters (the rendering, the runs it was
+// checked against, the scale), one measurement row per comparison and the summary as the run's summary — so the
+// store, GET /v1/runs/{id} and its measurements, export and the report read it as they read any run, and a query
+// by step prefix ("colour_7_3/", "light_spot/") gives one kind.
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "colorlab/core/step_records.hpp"
+#include "colorlab/verify/compare/verification.hpp"
+
+namespace colorlab::verify {
+
+inline constexpr const char* kVerifyCampaign = "verify";
+
+struct StoredVerification {
+  nlohmann::json params;   // {rendering, against: [run ids], scale (null: fitted), k}
+  nlohmann::json summary;  // Verification::summary() plus floor_difference
+  std::vector<records::Measurement> measurements;  // step "<kind>/<where>", value = the difference
+};
+
+StoredVerification to_store(const Verification& v, const std::string& rendering, const std::vector<std::string>& against,
+                            const CompareOptions& options);
+
+// The exit status a renderer's CI gates on: 0 every comparison agrees, 4 some differ beyond the measurement's
+// uncertainty. colorlab's other codes keep their meaning (docs/ARCHITECTURE.md: 1 local error, 2 API refused), so a
+// verification that could not be made is never read as a verdict.
+inline constexpr int kExitAgrees = 0;
+inline constexpr int kExitDiffers = 4;
+int exit_status(const Verification& v);
+
+}  // namespace colorlab::verify

@@ -1,0 +1,29 @@
+#include "colorlab/verify/compare/stored.hpp"
+
+namespace colorlab::verify {
+
+StoredVerification to_store(const Verification& v, const std::string& rendering, const std::vector<std::string>& against,
+                            const CompareOptions& options) {
+  StoredVerification s;
+  s.params = {{"rendering", rendering}, {"against", against},
+              {"scale", options.scale ? nlohmann::json(*options.scale) : nlohmann::json(nullptr)}, {"k", options.k}};
+  const auto full = v.to_json();
+  s.summary = full["summary"];
+  s.summary["floor_difference"] = full["floor_difference"];
+  for (std::size_t i = 0; i < v.comparisons.size(); ++i) {
+    const auto& c = v.comparisons[i];
+    records::Measurement m;
+    m.step = c.kind + "/" + c.where;
+    m.instrument_id = "verify";
+    m.quantity = c.kind == "colour_7_3" ? "delta_e00" : "relative_difference";
+    m.value = c.difference;
+    m.unit = c.kind == "colour_7_3" ? "ΔE00" : "1";
+    m.data = full["comparisons"][i];
+    s.measurements.push_back(std::move(m));
+  }
+  return s;
+}
+
+int exit_status(const Verification& v) { return v.differs() ? kExitDiffers : kExitAgrees; }
+
+}  // namespace colorlab::verify

@@ -1,0 +1,136 @@
+#include "colorlab/verify/compare/stored_request.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "colorlab/core/error.hpp"
+
+namespace colorlab::verify {
+
+using nlohmann::json;
+
+namespace {
+
+Error bad(const std::string& what) {
+  return Error(ErrorClass::bad_parameter, "verification: " + what,
+               "send the result of a comparison as colorlab verify --json prints it (docs/API.md, POST /v1/verifications)");
+}
+
+const json& field(const json& o, const char* key, const std::string& where) {
+  if (!o.is_object() || !o.contains(key)) throw bad(where + " has no '" + key + "'");
+  return o[key];
+}
+
+double num(const json& o, const char* key, const std::string& where) {
+  const json& v = field(o, key, where);
+  if (!v.is_number() || !std::isfinite(v.get<double>())) throw bad(where + "." + key + " is not a finite number");
+  return v.get<double>();
+}
+
+std::string str(const json& o, const char* key, const std::string& where) {
+  const json& v = field(o, key, where);
+  if (!v.is_string() || v.get<std::string>().empty()) throw bad(where + "." + key + " is not a non-empty string");
+  return v.get<std::string>();
+}
+
+std::vector<double> numbers(const json& o, const char* key, const std::string& where) {
+  const json& v = field(o, key, where);
+  if (!v.is_array()) throw bad(where + "." + key + " is not an array");
+  std::vector<double> out;
+  for (const auto& x : v) {
+    if (!x.is_number()) throw bad(where + "." + key + " holds a non-number");
+    out.push_back(x.get<double>());
+  }
+  return out;
+}
+
+}  // namespace
+
+Verification verification_from_json(const json& result) {
+  Verification v;
+  const json& items = field(result, "comparisons", "result");
+  if (!items.is_array() || items.empty()) throw bad("result.comparisons is not a non-empty array");
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    const json& c = items[i];
+    const std::string at = "comparisons[" + std::to_string(i) + "]";
+    Comparison k;
+    k.kind = str(c, "kind", at);
+    if (k.kind != "colour_7_3" && k.kind != "colour_7_4" && k.kind != "light_spot" && k.kind != "light_floor")
+      throw bad(at + ".kind '" + k.kind + "' is none of colour_7_3, colour_7_4, light_spot, light_floor");
+    k.where = str(c, "where", at);
+    k.rendered = numbers(c, "rendered", at);
+    k.measured = numbers(c, "measured", at);
+    k.difference = num(c, "difference", at);
+    k.expanded = num(c, "expanded", at);
+    k.mahalanobis = num(c, "mahalanobis", at);
+    k.threshold = num(c, "threshold", at);
+    const std::string verdict = str(c, "verdict", at);
+    if (verdict != "agrees" && verdict != "differs") throw bad(at + ".verdict '" + verdict + "' is neither agrees nor differs");
+    k.verdict = verdict == "differs" ? Verdict::differs : Verdict::agrees;
+    // The engine's rule: differs exactly when the distance exceeds the threshold.
+    if ((k.mahalanobis > k.threshold) != (k.verdict == Verdict::differs))
+      throw bad(at + ".verdict '" + verdict + "' contradicts its distance " + std::to_string(k.mahalanobis) +
+                " against the threshold " + std::to_string(k.threshold));
+    const json& tell = field(c, "cannot_tell", at);
+    if (!tell.is_boolean()) throw bad(at + ".cannot_tell is not a boolean");
+    k.cannot_tell = tell.get<bool>();
+    const json& budget = field(c, "budget", at);
+    if (!budget.is_object()) throw bad(at + ".budget is not an object");
+    for (const auto& [source, u] : budget.items()) {
+      if (!u.is_number()) throw bad(at + ".budget." + source + " is not a number");
+      k.budget.emplace_back(source, u.get<double>());
+    }
+    v.comparisons.push_back(std::move(k));
+  }
+  if (result.contains("summary") && result["summary"].contains("scales")) {
+    for (const auto& s : result["summary"]["scales"]) {
+      ScaleUsed u;
+      u.kind = str(s, "kind", "summary.scales[]");
+      u.how = str(s, "how", "summary.scales[]");
+      u.factor = num(s, "factor", "summary.scales[]");
+      v.scales.push_back(u);
+    }
+  }
+  if (result.contains("floor_difference")) {
+    const json& f = result["floor_difference"];
+    if (!f.is_array()) throw bad("result.floor_difference is not an array of rows");
+    for (const auto& row : f) {
+      if (!row.is_array()) throw bad("result.floor_difference holds a row that is not an array");
+      std::vector<double> r;
+      for (const auto& x : row) {
+        if (x.is_null()) r.push_back(std::numeric_limits<double>::quiet_NaN());
+        else if (x.is_number()) r.push_back(x.get<double>());
+        else throw bad("result.floor_difference holds a value that is neither a number nor null");
+      }
+      v.floor_ratio.push_back(std::move(r));
+    }
+  }
+  return v;
+}
+
+StoredVerification stored_from_request(const json& body) {
+  if (!body.is_object()) throw bad("the body is not a JSON object");
+  const std::string rendering = str(body, "rendering", "body");
+  const json& against = field(body, "against", "body");
+  if (!against.is_array() || against.empty()) throw bad("body.against is not a non-empty array of run ids");
+  std::vector<std::string> runs;
+  for (const auto& r : against) {
+    if (!r.is_string() || r.get<std::string>().empty()) throw bad("body.against holds something that is not a run id");
+    runs.push_back(r.get<std::string>());
+  }
+  CompareOptions options;
+  if (body.contains("scale") && !body["scale"].is_null()) {
+    options.scale = num(body, "scale", "body");
+    if (!(*options.scale > 0)) throw bad("body.scale must be positive (renderer unit -> cd/m²) or null (fitted)");
+  }
+  if (body.contains("k")) options.k = num(body, "k", "body");
+  return to_store(verification_from_json(field(body, "result", "body")), rendering, runs, options);
+}
+
+json store_request(const Verification& v, const std::string& rendering, const std::vector<std::string>& against,
+                   const CompareOptions& options) {
+  return {{"rendering", rendering}, {"against", against},
+          {"scale", options.scale ? json(*options.scale) : json(nullptr)}, {"k", options.k}, {"result", v.to_json()}};
+}
+
+}  // namespace colorlab::verify
