@@ -9,8 +9,6 @@ preset="${1:-dev}"
 packages=(
   # toolchain
   g++ cmake ninja-build pkg-config git
-  # the linker the build uses where it is present (cmake/ColorlabLinker.cmake): links the tests' debug info faster
-  lld
   # libraries
   libboost-dev libsqlite3-dev libserialport-dev libhidapi-dev libusb-1.0-0-dev libraw-dev libaravis-dev
   libgphoto2-dev liblcms2-dev libeigen3-dev nlohmann-json3-dev libtomlplusplus-dev libcli11-dev liblua5.4-dev
