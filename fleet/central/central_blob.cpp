@@ -1,40 +1,15 @@
 // GET /v1/blobs/{sha256} on central: the object sha256/<hex> from the bucket, with the bench's headers and rules
 // (daemon/api/src/routes/blob_routes.cpp): a strong ETag that is the name, If-None-Match answered from the
 // catalog without touching the bucket, one Range passed on to the store as a ranged GET, If-Range, 416.
-#include <nlohmann/json.hpp>
 
 #include "central_routes.hpp"
 #include "colorlab/api/conditional.hpp"
 #include "colorlab/api/problem.hpp"
-#include "colorlab/campaigns/frame_keeper.hpp"
 #include "colorlab/core/error.hpp"
+#include "blob_headers.hpp"
 #include "colorlab/store/blob_store.hpp"
 
 namespace colorlab::fleet::central_routes {
-
-using nlohmann::json;
-
-namespace {
-
-std::string join_shape(const json& shape) {
-  std::string out;
-  for (const auto& d : shape) out += (out.empty() ? "" : ",") + std::to_string(d.get<long long>());
-  return out;
-}
-
-void describe(HttpResponse& r, const store::BlobRecord& blob, const std::string& etag) {
-  r.headers["ETag"] = etag;
-  r.headers["Accept-Ranges"] = "bytes";
-  r.headers["Cache-Control"] = "public, max-age=31536000, immutable";
-  if (blob.media_type == campaigns::kArrayMediaType) {
-    const json& m = blob.meta;
-    if (m.contains("dtype") && m["dtype"].is_string()) r.headers["X-Colorlab-Dtype"] = m["dtype"].get<std::string>();
-    if (m.contains("shape") && m["shape"].is_array()) r.headers["X-Colorlab-Shape"] = join_shape(m["shape"]);
-    if (m.contains("cfa") && m["cfa"].is_string()) r.headers["X-Colorlab-Cfa"] = m["cfa"].get<std::string>();
-  }
-}
-
-}  // namespace
 
 HttpResponse get_blob(CentralContext& ctx, const HttpRequest& req, const PathParams& params) {
   const std::string& sha256 = params["sha256"];
@@ -52,7 +27,7 @@ HttpResponse get_blob(CentralContext& ctx, const HttpRequest& req, const PathPar
   const std::string etag = "\"" + sha256 + "\"";
   HttpResponse r;
   r.content_type = blob->media_type;
-  describe(r, *blob, etag);
+  daemon::describe_blob(r, *blob, etag);
   if (auto inm = req.header("if-none-match"); inm && daemon::none_match_hits(*inm, etag)) {
     r.status = 304;
     return r;
@@ -66,7 +41,7 @@ HttpResponse get_blob(CentralContext& ctx, const HttpRequest& req, const PathPar
     auto p = daemon::problem_response(416, "range-not-satisfiable", "Range not satisfiable",
                                       "blob " + sha256 + " has " + std::to_string(size) +
                                           " bytes; the range asked for starts beyond them");
-    describe(p, *blob, etag);
+    daemon::describe_blob(p, *blob, etag);
     p.headers["Content-Range"] = "bytes */" + std::to_string(size);
     return p;
   }

@@ -4,6 +4,7 @@
 
 #include "colorlab/campaigns/frame_keeper.hpp"
 #include "colorlab/core/error.hpp"
+#include "blob_headers.hpp"
 #include "colorlab/daemon/blob_service.hpp"
 #include "colorlab/api/problem.hpp"
 #include "colorlab/protocol/api.hpp"
@@ -40,26 +41,6 @@ store::BlobRecord require_blob(ApiContext& ctx, const std::string& sha256) {
   return *row;
 }
 
-std::string join_shape(const json& shape) {
-  std::string out;
-  for (const auto& d : shape) out += (out.empty() ? "" : ",") + std::to_string(d.get<long long>());
-  return out;
-}
-
-// Everything a GET and a HEAD of the blob share, before the body: identity, type and caching. The
-// bytes of a name never change, so a client may keep them for good.
-void describe(HttpResponse& r, const store::BlobRecord& blob, const std::string& etag) {
-  r.headers["ETag"] = etag;
-  r.headers["Accept-Ranges"] = "bytes";
-  r.headers["Cache-Control"] = "public, max-age=31536000, immutable";
-  if (blob.media_type == campaigns::kArrayMediaType) {
-    const json& m = blob.meta;
-    if (m.contains("dtype") && m["dtype"].is_string()) r.headers["X-Colorlab-Dtype"] = m["dtype"].get<std::string>();
-    if (m.contains("shape") && m["shape"].is_array()) r.headers["X-Colorlab-Shape"] = join_shape(m["shape"]);
-    if (m.contains("cfa") && m["cfa"].is_string()) r.headers["X-Colorlab-Cfa"] = m["cfa"].get<std::string>();
-  }
-}
-
 HttpResponse serve_blob(ApiContext& ctx, const HttpRequest& req, const std::string& sha256) {
   const store::BlobRecord blob = require_blob(ctx, sha256);
   const fs::path path = service(ctx).files().path_of(sha256);
@@ -72,7 +53,7 @@ HttpResponse serve_blob(ApiContext& ctx, const HttpRequest& req, const std::stri
   const std::string etag = "\"" + sha256 + "\"";
   HttpResponse r;
   r.content_type = blob.media_type;
-  describe(r, blob, etag);
+  describe_blob(r, blob, etag);
   if (auto inm = req.header("if-none-match"); inm && none_match_hits(*inm, etag)) {
     r.status = 304;
     return r;
@@ -87,7 +68,7 @@ HttpResponse serve_blob(ApiContext& ctx, const HttpRequest& req, const std::stri
   if (range.kind == ByteRange::Kind::unsatisfiable) {
     auto p = problem_response(416, "range-not-satisfiable", "Range not satisfiable",
                                    "blob " + sha256 + " has " + std::to_string(size) + " bytes; the range asked for starts beyond them");
-    describe(p, blob, etag);
+    describe_blob(p, blob, etag);
     p.headers["Content-Range"] = "bytes */" + std::to_string(size);
     return p;
   }
