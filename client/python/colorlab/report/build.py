@@ -5,6 +5,7 @@ import datetime as dt
 import sys
 
 from . import appendix, cabinet_grid, characterization, common, exposure, fetch, frame_average, imaging_meter, pareto, stability, summaries
+from . import verification
 from .html import document, esc
 
 TITLES = {
@@ -15,12 +16,14 @@ TITLES = {
     "luminance-spot": "Spot luminance",
     "floor-luminance": "The camera as an imaging luminance meter (§6.2's floor)",
     "dimmer-exposure": "Which dimmer setting to use: exposure against dimmer level (§6.2, Tables 7, 8)",
+    "verify": "A rendering verified against the measured scene (issue 23)",
     "other": "Run summary",
 }
 
 
 SECTIONS = {"dimmer-exposure": exposure.section, "frame-average": frame_average.section, "cabinet-grid": cabinet_grid.section,
             "characterize-camera": characterization.section, "floor-luminance": imaging_meter.section}
+SECTIONS["verify"] = verification.section
 
 
 def section_for(run) -> str:
@@ -80,6 +83,7 @@ def load_runs(client, run_ids):
             except Exception:  # the reference only adds the L*a*b* comparisons; the section says when it lacks it
                 run.extra["reference"] = None
     imaging_meter.link(client, runs)  # each floor-luminance run's cabinet-grid
+    verification.link(client, runs)  # each verify run's chart-read (chapter 8)
     # The stability section's "another lamp": the report's other characterize-camera runs of the same reference.
     cc = [r for r in runs if fetch.kind_of(r) == "characterize-camera"]
     for run in cc:

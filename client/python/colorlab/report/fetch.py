@@ -46,7 +46,7 @@ def load(client, run_id: str) -> RunData:
 def kind_of(run: RunData) -> str:
     """The campaign by name; a lab's own copy under another name by the steps it stored."""
     known = {"frame-average", "cabinet-grid", "characterize-camera", "chart-read", "luminance-spot", "floor-luminance",
-             "dimmer-exposure"}
+             "dimmer-exposure", "verify"}
     if run.campaign in known:
         return run.campaign
     steps = run.measurements.step if not run.measurements.empty else pd.Series([], dtype=str)
