@@ -18,6 +18,7 @@ from .html import cell, esc, figure
 from .plots import subplots, to_svg
 
 WORST = 5
+EXACT = 0.01  # ΔE00 below which a lamp's RGB rendering is exact (rounding only)
 
 
 def spectra(chart_read):
@@ -72,6 +73,8 @@ def _worst_rows(res, ids, short):
     rows = []
     for lamp, r in res.items():
         e = r["rgb_de00"]
+        if e.max() < EXACT:  # D65: the albedos are D65 colours, nothing to rank
+            continue
         for rank, i in enumerate(np.argsort(-e)[:WORST], 1):
             key = f"{lamp}/{ids[i]}"
             rows.append(f'<tr data-row="{esc(key)}"><td class="label">{esc(lamp)}</td><td class="label">{rank}</td>'
@@ -80,7 +83,7 @@ def _worst_rows(res, ids, short):
                         + f'<td class="label">{"yes" if r["albedo_out_of_gamut"][i] else ""}</td></tr>')
     head = ["lamp", "rank", "patch", "RGB ΔE00", "XYZ ΔE00", "albedo outside sRGB"]
     return (f'<div class="section-table"><table id="{short}-ch8-worst"><caption>The patches an RGB renderer gets '
-            f"most wrong ({WORST} per lamp)</caption><thead><tr>"
+            f"most wrong ({WORST} per lamp where it is not exact)</caption><thead><tr>"
             + "".join(f'<th class="label">{esc(h)}</th>' for h in head) + "</tr></thead><tbody>" + "".join(rows)
             + "</tbody></table></div>")
 

@@ -58,9 +58,9 @@ def chart_map(items_by_kind: dict, salt: str) -> str | None:
     return to_svg(fig, salt)
 
 
-def _floor_axes(ax, title):
-    ax.set_xlim(0, 1200)
-    ax.set_ylim(0, 600)
+def _floor_axes(ax, title, extent):
+    ax.set_xlim(0, extent[0])  # the grid's part of the 1200 × 600 mm floor (§6.2 measures one half)
+    ax.set_ylim(0, extent[1])
     ax.set_aspect("equal")
     ax.grid(False)
     ax.set_xlabel("x on the floor, mm (from the left wall)")
@@ -78,8 +78,10 @@ def floor_map(items_by_kind: dict, salt: str) -> str | None:
     span = max(0.02, float(np.max(np.abs(np.array(ratios) - 1))))
     norm = TwoSlopeNorm(vcenter=1.0, vmin=1 - span, vmax=1 + span)
     cmap = colormaps["RdBu_r"]
-    fig, axes = subplots(len(kinds), ncols=1, width=7.0, height=3.6)
+    fig, axes = subplots(len(kinds), ncols=len(kinds), width=5.0 * len(kinds), height=3.8)
     px, py = vd.PITCH_MM
+    places = [vd.spot_rc(c["where"]) for k in kinds for c in items_by_kind[k] if vd.spot_rc(c["where"])]
+    extent = ((max(c for _, c in places) + 1) * px, (max(r for r, _ in places) + 1) * py)
     for ax, kind in zip(axes, kinds):
         for c in items_by_kind[kind]:
             rc = vd.spot_rc(c["where"])
@@ -95,7 +97,7 @@ def floor_map(items_by_kind: dict, salt: str) -> str | None:
                 ax.add_patch(Circle((x, y), 22, facecolor=colour, **edge))
             _mark(ax, c, x, y)
         _floor_axes(ax, "floor map: rendered / measured luminance" if kind == "light_floor"
-                    else "LS-110 spots: rendered / measured luminance")
+                    else "LS-110 spots: rendered / measured luminance", extent)
         sm = ScalarMappable(cmap=cmap, norm=norm)
         fig.colorbar(sm, ax=ax, shrink=0.85, label="ratio")
     return to_svg(fig, salt)
