@@ -187,8 +187,8 @@ def section(run) -> str:
     svg = maps.floor_map(kinds, f"{run.short}-verify-floor-map")
     if svg:
         out.append(figure(f"{run.short}-fig-verify-floor", svg, "Luminance ratio rendered / measured over the floor "
-                          "(1 = agree; the floor map's cells are the difference image, the LS-110's spots drawn at "
-                          "their places): outlined in red where it differs beyond k = 2, a dot where the measurement "
+                          "(1 = agree; the floor map's cells are the difference image; the LS-110's spots drawn at "
+                          "their places over the measured floor luminance in grey, lighter = brighter): outlined in red where it differs beyond k = 2, a dot where the measurement "
                           "cannot tell.", "verify-floor"))
     for kind in PATCH_KINDS:
         if kind in kinds:

@@ -68,6 +68,16 @@ def _floor_axes(ax, title, extent):
     ax.set_title(title)
 
 
+def _measured_floor(items_by_kind: dict) -> dict:
+    """{(row, col): measured cd/m²}: the floor map's cells, else the LS-110's readings at its spots."""
+    for kind in ("light_floor", "light_spot"):
+        cells = {vd.spot_rc(c["where"]): (c.get("measured") or [None])[0] for c in items_by_kind.get(kind, [])}
+        cells = {rc: v for rc, v in cells.items() if rc and v is not None and v > 0}
+        if cells:
+            return cells
+    return {}
+
+
 def floor_map(items_by_kind: dict, salt: str) -> str | None:
     """Luminance ratio rendered / measured = 1 + the stored relative difference, over the floor."""
     kinds = [k for k in ("light_floor", "light_spot") if k in items_by_kind
@@ -82,7 +92,13 @@ def floor_map(items_by_kind: dict, salt: str) -> str | None:
     px, py = vd.PITCH_MM
     places = [vd.spot_rc(c["where"]) for k in kinds for c in items_by_kind[k] if vd.spot_rc(c["where"])]
     extent = ((max(c for _, c in places) + 1) * px, (max(r for r, _ in places) + 1) * py)
+    underlay = _measured_floor(items_by_kind)
     for ax, kind in zip(axes, kinds):
+        if kind == "light_spot":  # the spots over the floor map as measured
+            top = max(underlay.values())
+            for (r, col), lum in underlay.items():
+                ax.add_patch(Rectangle((col * px, r * py), px, py, facecolor=str(0.35 + 0.6 * lum / top),
+                                       edgecolor="none"))
         for c in items_by_kind[kind]:
             rc = vd.spot_rc(c["where"])
             if not rc:
@@ -96,8 +112,8 @@ def floor_map(items_by_kind: dict, salt: str) -> str | None:
             else:  # the LS-110's 20 mm measuring spot, drawn larger to be seen
                 ax.add_patch(Circle((x, y), 22, facecolor=colour, **edge))
             _mark(ax, c, x, y)
-        _floor_axes(ax, "floor map: rendered / measured luminance" if kind == "light_floor"
-                    else "LS-110 spots: rendered / measured luminance", extent)
+        _floor_axes(ax, "floor map: luminance rendered / measured" if kind == "light_floor"
+                    else "LS-110 spots over the measured floor", extent)
         sm = ScalarMappable(cmap=cmap, norm=norm)
         fig.colorbar(sm, ax=ax, shrink=0.85, label="ratio")
     return to_svg(fig, salt)
