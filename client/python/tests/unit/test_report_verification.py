@@ -263,6 +263,21 @@ class Chapter8(unittest.TestCase):
         # Physics, not this implementation: the RGB renderer's albedos are D65 colours, so under D65 it is exact.
         self.assertLess(self.cells.value("D65", "rgb max"), 0.02)
 
+    def test_hostile_patch_ids_are_text(self):
+        items = [{"seq": i + 1, "step": f"patch/{pid}", "instrument_id": "spectro", "quantity": "reflectance_spectrum",
+                  "value": 50.0, "unit": "L*", "measured_at": "2026-11-29T06:00:00Z", "simulated": True,
+                  "data": {"id": pid, "first_nm": 380, "step_nm": 10, "values": list(self.refl[i])}}
+                 for i, pid in enumerate(["A1", "</td><script>x</script>", HOSTILE])]
+        chart = RunData({"id": '"><img src=x>', "campaign": "chart-read", "params": {}, "status": "finished_ok",
+                         "instruments": []}, measurements_frame(items))
+        run, _ = stored_verification()
+        run.extra["chart_read"] = chart
+        from colorlab.report import verification
+        html = verification.section(run).lower()
+        self.assertNotIn("<script", html)
+        self.assertNotIn("<img", html)
+        self.assertIn("&lt;/td&gt;&lt;script&gt;x&lt;/script&gt;", html)
+
     def test_xyz_products_against_the_locus(self):
         from matplotlib.path import Path as MplPath
         c = self.cmf_1nm.loc[380:700].to_numpy(float)
