@@ -1,7 +1,5 @@
 #include "colorlab/store/ship_log.hpp"
 
-#include "colorlab/store/store.hpp"
-
 namespace colorlab::store {
 
 namespace {
@@ -10,12 +8,27 @@ const std::string kIsEnd = std::string("topic = 'execution' AND json_extract(pay
                                        "json_extract(payload, '$.status') IN ") +
                            kEndedStatusesSql;
 
+// The count, the oldest run and the newest event from one snapshot.
+class ReadTx {
+ public:
+  explicit ReadTx(Database& db) : db_(db) { db_.exec("BEGIN DEFERRED"); }
+  ~ReadTx() {
+    try {
+      db_.exec("COMMIT");
+    } catch (...) {
+    }
+  }
+  ReadTx(const ReadTx&) = delete;
+  ReadTx& operator=(const ReadTx&) = delete;
+
+ private:
+  Database& db_;
+};
+
 }  // namespace
 
-ShipLog::ShipLog(Store& store) : store_(store), db_(store.db_) {}
-
 ShipBacklog ShipLog::backlog(std::int64_t position) {
-  Store::ReadSnapshot snapshot(store_);
+  ReadTx tx(db_);
   ShipBacklog b;
   {
     // seq is the key: only the log after the position is read, which is short while the agent keeps up.

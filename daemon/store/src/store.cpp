@@ -117,13 +117,13 @@ Store::Store(const fs::path& database_path) {
       .bind(1, std::string_view(now))
       .run();
   // Those just finalised, and any an older colorlabd finalised so: without an end event they would never ship.
-  end_events_recorded_at_open_ = record_missing_end_events(db_, now);
+  const int recorded = record_missing_end_events(db_, now);
   tx.commit();
   if (interrupted_at_open_ > 0) {
     log::warning("store", std::to_string(interrupted_at_open_) + " run(s) from a previous process marked interrupted");
   }
-  if (end_events_recorded_at_open_ > 0) {
-    log::info("store", std::to_string(end_events_recorded_at_open_) + " ended run(s) without an end event given one");
+  if (recorded > 0) {
+    log::info("store", std::to_string(recorded) + " ended run(s) without an end event given one, so that they ship");
   }
 }
 

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "colorlab/protocol/api.hpp"
 #include "colorlab/store/ship_log.hpp"
 #include "handlers.hpp"
 
@@ -64,7 +65,12 @@ HttpResponse get_shipping(ApiContext& ctx, const HttpRequest&, const PathParams&
   const fs::path dir = ctx.state_dir / "ship";
   const double now = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
   const std::int64_t position = shipped_position(dir / "shipped-position");
-  const auto backlog = store::ShipLog(ctx.reads()).backlog(position);
+  // A read-only connection of its own: the pool's connections belong to their threads' snapshots, and this one
+  // reads the log after the agent's position only.
+  store::Database db((ctx.state_dir / std::string(protocol::kDatabaseName)).string(), true);
+  db.exec("PRAGMA busy_timeout = 5000");
+  db.exec("PRAGMA query_only = ON");
+  const auto backlog = store::ShipLog(db).backlog(position);
 
   json lag{{"unshipped_runs", backlog.runs},
            {"oldest_unshipped_run", backlog.oldest_run_id.empty() ? json(nullptr) : json(backlog.oldest_run_id)},

@@ -9,8 +9,6 @@
 
 namespace colorlab::store {
 
-class Store;
-
 // The statuses that end a run; the same list the agent and blob retention use.
 inline constexpr const char* kEndedStatusesSql = "('finished_ok', 'finished_error', 'aborted', 'interrupted')";
 
@@ -23,15 +21,16 @@ struct ShipBacklog {
   std::int64_t last_event = 0;   // the newest event on the bench
 };
 
+// On a connection of its own (colorlabd's route opens one read-only per request, as the agent does), never inside a
+// transaction: it reads in one of its own.
 class ShipLog {
  public:
-  explicit ShipLog(Store& store);
+  explicit ShipLog(Database& db) : db_(db) {}
 
   // Runs ended after event `position` (colorlab-ship's shipped-position note), in one snapshot.
   ShipBacklog backlog(std::int64_t position);
 
  private:
-  Store& store_;
   Database& db_;
 };
 

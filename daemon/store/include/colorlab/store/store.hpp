@@ -245,21 +245,17 @@ class Store {
   // Events with seq > after, oldest first (a client resumes from the last seq it saw).
   std::vector<EventRecord> events(std::int64_t after, unsigned limit, const std::optional<std::string>& topic);
   int interrupted_at_open() const { return interrupted_at_open_; }
-  // Ended runs that had no end event when the store opened, given one then (ship_log.hpp).
-  int end_events_recorded_at_open() const { return end_events_recorded_at_open_; }
 
  private:
   // The queue's rows live in their own file and share this connection (one writer, one thread).
   friend class QueueStore;
   friend class BlobIndex;  // blob_index.hpp: the blob store's rows
   friend class ApiKeyStore;  // api_keys.hpp: keys on the same writer connection
-  friend class ShipLog;      // ship_log.hpp: the event log as colorlab-ship reads it
   RunRecord read_run(Statement& st);
   ExecutionRecord read_execution(Statement& st);
 
   Database db_;
   int interrupted_at_open_ = 0;
-  int end_events_recorded_at_open_ = 0;
 };
 
 }  // namespace colorlab::store
