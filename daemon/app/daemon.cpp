@@ -221,8 +221,6 @@ Daemon::Daemon(DaemonConfig config) : impl_(std::make_unique<Impl>()) {
   d.api->control = d.access.lock.get();
   d.api->blobs = d.blobs.get();
   d.api->console_dir = shipped_console_dir();
-  d.api->state_dir = d.config.state_dir;
-  d.api->shipping = d.config.blobs.keep_unshipped;
   ReportService::Options report_options;
   report_options.directory = d.config.state_dir / "reports";
   report_options.unix_socket = d.config.socket_path();

@@ -10,6 +10,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "colorlab/core/error.hpp"
+#include "colorlab/daemon/blob_service.hpp"
 #include "colorlab/protocol/api.hpp"
 #include "colorlab/store/ship_log.hpp"
 #include "handlers.hpp"
@@ -62,12 +64,15 @@ json agent_status(const fs::path& file) {
 }  // namespace
 
 HttpResponse get_shipping(ApiContext& ctx, const HttpRequest&, const PathParams&) {
-  const fs::path dir = ctx.state_dir / "ship";
+  if (!ctx.blobs) throw Error(ErrorClass::internal, "GET /v1/shipping without the blob service");
+  // The blob store lives in <state_dir>/blobs, beside the agent's notes (retention reads them the same way).
+  const fs::path state_dir = ctx.blobs->files().root().parent_path();
+  const fs::path dir = state_dir / "ship";
   const double now = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
   const std::int64_t position = shipped_position(dir / "shipped-position");
   // A read-only connection of its own: the pool's connections belong to their threads' snapshots, and this one
   // reads the log after the agent's position only.
-  store::Database db((ctx.state_dir / std::string(protocol::kDatabaseName)).string(), true);
+  store::Database db((state_dir / std::string(protocol::kDatabaseName)).string(), true);
   db.exec("PRAGMA busy_timeout = 5000");
   db.exec("PRAGMA query_only = ON");
   const auto backlog = store::ShipLog(db).backlog(position);
@@ -79,7 +84,7 @@ HttpResponse get_shipping(ApiContext& ctx, const HttpRequest&, const PathParams&
            // How long the oldest unshipped run has waited since it ended; 0 when nothing waits.
            {"age_s", backlog.runs == 0 ? json(0) : seconds_since(backlog.oldest_ended_at, now)}};
   json agent = agent_status(dir / "status.json");
-  json out{{"enabled", ctx.shipping},
+  json out{{"enabled", ctx.blobs->config().keep_unshipped},
            {"shipped_position", position},
            {"last_event", backlog.last_event},
            {"lag", lag},

@@ -41,8 +41,6 @@ struct ApiContext {
   ControlLock* control = nullptr;  // /v1/control (control_routes.cpp)
   std::filesystem::path console_dir;  // the web console's static files, served at / (console_files.cpp)
   ReportService* reports = nullptr;   // GET /v1/runs/{id}/report (report_response.hpp)
-  std::filesystem::path state_dir;    // GET /v1/shipping reads colorlab-ship's notes under state_dir/ship
-  bool shipping = false;              // the TOML has a [ship] section
 };
 
 }  // namespace colorlab::daemon
