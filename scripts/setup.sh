@@ -46,6 +46,8 @@ packages=(
   blender python3-openimageio
   # renderings verified against the lab (verify/io, issue 23): OpenEXR 3.1, and OpenImageIO as the independent reader
   libopenexr-dev libimath-dev openimageio-tools python3-openimageio
+  # colorlab-ship's fault tests (tests/fleet/ship_faults_test.cpp): the network cut by killing a socat TCP proxy
+  socat
 )
 
 missing=()

@@ -1,5 +1,6 @@
 #include "commands.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <chrono>
 #include <set>
@@ -105,7 +106,12 @@ int run_campaign(const GlobalOptions& g, const RunOptions& o) {
 void add_daemon_commands(CLI::App& app, GlobalOptions& global) {
   auto* status = app.add_subcommand("status", "Show the daemon's version, API version and state");
   status->callback([&global] {
-    print(global, make_client(global).get("/v1"), format_status);
+    auto client = make_client(global);
+    json root = client.get("/v1");
+    // A daemon that knows shipping says so (central and older daemons do not): one more local read, no network.
+    const json features = root.value("features", json::array());
+    if (std::find(features.begin(), features.end(), "shipping") != features.end()) root["shipping"] = client.get("/v1/shipping");
+    print(global, root, format_status);
   });
 
   auto* instruments = app.add_subcommand("instruments", "List instruments, their state and whether they are simulated");

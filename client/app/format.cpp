@@ -33,11 +33,44 @@ std::string duration(double s) {
 
 }  // namespace
 
+// GET /v1/shipping (docs/fleet.md, "Lag"): what waits to ship and what the agent last said.
+std::string format_shipping(const json& s) {
+  std::ostringstream o;
+  if (!s.value("enabled", false) && s["agent"].is_null()) return "  shipping: off (no [ship] section)\n";
+  const json& lag = s["lag"];
+  const auto waiting = lag.value("unshipped_runs", 0LL);
+  if (waiting == 0) {
+    o << "  shipping: every ended run has shipped (position " << str(s, "shipped_position") << ")\n";
+  } else {
+    o << "  shipping: " << waiting << " ended run(s) not shipped; the oldest " << str(lag, "oldest_unshipped_run") << " ("
+      << str(lag, "oldest_unshipped_status") << ") ended " << str(lag, "oldest_unshipped_ended_at");
+    if (lag["age_s"].is_number()) o << ", " << duration(lag["age_s"].get<double>()) << " ago";
+    o << "\n";
+  }
+  const json& agent = s["agent"];
+  if (!agent.is_object()) {
+    o << "  agent: no cycle recorded yet (is colorlab-ship running?)\n";
+  } else {
+    o << "  agent: last cycle " << (agent.value("ok", false) ? "ok" : "FAILED");
+    if (s["agent_seen_s_ago"].is_number()) o << ", " << duration(s["agent_seen_s_ago"].get<double>()) << " ago";
+    o << "\n";
+  }
+  const json& e = s["last_error"];
+  if (e.is_object()) {
+    o << "  last error (" << str(e, "at") << "): " << str(e, "message") << "\n";
+    if (e.contains("hint") && e["hint"].is_string() && !e["hint"].get<std::string>().empty()) {
+      o << "    hint: " << e["hint"].get<std::string>() << "\n";
+    }
+  }
+  return o.str();
+}
+
 std::string format_status(const json& root) {
   std::ostringstream o;
   o << "colorlabd " << str(root, "server_version") << " (API v" << str(root, "api_version") << ")";
   if (root.value("simulated_lab", false)) o << " — SIMULATED LAB";
   o << "\n  up since " << str(root, "started_at") << ", running executions: " << str(root, "running_executions") << "\n";
+  if (root.contains("shipping") && root["shipping"].is_object()) o << format_shipping(root["shipping"]);
   return o.str();
 }
 

@@ -6,7 +6,9 @@
 
 namespace colorlab::cli {
 
+// GET /v1, with GET /v1/shipping under "shipping" when the daemon has that route.
 std::string format_status(const nlohmann::json& root);
+std::string format_shipping(const nlohmann::json& shipping);
 std::string format_instruments(const nlohmann::json& list);
 std::string format_campaigns(const nlohmann::json& list);
 std::string format_runs(const nlohmann::json& page);

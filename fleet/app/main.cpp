@@ -11,6 +11,7 @@
 #include "colorlab/core/error.hpp"
 #include "colorlab/core/log.hpp"
 #include "colorlab/fleet/config.hpp"
+#include "colorlab/fleet/ship_status.hpp"
 #include "colorlab/fleet/shipper.hpp"
 
 namespace {
@@ -27,6 +28,21 @@ nlohmann::json to_json(const colorlab::fleet::CycleReport& r) {
           {"runs_shipped", r.runs_shipped},       {"measurements", r.measurements},
           {"events", r.events},                   {"blobs_uploaded", r.blobs_uploaded},
           {"divergences", d}};
+}
+
+// One cycle, its outcome noted in <state_dir>/ship/status.json for the bench to show (GET /v1/shipping).
+colorlab::fleet::CycleReport noted_cycle(const colorlab::fleet::ShipConfig& config) {
+  try {
+    auto r = colorlab::fleet::ship_cycle(config);
+    colorlab::fleet::note_cycle_ok(config, r);
+    return r;
+  } catch (const colorlab::Error& e) {
+    colorlab::fleet::note_cycle_failed(config, e.what(), e.hint());
+    throw;
+  } catch (const std::exception& e) {
+    colorlab::fleet::note_cycle_failed(config, e.what(), "");
+    throw;
+  }
 }
 
 void report_error(const colorlab::Error& e) {
@@ -55,7 +71,7 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (once->parsed()) {
-      auto r = colorlab::fleet::ship_cycle(config);
+      auto r = noted_cycle(config);
       std::cout << to_json(r).dump() << std::endl;
       return r.divergences.empty() ? 0 : 3;
     }
@@ -71,11 +87,13 @@ int main(int argc, char** argv) {
       std::signal(SIGINT, on_signal);
       while (!g_stop) {
         try {
-          auto r = colorlab::fleet::ship_cycle(config);
+          auto r = noted_cycle(config);
           if (r.runs_shipped > 0 || !r.divergences.empty()) colorlab::log::info("ship", to_json(r).dump());
         } catch (const colorlab::Error& e) {
           // The network or central being away is the normal case for a bench: log and try again next cycle.
           colorlab::log::warning("ship", std::string(e.what()) + (e.hint().empty() ? "" : " (" + e.hint() + ")"));
+        } catch (const std::exception& e) {
+          colorlab::log::warning("ship", e.what());
         }
         for (double waited = 0; waited < config.interval_s && !g_stop; waited += 0.1) {
           std::this_thread::sleep_for(std::chrono::milliseconds(100));

@@ -73,6 +73,10 @@ ShipConfig load_ship_config(const fs::path& file) {
       auto v = node.value<double>();
       if (!v || !(*v >= 0.1 && *v <= 86400)) bad(file, node.source(), "ship.interval_s must be from 0.1 to 86400");
       c.interval_s = *v;
+    } else if (k == "stall_timeout_s") {
+      auto v = node.value<std::int64_t>();
+      if (!v || *v < 1 || *v > 3600) bad(file, node.source(), "ship.stall_timeout_s must be an integer from 1 to 3600");
+      c.stall_timeout_s = static_cast<int>(*v);
     } else {
       bad(file, node.source(), "unknown key 'ship." + k + "'");
     }

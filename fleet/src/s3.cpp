@@ -67,9 +67,9 @@ S3Client::Reply S3Client::request(const std::string& method, const std::string& 
   curl_easy_setopt(c, CURLOPT_PASSWORD, credentials_.secret_key.c_str());
   curl_easy_setopt(c, CURLOPT_NOSIGNAL, 1L);
   curl_easy_setopt(c, CURLOPT_CONNECTTIMEOUT, 10L);
-  // A stalled store must not hang a cycle: below 1 KiB/s for 30 s ends the request.
+  // A stalled store must not hang a cycle: below 1 KiB/s for stall_timeout_s_ ends the request.
   curl_easy_setopt(c, CURLOPT_LOW_SPEED_LIMIT, 1024L);
-  curl_easy_setopt(c, CURLOPT_LOW_SPEED_TIME, 30L);
+  curl_easy_setopt(c, CURLOPT_LOW_SPEED_TIME, stall_timeout_s_);
   curl_easy_setopt(c, CURLOPT_WRITEFUNCTION, collect);
   curl_easy_setopt(c, CURLOPT_WRITEDATA, &reply.body);
   curl_slist* headers = nullptr;
@@ -98,6 +98,12 @@ S3Client::Reply S3Client::request(const std::string& method, const std::string& 
   curl_easy_setopt(c, CURLOPT_HTTPHEADER, headers);
   CURLcode rc = curl_easy_perform(c);
   curl_slist_free_all(headers);
+  if (rc == CURLE_OPERATION_TIMEDOUT) {
+    throw Error(ErrorClass::no_comms,
+                "S3 store " + endpoint_ + ": " + method + " " + key + " stalled (under 1 KiB/s for " +
+                    std::to_string(stall_timeout_s_) + " s)",
+                "the store or the link to it is stalling; the next cycle retries ([ship] stall_timeout_s)");
+  }
   if (rc != CURLE_OK) {
     throw Error(ErrorClass::no_comms, "S3 store " + endpoint_ + ": " + method + " " + key + ": " + curl_easy_strerror(rc),
                 "check [ship] s3_endpoint and that the store runs; the next cycle retries");

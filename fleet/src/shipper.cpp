@@ -56,7 +56,9 @@ const std::string& batch_part(const RunBatch& b, int i) {
 S3Client make_s3(const ShipConfig& c) {
   S3Credentials k{read_secret_file(c.access_key_file, "S3 access key"),
                   read_secret_file(c.secret_key_file, "S3 secret key")};
-  return S3Client(c.s3_endpoint, c.bucket, c.region, std::move(k));
+  S3Client s3(c.s3_endpoint, c.bucket, c.region, std::move(k));
+  s3.set_stall_timeout(c.stall_timeout_s);
+  return s3;
 }
 
 void check_bench_schema(BenchReader& bench) {

@@ -64,6 +64,8 @@ constexpr Route kRoutes[] = {
     {"GET",    "/v1/blobs/check",                      read,    pool,    r::get_blob_check},
     // Retention deletes kept frames' files: not something a campaign operator's key should do.
     {"POST",   "/v1/blobs/retention",                  admin,   main,    r::post_blob_retention},
+    // The bench's own files only (the event log, the agent's notes): never the network.
+    {"GET",    "/v1/shipping",                         read,    pool,    r::get_shipping},
 };
 
 }  // namespace

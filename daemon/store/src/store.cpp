@@ -9,6 +9,7 @@
 #include "colorlab/core/log.hpp"
 #include "colorlab/store/blob_index.hpp"
 #include "colorlab/store/schema.hpp"
+#include "colorlab/store/ship_log.hpp"
 #include "colorlab/store/wal_policy.hpp"
 
 namespace colorlab::store {
@@ -115,9 +116,14 @@ Store::Store(const fs::path& database_path) {
          "script_sha256 IS NULL")
       .bind(1, std::string_view(now))
       .run();
+  // Those just finalised, and any an older colorlabd finalised so: without an end event they would never ship.
+  const int recorded = record_missing_end_events(db_, now);
   tx.commit();
   if (interrupted_at_open_ > 0) {
     log::warning("store", std::to_string(interrupted_at_open_) + " run(s) from a previous process marked interrupted");
+  }
+  if (recorded > 0) {
+    log::info("store", std::to_string(recorded) + " ended run(s) without an end event given one, so that they ship");
   }
 }
 

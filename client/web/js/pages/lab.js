@@ -1,7 +1,8 @@
 // Lab: every instrument as the daemon sees it. Instrument state changes are not events (only added and
-// removed are), so the page re-reads GET /v1/instruments while it is shown.
+// removed are), so the page re-reads GET /v1/instruments while it is shown; with shipping on, also what
+// colorlab-ship has not shipped yet and its last error (GET /v1/shipping, read from the bench's own files).
 import { get } from "../api.js";
-import { h, replace, badge, errorBox } from "../dom.js";
+import { h, replace, badge, errorBox, fmtDuration, fmtTime, short } from "../dom.js";
 
 const POLL_MS = 5000;
 
@@ -46,13 +47,46 @@ function lampState(i) {
     lab.dimmer !== undefined ? ` · dimmer ${lab.dimmer} %` : "");
 }
 
+// GET /v1/shipping as one card; nothing when the bench does not ship (no [ship] section, no agent seen).
+function shippingCard(s) {
+  if (!s || (!s.enabled && !s.agent)) return null;
+  const lag = s.lag || {};
+  const waiting = lag.unshipped_runs || 0;
+  const agent = s.agent;
+  const err = s.last_error;
+  return h("article", { class: "card shipping", id: "shipping" },
+    h("header", {}, h("h3", {}, "Shipping"),
+      badge(waiting === 0 ? "shipped" : "waiting"),
+      agent ? badge(agent.ok ? "agent_ok" : "agent_failing") : badge("no_agent")),
+    h("dl", {},
+      h("dt", {}, "not shipped"), h("dd", { id: "shipping-lag" }, waiting === 0 ? "every ended run has shipped"
+        : `${waiting} ended run(s); the oldest ${short(lag.oldest_unshipped_run)} (${lag.oldest_unshipped_status}) waits ${fmtDuration(lag.age_s)}`),
+      h("dt", {}, "position"), h("dd", { class: "mono" }, `${s.shipped_position} of ${s.last_event}`),
+      h("dt", {}, "agent"), h("dd", {}, agent ? `last cycle ${agent.ok ? "ok" : "failed"}, ${fmtDuration(s.agent_seen_s_ago)} ago`
+        : "no cycle recorded yet (is colorlab-ship running?)")),
+    err ? h("p", { class: "error", id: "shipping-error" }, `last error (${fmtTime(err.at)}): ${err.message}`,
+      err.hint ? h("span", { class: "hint" }, ` — ${err.hint}`) : null) : null);
+}
+
 export function mount(section, ctx) {
   const list = h("div", { class: "cards", id: "instruments" });
   const status = h("p", { class: "muted", "aria-live": "polite" });
-  section.append(h("h2", {}, "Lab"), status, list);
+  const shipping = h("div", { class: "cards", id: "shipping-box" });
+  section.append(h("h2", {}, "Lab"), status, shipping, list);
   let timer = null;
 
+  async function refreshShipping() {
+    try {
+      replace(shipping, shippingCard(await get("/v1/shipping")));
+    } catch (e) {
+      // An older daemon without the route: nothing to show.
+      if (e && e.status === 404) replace(shipping);
+      else replace(shipping, errorBox(e));
+    }
+  }
+
   async function refresh() {
+    refreshShipping();
     try {
       const r = await get("/v1/instruments");
       for (const i of r.items) ctx.store.instruments.set(i.id, i);

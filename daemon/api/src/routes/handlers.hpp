@@ -17,6 +17,9 @@ HttpResponse get_instruments(ApiContext& ctx, const HttpRequest& req, const Path
 HttpResponse get_ports(ApiContext& ctx, const HttpRequest& req, const PathParams& params);
 HttpResponse get_campaigns(ApiContext& ctx, const HttpRequest& req, const PathParams& params);
 
+// ship_routes.cpp: colorlab-ship's lag and last error, read from the bench's own files.
+HttpResponse get_shipping(ApiContext& ctx, const HttpRequest& req, const PathParams& params);
+
 // event_routes.cpp: the event log, paged and live.
 HttpResponse get_events(ApiContext& ctx, const HttpRequest& req, const PathParams& params);
 HttpResponse get_event_stream(ApiContext& ctx, const HttpRequest& req, const PathParams& params);

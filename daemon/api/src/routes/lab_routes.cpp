@@ -31,7 +31,7 @@ HttpResponse get_root(ApiContext& ctx, const HttpRequest&, const PathParams&) {
   json features = json::array({"instruments", "ports", "events", "campaigns", "lua-campaigns", "executions",
                                "execution-control", "resume-after-restart", "runs", "run-script", "problem+json",
                                "cursor-paging", "idempotency-key", "operator-requests", "queue", "measurement-pages",
-                               "event-stream", "blobs", "locate-chart", "exports", "api-keys", "control-lock", "tls"});
+                               "event-stream", "blobs", "locate-chart", "exports", "api-keys", "control-lock", "tls", "shipping"});
   return HttpResponse::json(200, {{"server", "colorlabd"},
                                   {"server_version", COLORLAB_VERSION},
                                   {"api_version", protocol::kApiVersion},

@@ -19,6 +19,7 @@ struct ShipConfig {
   std::filesystem::path secret_key_file;
   int batch_runs = 50;       // runs shipped per cycle, each in its own PostgreSQL transaction
   double interval_s = 30;    // between cycles when running as a service
+  int stall_timeout_s = 30;  // an S3 request under 1 KiB/s for this long ends the cycle (retried next cycle)
 
   std::filesystem::path database_path() const { return state_dir / "colorlab.db"; }
   std::filesystem::path blob_root() const { return state_dir / "blobs"; }

@@ -29,6 +29,9 @@ class S3Client {
   // streams on. Error{not_found} when the object is missing, otherwise as exists().
   std::string get_part(const std::string& key, std::optional<std::pair<std::uint64_t, std::uint64_t>> range);
   void create_bucket();
+  // A request that moves under 1 KiB/s for this long ends as Error{no_comms} (a stalled store must not hang a
+  // cycle). Default 30 s; [ship] stall_timeout_s.
+  void set_stall_timeout(long seconds) { stall_timeout_s_ = seconds; }
 
  private:
   struct Reply {
@@ -40,6 +43,7 @@ class S3Client {
   [[noreturn]] void refuse(const std::string& what, const Reply& r) const;
   std::string endpoint_, bucket_, region_;
   S3Credentials credentials_;
+  long stall_timeout_s_ = 30;
 };
 
 // SHA-256 of bytes, lower-case hex.
