@@ -29,6 +29,8 @@ class S3Client {
   // streams on. Error{not_found} when the object is missing, otherwise as exists().
   std::string get_part(const std::string& key, std::optional<std::pair<std::uint64_t, std::uint64_t>> range);
   void create_bucket();
+  // Deletes an object (backup rotation); a missing one is no error (S3 answers 204 either way).
+  void remove(const std::string& key);
 
  private:
   struct Reply {
