@@ -119,9 +119,15 @@ bool superseded_by_restore(Pg& pg, const RunBatch& b) {
 
 // The replayed run's events still ship (the bench's event history stays whole) and the position passes it; its
 // rows do not, and ship_problems says so.
-void commit_superseded(Pg& pg, const ShipConfig& c, const RunBatch& b, const Divergence& d) {
+// False when another agent for this bench moved the position meanwhile (as commit_run's `raced`).
+bool commit_superseded(Pg& pg, const ShipConfig& c, const RunBatch& b, std::int64_t position, const Divergence& d) {
   pg.exec("BEGIN");
   try {
+    auto held = pg.query("SELECT shipped_position FROM benches WHERE id = $1 FOR UPDATE", {c.bench_id});
+    if (held.int64(0, 0) != position) {
+      rollback(pg);
+      return false;
+    }
     if (!b.events.empty()) {
       pg.copy_in(std::string("stage_events (") + kStaged[5].columns + ")", b.events);
       pg.exec(std::string("INSERT INTO events (") + kStaged[5].columns + ") SELECT " + kStaged[5].columns +
@@ -138,6 +144,7 @@ void commit_superseded(Pg& pg, const ShipConfig& c, const RunBatch& b, const Div
     rollback(pg);
     throw;
   }
+  return true;
 }
 
 // The run's rows and the bench's new position in one transaction; the digest is compared before COMMIT so a
@@ -165,8 +172,7 @@ Outcome commit_run(Pg& pg, const ShipConfig& c, const RunBatch& b, std::int64_t 
       const bool superseded = superseded_by_restore(pg, b);
       rollback(pg);
       if (!superseded) return Outcome::diverged;
-      commit_superseded(pg, c, b, divergence);
-      return Outcome::superseded;
+      return commit_superseded(pg, c, b, position, divergence) ? Outcome::superseded : Outcome::raced;
     }
     pg.query("UPDATE benches SET shipped_position = $2, last_seen = now(), last_error = NULL WHERE id = $1",
              {c.bench_id, std::to_string(b.run.ended_event)});

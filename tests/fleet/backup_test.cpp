@@ -24,6 +24,7 @@
 #include "colorlab/store/blob_store.hpp"
 #include "colorlab/store/sqlite.hpp"
 #include "colorlab/testing/process.hpp"
+#include "colorlab/testing/temp_dir.hpp"
 #include "fleet_servers.hpp"
 #include "resume_support.hpp"
 #include "sim_bench.hpp"
@@ -65,11 +66,6 @@ Servers& servers() {
               << s.swift->start_seconds << " s\n";
   }
   return s;
-}
-
-std::string sql_text(store::Database& db, const std::string& sql) {
-  auto st = db.prepare(sql);
-  return st.step() && !st.is_null(0) ? st.text(0) : std::string();
 }
 
 std::int64_t sql_int(store::Database& db, const std::string& sql) {
@@ -174,8 +170,10 @@ TEST_F(Backup, SnapshotUnderLoadRestoresIntoADaemonServingTheSameRuns) {
   EXPECT_EQ(fleet::sha256_hex(s3.get(prefix + "colorlab.db")), manifest["database"]["sha256"]);
   EXPECT_EQ(manifest["last_event"], report["last_event"]);
 
-  // Restored through `colorlab restore`: a new state directory, the database whole, every blob in place.
-  const fs::path restored = dir_ / "restored";
+  // Restored through `colorlab restore`: a new state directory, the database whole, every blob in place. A short
+  // path: colorlabd's Unix socket lives in it, and a socket's path has at most 107 bytes.
+  ct::TempDir short_dir;
+  const fs::path restored = short_dir / "restored";
   r = colorlab({"restore", "--config", config.string(), "--into", restored.string()});
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
   const json rr = json::parse(r.out);
@@ -220,7 +218,13 @@ TEST_F(Backup, SnapshotUnderLoadRestoresIntoADaemonServingTheSameRuns) {
   // A fresh colorlabd on the restored state directory serves those runs.
   {
     auto daemon_config = ct::write_daemon_config(dir_, 500, 3);
-    ct::DaemonProcess daemon(restored, daemon_config, dir_ / "restored-colorlabd.log");
+    std::unique_ptr<ct::DaemonProcess> started;
+    try {
+      started = std::make_unique<ct::DaemonProcess>(restored, daemon_config, dir_ / "restored-colorlabd.log");
+    } catch (const std::exception& e) {
+      FAIL() << e.what() << "\n" << ct::shell_output("tail -30 " + (dir_ / "restored-colorlabd.log").string());
+    }
+    auto& daemon = *started;
     auto api = ct::api_for(daemon);
     std::map<std::string, std::string> served;
     std::string cursor;
@@ -234,7 +238,9 @@ TEST_F(Backup, SnapshotUnderLoadRestoresIntoADaemonServingTheSameRuns) {
     for (const auto& [id, status] : restored_status) {
       ASSERT_TRUE(served.count(id)) << "run " << id << " not served";
       // The run the writer had under way was left unfinished without a script: colorlabd marks it interrupted.
-      if (status == "finished_ok") EXPECT_EQ(served[id], status) << id;
+      if (status == "finished_ok") {
+        EXPECT_EQ(served[id], status) << id;
+      }
       const json m = api.get("/v1/runs/" + id + "/measurements?limit=100");
       EXPECT_EQ(static_cast<std::int64_t>(m["items"].size()), store::Store(restored / "colorlab.db", store::Store::ReadOnly{})
                                                                    .measurement_count(id)) << id;
@@ -309,8 +315,11 @@ TEST_F(Backup, RestoredBenchShipsAgainInANewEpochWithNoStuckMismatch) {
   std::int64_t expect0 = 1, expect1 = (std::int64_t{1} << fleet::kEpochShift) + 1;
   for (int i = 0; i < ev.rows(); ++i) {
     const std::int64_t s = ev.int64(i, 0);
-    if (fleet::epoch_of(s) == 0) ASSERT_EQ(s, expect0++);
-    else ASSERT_EQ(s, expect1++);
+    if (fleet::epoch_of(s) == 0) {
+      ASSERT_EQ(s, expect0++);
+    } else {
+      ASSERT_EQ(s, expect1++);
+    }
   }
   EXPECT_EQ(expect0 - 1, held);
   EXPECT_EQ(expect1 - 1, now_held);
