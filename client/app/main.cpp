@@ -16,6 +16,7 @@
 #include "doctor_command.hpp"
 #include "scene_command.hpp"
 #include "verify_command.hpp"
+#include "backup_commands.hpp"
 #ifdef COLORLAB_HAVE_ANALYZE
 #include "colorlab/cli/analyze_command.hpp"
 #endif
@@ -42,6 +43,7 @@ int main(int argc, char** argv) {
   colorlab::cli::add_doctor_command(app, global);
   colorlab::cli::add_scene_command(app, global);
   colorlab::cli::add_verify_command(app, global);
+  colorlab::cli::add_backup_commands(app);
 #ifdef COLORLAB_HAVE_ANALYZE
   colorlab::cli::add_analyze_command(app);
 #endif

@@ -10,6 +10,7 @@
 
 #include "colorlab/core/error.hpp"
 #include "colorlab/core/log.hpp"
+#include "colorlab/fleet/backup.hpp"
 #include "colorlab/fleet/config.hpp"
 #include "colorlab/fleet/ship_status.hpp"
 #include "colorlab/fleet/shipper.hpp"
@@ -24,10 +25,14 @@ nlohmann::json to_json(const colorlab::fleet::CycleReport& r) {
   for (const auto& x : r.divergences) {
     d.push_back({{"run_id", x.run_id}, {"bench_digest", x.bench_digest}, {"central_digest", x.central_digest}});
   }
+  nlohmann::json s = nlohmann::json::array();
+  for (const auto& x : r.superseded) {
+    s.push_back({{"run_id", x.run_id}, {"bench_digest", x.bench_digest}, {"central_digest", x.central_digest}});
+  }
   return {{"position_before", r.position_before}, {"position_after", r.position_after},
           {"runs_shipped", r.runs_shipped},       {"measurements", r.measurements},
           {"events", r.events},                   {"blobs_uploaded", r.blobs_uploaded},
-          {"divergences", d}};
+          {"divergences", d},                     {"superseded", s}};
 }
 
 // One cycle, its outcome noted in <state_dir>/ship/status.json for the bench to show (GET /v1/shipping).
@@ -61,6 +66,11 @@ int main(int argc, char** argv) {
   auto* once = app.add_subcommand("once", "ship what has ended, print a JSON report, exit");
   auto* run = app.add_subcommand("run", "ship every interval_s until SIGTERM (the systemd service)");
   auto* verify = app.add_subcommand("verify", "compare every shipped run's digest on the bench and central");
+  auto* backup = app.add_subcommand("backup", "snapshot this bench's store into the bucket, then rotate (docs/fleet.md)");
+  auto* restore = app.add_subcommand("restore", "rebuild a state directory from a snapshot in the bucket");
+  std::string snapshot, into;
+  restore->add_option("--snapshot", snapshot, "the snapshot's name (default: the newest)");
+  restore->add_option("--into", into, "the state directory to rebuild (default: state_dir; must hold no database)");
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -68,6 +78,25 @@ int main(int argc, char** argv) {
     if (init->parsed()) {
       colorlab::fleet::central_init(config);
       std::cout << "central schema is current\n";
+      return 0;
+    }
+    if (backup->parsed()) {
+      auto r = colorlab::fleet::backup(config);
+      std::cout << nlohmann::json{{"name", r.name}, {"database_key", r.database_key},
+                                  {"database_bytes", r.database_bytes}, {"last_event", r.last_event},
+                                  {"runs", r.runs}, {"blobs", r.blobs}, {"blobs_uploaded", r.blobs_uploaded},
+                                  {"blobs_missing", r.blobs_missing}, {"rotated_out", r.rotated_out}}
+                       .dump()
+                << std::endl;
+      return 0;
+    }
+    if (restore->parsed()) {
+      auto r = colorlab::fleet::restore(config, snapshot, into.empty() ? config.state_dir : std::filesystem::path(into));
+      std::cout << nlohmann::json{{"name", r.name}, {"state_dir", r.state_dir.string()}, {"epoch", r.epoch},
+                                  {"next_event", r.next_event}, {"last_event", r.last_event}, {"runs", r.runs},
+                                  {"blobs_restored", r.blobs_restored}, {"blobs_missing", r.blobs_missing}}
+                       .dump()
+                << std::endl;
       return 0;
     }
     if (once->parsed()) {

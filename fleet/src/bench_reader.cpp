@@ -73,6 +73,14 @@ int BenchReader::schema_version() {
   return st.step() ? static_cast<int>(st.int64(0)) : 0;
 }
 
+std::int64_t BenchReader::last_event() {
+  // sqlite_sequence too: a bench restored a moment ago has its new epoch there before its first event.
+  auto st = db_.prepare(
+      "SELECT max(coalesce((SELECT max(seq) FROM event_log), 0), "
+      "coalesce((SELECT seq FROM sqlite_sequence WHERE name = 'event_log'), 0))");
+  return st.step() ? st.int64(0) : 0;
+}
+
 std::vector<EndedRun> BenchReader::ended_after(std::int64_t position, int limit) {
   auto st = db_.prepare(kEnded);
   st.bind(1, position).bind(2, static_cast<std::int64_t>(limit));

@@ -69,6 +69,10 @@ ShipConfig load_ship_config(const fs::path& file) {
       auto v = node.value<std::int64_t>();
       if (!v || *v < 1 || *v > 100000) bad(file, node.source(), "ship.batch_runs must be an integer from 1 to 100000");
       c.batch_runs = static_cast<int>(*v);
+    } else if (k == "backup_keep_daily" || k == "backup_keep_weekly") {
+      auto v = node.value<std::int64_t>();
+      if (!v || *v < 0 || *v > 3660) bad(file, node.source(), "ship." + k + " must be an integer from 0 to 3660");
+      (k == "backup_keep_daily" ? c.backup_keep_daily : c.backup_keep_weekly) = static_cast<int>(*v);
     } else if (k == "interval_s") {
       auto v = node.value<double>();
       if (!v || !(*v >= 0.1 && *v <= 86400)) bad(file, node.source(), "ship.interval_s must be from 0.1 to 86400");

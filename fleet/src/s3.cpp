@@ -79,6 +79,8 @@ S3Client::Reply S3Client::request(const std::string& method, const std::string& 
   std::unique_ptr<FILE, decltype(&std::fclose)> file(nullptr, std::fclose);
   if (method == "HEAD") {
     curl_easy_setopt(c, CURLOPT_NOBODY, 1L);
+  } else if (method == "DELETE") {
+    curl_easy_setopt(c, CURLOPT_CUSTOMREQUEST, "DELETE");
   } else if (method == "PUT") {
     curl_easy_setopt(c, CURLOPT_UPLOAD, 1L);
     if (upload) {
@@ -160,6 +162,11 @@ std::string S3Client::get_part(const std::string& key, std::optional<std::pair<s
   }
   if (r.status != (range ? 206 : 200)) refuse("GET " + key, r);
   return std::move(r.body);
+}
+
+void S3Client::remove(const std::string& key) {
+  Reply r = request("DELETE", key, nullptr, kEmptySha256);
+  if (r.status != 204 && r.status != 200 && r.status != 404) refuse("DELETE " + key, r);
 }
 
 void S3Client::create_bucket() {

@@ -4,6 +4,7 @@
 
 #include "colorlab/core/error.hpp"
 #include "colorlab/core/log.hpp"
+#include "colorlab/fleet/backup.hpp"
 #include "colorlab/fleet/bench_reader.hpp"
 #include "colorlab/fleet/central_schema.hpp"
 #include "colorlab/fleet/digest.hpp"
@@ -108,7 +109,45 @@ void rollback(Pg& pg) {
   }
 }
 
-enum class Outcome { committed, raced, diverged };
+enum class Outcome { committed, raced, diverged, superseded };
+
+// A bench restored from a snapshot replays what it held then: a run it had not finished may have ended on the
+// dead bench after the snapshot and shipped from there, and the restored bench ends it differently (interrupted).
+// Central got that run in an earlier epoch of this bench (backup.hpp), so central's copy is the later word.
+bool superseded_by_restore(Pg& pg, const RunBatch& b) {
+  auto r = pg.query("SELECT ended_event FROM runs WHERE id = $1", {b.run.run_id});
+  return r.rows() == 1 && epoch_of(r.int64(0, 0)) < epoch_of(b.run.ended_event);
+}
+
+// The replayed run's events still ship (the bench's event history stays whole) and the position passes it; its
+// rows do not, and ship_problems says so.
+// False when another agent for this bench moved the position meanwhile (as commit_run's `raced`).
+bool commit_superseded(Pg& pg, const ShipConfig& c, const RunBatch& b, std::int64_t position, const Divergence& d) {
+  pg.exec("BEGIN");
+  try {
+    auto held = pg.query("SELECT shipped_position FROM benches WHERE id = $1 FOR UPDATE", {c.bench_id});
+    if (held.int64(0, 0) != position) {
+      rollback(pg);
+      return false;
+    }
+    if (!b.events.empty()) {
+      pg.copy_in(std::string("stage_events (") + kStaged[5].columns + ")", b.events);
+      pg.exec(std::string("INSERT INTO events (") + kStaged[5].columns + ") SELECT " + kStaged[5].columns +
+              " FROM stage_events ON CONFLICT (" + kStaged[5].key + ") DO NOTHING");
+    }
+    nlohmann::json detail{{"bench_digest", d.bench_digest}, {"central_digest", d.central_digest},
+                          {"bench_ended_event", b.run.ended_event}};
+    pg.query("INSERT INTO ship_problems (bench_id, run_id, kind, detail) VALUES ($1, $2, 'superseded_by_restore', $3)",
+             {c.bench_id, d.run_id, detail.dump()});
+    pg.query("UPDATE benches SET shipped_position = $2, last_seen = now() WHERE id = $1",
+             {c.bench_id, std::to_string(b.run.ended_event)});
+    pg.exec("COMMIT");
+  } catch (...) {
+    rollback(pg);
+    throw;
+  }
+  return true;
+}
 
 // The run's rows and the bench's new position in one transaction; the digest is compared before COMMIT so a
 // divergent run never moves the position.
@@ -131,9 +170,11 @@ Outcome commit_run(Pg& pg, const ShipConfig& c, const RunBatch& b, std::int64_t 
     }
     const std::string central = central_digest(pg, b.run.run_id);
     if (central != b.digest) {
-      rollback(pg);
       divergence = {b.run.run_id, b.digest, central};
-      return Outcome::diverged;
+      const bool superseded = superseded_by_restore(pg, b);
+      rollback(pg);
+      if (!superseded) return Outcome::diverged;
+      return commit_superseded(pg, c, b, position, divergence) ? Outcome::superseded : Outcome::raced;
     }
     pg.query("UPDATE benches SET shipped_position = $2, last_seen = now(), last_error = NULL WHERE id = $1",
              {c.bench_id, std::to_string(b.run.ended_event)});
@@ -212,6 +253,15 @@ CycleReport ship_cycle(const ShipConfig& c) {
           report.position_after = position;
           record_backlog(pg, bench, c.bench_id, position);
           return report;
+        case Outcome::superseded:
+          log::warning("ship", "run " + d.run_id + " ended again on this restored bench; central keeps the copy it "
+                               "shipped before the restore (ship_problems: superseded_by_restore)");
+          report.superseded.push_back(d);
+          position = run.ended_event;
+          write_shipped_position(c.shipped_position_file(), position);
+          report.events += b.event_count;
+          --budget;
+          break;
         case Outcome::committed:
           position = run.ended_event;
           write_shipped_position(c.shipped_position_file(), position);
@@ -235,14 +285,22 @@ std::vector<Divergence> verify_shipped(const ShipConfig& c) {
   Pg pg(c.postgres);
   central_require(pg);
   std::vector<Divergence> out;
-  auto runs = pg.query("SELECT id FROM runs WHERE bench_id = $1 ORDER BY ended_event", {c.bench_id});
+  // After a restore (backup.hpp) central holds runs the restored bench never had (they ended after its
+  // snapshot) and runs it ended again differently (superseded_by_restore): central's copies are the record then.
+  const std::int64_t epoch = epoch_of(bench.last_event());
+  auto runs = pg.query(
+      "SELECT id, ended_event, EXISTS (SELECT 1 FROM ship_problems p WHERE p.bench_id = runs.bench_id AND "
+      "p.run_id = runs.id AND p.kind = 'superseded_by_restore') FROM runs WHERE bench_id = $1 ORDER BY ended_event",
+      {c.bench_id});
   for (int i = 0; i < runs.rows(); ++i) {
     const std::string id = runs.text(i, 0);
+    if (runs.text(i, 2) == "t") continue;
     std::string mine;
     try {
       mine = bench.digest(id);
     } catch (const Error& e) {
       if (e.cls() != ErrorClass::not_found) throw;
+      if (epoch_of(runs.int64(i, 1)) < epoch) continue;
       mine = "(run missing on the bench)";
     }
     const std::string theirs = central_digest(pg, id);

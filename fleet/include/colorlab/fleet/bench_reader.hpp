@@ -46,6 +46,8 @@ class BenchReader {
   explicit BenchReader(const std::filesystem::path& database);
 
   int schema_version();
+  // The newest event's seq (0 for none); its epoch is the bench's (backup.hpp).
+  std::int64_t last_event();
   // Runs that ended after `position`, oldest first, at most `limit`.
   std::vector<EndedRun> ended_after(std::int64_t position, int limit);
   Backlog backlog(std::int64_t position);

@@ -20,11 +20,18 @@ struct ShipConfig {
   int batch_runs = 50;       // runs shipped per cycle, each in its own PostgreSQL transaction
   double interval_s = 30;    // between cycles when running as a service
   int stall_timeout_s = 30;  // an S3 request under 1 KiB/s for this long ends the cycle (retried next cycle)
+  // `colorlab backup` rotation (docs/fleet.md, "Backups"): after a successful upload the bucket keeps the
+  // newest snapshot of each of the last backup_keep_daily days and of each of the last backup_keep_weekly weeks
+  // (Monday to Sunday, UTC) that have one; the snapshot just taken is always kept.
+  int backup_keep_daily = 7;
+  int backup_keep_weekly = 4;
 
   std::filesystem::path database_path() const { return state_dir / "colorlab.db"; }
   std::filesystem::path blob_root() const { return state_dir / "blobs"; }
   // Where the agent records the position central holds, for colorlabd's blob retention (docs/fleet.md).
   std::filesystem::path shipped_position_file() const { return state_dir / "ship" / "shipped-position"; }
+  // Where `colorlab backup` writes its snapshot before the upload (on the bench's own disk).
+  std::filesystem::path backup_dir() const { return state_dir / "backup"; }
 };
 
 // Error{bad_parameter} naming the file, line and key for anything missing or malformed.

@@ -32,6 +32,8 @@ class S3Client {
   // A request that moves under 1 KiB/s for this long ends as Error{no_comms} (a stalled store must not hang a
   // cycle). Default 30 s; [ship] stall_timeout_s.
   void set_stall_timeout(long seconds) { stall_timeout_s_ = seconds; }
+  // Deletes an object (backup rotation); a missing one is no error (S3 answers 204 either way).
+  void remove(const std::string& key);
 
  private:
   struct Reply {

@@ -25,6 +25,9 @@ struct CycleReport {
   std::int64_t events = 0;
   int blobs_uploaded = 0;  // not already in the bucket
   std::vector<Divergence> divergences;  // shipping stopped at the first
+  // Runs a restored bench ended again that central holds from before the restore (backup.hpp): central's copy
+  // stays, the position moves on.
+  std::vector<Divergence> superseded;
 };
 
 // Sets up an empty central database; refuses a schema of another version (central_schema.hpp).
