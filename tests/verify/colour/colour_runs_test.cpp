@@ -146,6 +146,7 @@ class Lab {
   std::filesystem::path file(const std::string& name) const { return dir_.path() / name; }
   const std::string& characterize() const { return characterize_; }
   const std::string& chart_read() const { return chart_read_; }
+  client::ApiClient api() const { return api_for(*daemon_); }
 
  private:
   TempDir dir_;
@@ -233,6 +234,22 @@ TEST(VerifyColour, FromStoredRunsAgainstTheSimulatedLab) {
     if (k.count("colour_7_3")) {
       EXPECT_GE(1.0 - static_cast<double>(k.at("colour_7_3").differ) / 140, 0.95);
     }
+  }
+  {
+    SCOPED_TRACE("--store: the colour comparisons read back through the API");
+    const auto r = lab->cli({"verify", lab->file("defect.exr").string(), "--against", lab->characterize(), "--json", "--store"});
+    ASSERT_EQ(r.exit_code, 4) << r.err;
+    const json result = json::parse(r.out);
+    const json run = client::fetch_run(lab->api(), result.at("stored_run").get<std::string>());
+    EXPECT_EQ(run["campaign"], "verify");
+    ASSERT_EQ(run["measurements"].size(), result["comparisons"].size());
+    bool seen = false;
+    for (const auto& m : run["measurements"])
+      if (m["step"] == std::string("colour_7_3/") + kDefectPatch) {
+        seen = true;
+        EXPECT_EQ(m["data"]["verdict"], "differs") << m.dump();
+      }
+    EXPECT_TRUE(seen);
   }
   {
     SCOPED_TRACE("runs that lack what colour needs are typed errors with their cause");
