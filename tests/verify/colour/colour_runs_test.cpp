@@ -104,6 +104,15 @@ struct Kind {
   std::vector<std::string> differ_at;
 };
 
+// How close the nearest verdict came to flipping: the smallest |distance / threshold − 1| (the runs are the same
+// seeded lab every time, but not bit for bit: the lamp's warm-up follows the wall clock).
+double closest_to_flipping(const json& result) {
+  double closest = 1e9;
+  for (const auto& c : result["comparisons"])
+    closest = std::min(closest, std::abs(c["mahalanobis"].get<double>() / c["threshold"].get<double>() - 1));
+  return closest;
+}
+
 std::map<std::string, Kind> tally(const json& result) {
   std::map<std::string, Kind> k;
   for (const auto& c : result["comparisons"]) {
@@ -202,6 +211,7 @@ TEST(VerifyColour, FromStoredRunsAgainstTheSimulatedLab) {
       std::cout << "\n";
       EXPECT_GE(agree, 0.95) << kind << "\n" << result["summary"][kind].dump(2);
     }
+    std::cout << "closest verdict to flipping: " << closest_to_flipping(result) << " of its threshold\n";
     for (const auto& s : result["summary"]["scales"]) EXPECT_EQ(s["how"], "fitted") << s.dump();
     if (result.contains("colour")) std::cout << "colour: " << result["colour"].dump() << "\n";
   }
@@ -216,6 +226,7 @@ TEST(VerifyColour, FromStoredRunsAgainstTheSimulatedLab) {
     ASSERT_TRUE(c74);
     EXPECT_EQ((*c74)["verdict"], "differs") << c74->dump(2);
     const auto k = tally(result);
+    std::cout << "closest verdict to flipping: " << closest_to_flipping(result) << " of its threshold\n";
     for (const char* kind : {"colour_7_3", "colour_7_4"}) {
       const auto& t = k.at(kind);
       const int elsewhere = t.differ - 1;
