@@ -177,6 +177,17 @@ Eigen::MatrixXd SplineModel::apply(const Eigen::MatrixXd& rgb) const {
   return target_ == FitTarget::lab_direct ? t : xyz_rows_to_lab(t, white_);
 }
 
+Eigen::MatrixXd spline_loo_targets(const ChartData& data, const SplineOptions& o) {
+  data.check();
+  if (!o.smoothing) throw Error(ErrorClass::bad_parameter, "spline_loo_targets needs the smoothing λ");
+  const double scale = o.input_scale > 0 ? o.input_scale : (data.rgb.maxCoeff() > 0 ? data.rgb.maxCoeff() : 1.0);
+  const Eigen::MatrixXd u = cube_root_coordinates(data.rgb, scale);
+  const Eigen::MatrixXd K = cubic_kernel(u, u);
+  const Eigen::MatrixXd P = polynomial_part(term_set_by_name(o.base), data.rgb / scale, u);
+  const Eigen::MatrixXd Y = target_of(data, o.target);
+  return loo_predictions(solve_at(K, P, target_weights(data, o.target), Y, *o.smoothing, true), Y);
+}
+
 FitReport spline_report(const ChartData& data, const SplineOptions& o, const CvSpec& cv) {
   data.check();
   FitReport r;

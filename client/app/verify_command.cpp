@@ -1,5 +1,6 @@
 #include "verify_command.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -14,6 +15,9 @@
 #include "colorlab/verify/compare/stored.hpp"
 #include "colorlab/verify/compare/stored_request.hpp"
 #include "colorlab/verify/rendering.hpp"
+#ifdef COLORLAB_HAVE_VERIFY_COLOUR
+#include "colour_from_runs.hpp"
+#endif
 
 namespace colorlab::cli {
 
@@ -75,6 +79,8 @@ std::string human(const json& j) {
       out << "    the measurement cannot tell at " << blind.size() << " (band wider than the cannot-tell limit; --json names "
           << "the dominant source)\n";
   }
+  if (j.contains("not_compared"))
+    for (const auto& [kind, why] : j["not_compared"].items()) out << "  " << kind << " not compared: " << why.get<std::string>() << "\n";
   if (j.contains("stored_run")) out << "  stored as run " << j["stored_run"].get<std::string>() << "\n";
   return out.str();
 }
@@ -88,6 +94,17 @@ int verify(const GlobalOptions& global, const VerifyOptions& o) {
     check_id(id, "a run id", "colorlab runs lists them");
     runs.push_back(client::fetch_run(api, id));
   }
+#ifdef COLORLAB_HAVE_VERIFY_COLOUR
+  // A characterization is read with the chart-read it was fitted against (the patches' spectra): fetched here
+  // when not given, so `--against CHARACTERIZE_RUN` is enough for the colour.
+  const std::size_t given = runs.size();
+  for (std::size_t i = 0; i < given; ++i) {
+    const std::string ref = verify::chart_read_of(runs[i]);
+    if (ref.empty()) continue;
+    const bool have = std::any_of(runs.begin(), runs.end(), [&](const json& r) { return r.value("id", "") == ref; });
+    if (!have) runs.push_back(client::fetch_run(api, ref));
+  }
+#endif
   verify::RunsSceneOptions scene_options;
   scene_options.corner_accuracy_px = o.corner_accuracy_px;
   if (!o.lamp.empty() || o.dimmer) {
@@ -95,7 +112,12 @@ int verify(const GlobalOptions& global, const VerifyOptions& o) {
       throw Error(ErrorClass::bad_parameter, "--lamp and --dimmer go together", "e.g. --lamp D65 --dimmer 100");
     scene_options.light = verify::LightSelection{o.lamp, *o.dimmer};
   }
+#ifdef COLORLAB_HAVE_VERIFY_COLOUR
+  json colour;
+  const auto scene = verify::measured_scene_from_runs(runs, rendering, scene_options, &colour);
+#else
   const auto scene = verify::scene_from_runs(runs, rendering.width, rendering.height, scene_options);
+#endif
   verify::CompareOptions options;
   options.scale = o.scale;
   const auto v = verify::compare(rendering, scene, options);
@@ -106,6 +128,13 @@ int verify(const GlobalOptions& global, const VerifyOptions& o) {
   out["against"] = o.against;
   out["lamp"] = scene.lamp;
   out["exit_status"] = verify::exit_status(v);
+#ifdef COLORLAB_HAVE_VERIFY_COLOUR
+  if (!colour.is_null()) out["colour"] = colour;
+#endif
+  // A comparison the runs allow but the rendering does not is said, not silently left out.
+  if (scene.characterization && rendering.encoding != verify::Encoding::spectral)
+    out["not_compared"]["colour_7_4"] = "the rendering is not spectral: §7.4 takes each band's radiance through the camera's "
+                                        "sensitivities (render the bands, e.g. colorlab scene's --mode bands)";
   if (o.store) {
     const json stored = api.post("/v1/verifications", verify::store_request(v, name, o.against, options));
     out["stored_run"] = stored.at("run_id");
@@ -123,10 +152,12 @@ void add_verify_command(CLI::App& app, GlobalOptions& global) {
   auto* cmd = app.add_subcommand(
       "verify",
       "Compare a rendering (OpenEXR spectral/XYZ/RGB, Radiance .hdr, PFM) with the measured scene of cabinet-grid and "
-      "floor-luminance runs, within the measurement's uncertainty (k = 2). Exit 0 agrees, 4 differs, 1 local error, 2 API refused");
+      "floor-luminance runs (light) and a characterize-camera run (colour, §7.3 and §7.4), within the measurement's uncertainty "
+      "(k = 2). Exit 0 agrees, 4 differs, 1 local error, 2 API refused");
   cmd->add_option("rendering", o->rendering, "the rendering file, made with the exported camera (the floor photograph's view)")
       ->required();
-  cmd->add_option("--against", o->against, "run ids: one floor-luminance run (where the floor lies) and optionally one cabinet-grid run")
+  cmd->add_option("--against", o->against, "run ids: one floor-luminance run (where the floor lies) and optionally one cabinet-grid run; one "
+                  "characterize-camera run for the colour (its chart-read is fetched with it)")
       ->required();
   cmd->add_option("--scale", o->scale,
                   "renderer unit -> cd/m² (1 for W·m⁻²·sr⁻¹·nm⁻¹ spectral and cd/m² XYZ); omitted: one factor fitted per kind, "

@@ -37,14 +37,16 @@ class VerifyMixin:
 
         Returns the result document — ``summary`` (``verdict`` "agrees"/"differs", per kind compared/agree/differ,
         ``scales`` given or fitted), ``comparisons``, ``floor_difference``, ``exit_status`` (0 agrees, 4 differs),
-        ``stored_run`` with ``store=True`` — plus ``table``: the comparisons as a DataFrame (kind, where,
+        ``stored_run`` with ``store=True``, ``colour`` and ``not_compared`` when a characterize-camera run is among
+        ``against`` — plus ``table``: the comparisons as a DataFrame (kind, where,
         difference, expanded, verdict, …). ``scale``: renderer unit → cd/m² (omitted: one factor fitted per kind,
         which cannot see a uniformly wrong level). Raises ``VerifyFailed`` when no verdict could be made."""
         from .report.analyze import colorlab_binary  # the one place that knows where the binary is
 
         runs = [run_id(r) for r in against]
         if not runs:
-            raise ValueError("against: give at least one run (a floor-luminance run, optionally a cabinet-grid run)")
+            raise ValueError("against: give at least one run (a floor-luminance run, optionally a cabinet-grid run; "
+                             "a characterize-camera run for the colour)")
         cmd = [str(colorlab_binary())]
         env = dict(os.environ, LC_ALL="C")
         if self.conn.socket is not None:

@@ -103,10 +103,9 @@ void compare_colour_73(const Rendering& r, const MeasuredScene& s, const Compare
 
   // The rendering's XYZ into the measurement's relative scale (the lamp's perfect diffuser at Y = 100).
   ScaleUsed sc{"colour_7_3", "given", 1};
-  if (o.scale) {
-    if (!s.white_luminance_cd_m2 || *s.white_luminance_cd_m2 <= 0)
-      throw Error(ErrorClass::bad_data, "a given scale needs the white's luminance at the chart (LS-110)",
-                  "verify against a run that metered the chart's white, or let the scale be fitted");
+  // A given scale needs the white's metered luminance at the chart; runs that did not meter it (characterize-camera
+  // does not) get §7.3's factor fitted, and `scales` says so, while the light comparisons keep the given one.
+  if (o.scale && s.white_luminance_cd_m2 && *s.white_luminance_cd_m2 > 0) {
     sc.factor = *o.scale * 100.0 / *s.white_luminance_cd_m2;
   } else {
     std::vector<double> ratios;

@@ -95,7 +95,7 @@ MeasuredScene scene_from_runs(const std::vector<json>& runs, int width, int heig
     } else {
       throw Error(ErrorClass::bad_parameter,
                   "run " + id + " is a " + (campaign.empty() ? std::string("?") : campaign) + " run, which gives no light to verify against",
-                  "give cabinet-grid and floor-luminance runs (the colour half from characterize-camera is not read yet: docs/verify.md)");
+                  "give cabinet-grid and floor-luminance runs for the light, characterize-camera and its chart-read for the colour");
     }
   }
   if (grid_runs.size() > 1)

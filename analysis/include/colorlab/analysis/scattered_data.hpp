@@ -72,4 +72,10 @@ SplineModel fit_spline(const ChartData& train, const SplineOptions& options = {}
 // chosen on the same LOO). k-fold: nested — each fold chooses its own λ by LOO on its training patches.
 FitReport spline_report(const ChartData& data, const SplineOptions& options, const CvSpec& cv);
 
+// Each patch's held-out prediction of the fitted target (XYZ or L*a*b*, per options.target), n × 3, at the given λ
+// (options.smoothing, required) and input scale (0: the data's largest value, as spline_report's LOO): the exact
+// leave-one-out of the linear smoother, y_i − e_i / (1 − h_ii), so per-patch error vectors cost one solve, not n
+// fits (issue 23's verification). NaN rows where h_ii ≈ 1.
+Eigen::MatrixXd spline_loo_targets(const ChartData& data, const SplineOptions& options);
+
 }  // namespace colorlab::analysis
