@@ -80,6 +80,7 @@ struct AcrossLampsOptions {
   CvSpec cv = CvSpec::loo();
   int draws = 40;      // posterior draws propagated to the per-patch uncertainty
   unsigned seed = 1;   // of the draws: a characterization is reproducible
+  SmoothingSearch spline_search = SmoothingSearch::eigen;  // direct: the reference path (bench A/B)
 };
 
 // One characterization per lamp, named by it.
