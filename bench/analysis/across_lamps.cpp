@@ -2,7 +2,10 @@
 // sensitivities, beside today's same-lamp selection and ArgyllCMS colprof -ax / -am, in one run on the same data.
 //
 //   bench_analysis_across_lamps [--quality m] [--cameras Canon_20D,…] [--conditions A,F11] [--draws 40] [--argyll 1]
-//                               [--noise 0.005] [--keep DIR] [--ab 1]
+//                               [--noise 0.005] [--keep DIR] [--ab 1] [--remedy 1 [--pareto FILE]]
+//
+// --pareto FILE (with --remedy 1): the photographs-taken against ΔE00-reached averages as JSON, the data of the
+// report's Pareto chart (client/python/colorlab/report/data/across_lamps_pareto.json).
 //
 // --ab 1: the spline's λ search both ways, interleaved case by case (the LU per λ, then one eigendecomposition):
 // today's selection and the across-lamps fit timed and their ΔE00 compared (docs/PERFORMANCE.md, issue 26).
@@ -140,7 +143,7 @@ int main(int argc, char** argv) {
   std::string quality = "m";
   std::vector<std::string> cameras = kCameras;
   std::vector<std::string> condition_names = {"A", "F11", "F2"};
-  std::optional<fs::path> keep;
+  std::optional<fs::path> keep, pareto;
   bool argyll = true, remedy = false, ab = false;
   int draws = 40;
   double noise = 0.005;
@@ -155,6 +158,7 @@ int main(int argc, char** argv) {
     else if (a == "--noise") noise = std::stod(v);
     else if (a == "--remedy") remedy = v == "1";
     else if (a == "--ab") ab = v == "1";
+    else if (a == "--pareto") pareto = v;
     else {
       std::cerr << "unknown option " << a << "\n";
       return 2;
@@ -203,6 +207,21 @@ int main(int argc, char** argv) {
   std::string worst_case;
   std::vector<std::string> timing_rows, remedy_rows, ab_rows;
   double ab_worst = 0;
+  // The Pareto chart's points: per remedy, the sums over cases of mean and max ΔE00, the worst max, the cases.
+  struct Point {
+    int photographs = 0;
+    double mean = 0, max = 0, worst = 0;
+    int cases = 0;
+  };
+  std::map<std::string, Point> points;
+  auto add_point = [&](const std::string& what, int photographs, double mean, double max) {
+    Point& p = points[what];
+    p.photographs = photographs;
+    p.mean += mean;
+    p.max += max;
+    p.worst = std::max(p.worst, max);
+    ++p.cases;
+  };
   for (const auto& cam : cameras) {
     const ca::SpectralSet curves = colorlab::bench::camera_curves(cams, cam);
     // The photograph: white-balanced RGB under D65 with multiplicative noise (the black box takes any scale).
@@ -273,9 +292,13 @@ int main(int argc, char** argv) {
           const auto m = select_same_lamp(stack(charts));
           const std::string ms = tm.ms();
           const auto me = ca::evaluate(m.apply(test.rgb), test.lab);
+          add_point(charts.size() == 2 ? "D65 + booth A, one model" : "D65 + booth A + booth CWF, one model",
+                    static_cast<int>(charts.size()), me.s00.mean, me.s00.max);
           remedy_rows.push_back("| " + cam + " | " + cond.name + " | " + std::to_string(charts.size()) + " (D65 + " +
                                 (charts.size() == 2 ? "booth A" : "booth A + CWF") + ") | " + fmt({me.s00.mean, me.s00.max}) + " | " + ms + " |");
         }
+        add_point("D65, across lamps", 1, e.s00.mean, e.s00.max);
+        add_point("D65, today's same-lamp selection", 1, te.s00.mean, te.s00.max);
         remedy_rows.push_back("| " + cam + " | " + cond.name + " | 1 (D65), across lamps | " + fmt({e.s00.mean, e.s00.max}) + " | |");
         remedy_rows.push_back("| " + cam + " | " + cond.name + " | 1 (D65), today | " + fmt({te.s00.mean, te.s00.max}) + " | |");
       }
@@ -365,6 +388,27 @@ int main(int argc, char** argv) {
   if (remedy) {
     std::cout << "\n| camera | test lamp | photographs (training lamps) | mean / max ΔE00 | selection time |\n|---|---|---|---|---|\n";
     for (const auto& r : remedy_rows) std::cout << r << "\n";
+    if (pareto) {
+      std::ofstream f(*pareto);
+      f << std::setprecision(17) << "{\n  \"source\": \"bench_analysis_across_lamps --argyll 0 --remedy 1 --cameras ";
+      for (std::size_t i = 0; i < cameras.size(); ++i) f << (i ? "," : "") << cameras[i];
+      f << "\",\n  \"test_lamps\": [";
+      for (std::size_t i = 0; i < conditions.size(); ++i)
+        f << (i ? ", " : "") << "\"" << (conditions[i].measured_column ? *conditions[i].measured_column : "CIE " + conditions[i].assumed) << "\"";
+      f << "],\n  \"noise\": " << noise << ",\n  \"points\": [";
+      bool first = true;
+      for (const auto& [what, p] : points) {
+        f << (first ? "\n" : ",\n") << "    {\"what\": \"" << what << "\", \"photographs\": " << p.photographs
+          << ", \"mean_de00\": " << p.mean / p.cases << ", \"max_de00\": " << p.max / p.cases << ", \"worst_max_de00\": " << p.worst
+          << ", \"cases\": " << p.cases << "}";
+        first = false;
+      }
+      f << "\n  ]\n}\n";
+      if (!f) {
+        std::cerr << "could not write " << pareto->string() << "\n";
+        return 1;
+      }
+    }
   }
   if (!keep) {
     std::error_code ec;

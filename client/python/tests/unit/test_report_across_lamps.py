@@ -39,7 +39,7 @@ def lamp_run():
 def cells(text, row):
     """{column: data-value} of one table row's cells."""
     return {html.unescape(c): float(v) for c, v in
-            re.findall(rf'data-row="{re.escape(row)}" data-col="([^"]+)" data-kind="[^"]*" data-value="([^"]+)"', text)}
+            re.findall(rf'data-row="{re.escape(html.escape(row))}" data-col="([^"]+)" data-kind="[^"]*" data-value="([^"]+)"', text)}
 
 
 class AcrossLampsSection(unittest.TestCase):
@@ -71,6 +71,27 @@ class AcrossLampsSection(unittest.TestCase):
         self.assertIn(f'id="{run.short}-across-lamps-table"', render([run]))
         run.doc["summary"]["script"] = {"formats": {"raw": {"across_lamps": {}}}}
         self.assertEqual(across_lamps.section(run), "")
+
+    def test_pareto_points_are_the_bench_output(self):
+        run, _ = lamp_run()
+        text = across_lamps.section(run)
+        data = across_lamps.pareto_points()
+        self.assertIn(f'id="{run.short}-fig-across-lamps-pareto"', text)
+        self.assertEqual(sorted(p["photographs"] for p in data["points"]), [1, 1, 2, 3])
+        for p in data["points"]:
+            got = cells(text, f"pareto:{p['what']}")
+            self.assertEqual(got["photographs"], p["photographs"])
+            self.assertEqual(got["mean ΔE00"], p["mean_de00"])
+            self.assertEqual(got["max ΔE00"], p["max_de00"])
+            self.assertEqual(got["worst max ΔE00"], p["worst_max_de00"])
+        # The front by its definition: no other point at most as many photographs and at most its max ΔE00, and
+        # better in one.
+        pts = data["points"]
+        for p in pts:
+            dominated = any(q is not p and q["photographs"] <= p["photographs"] and q["max_de00"] <= p["max_de00"]
+                            and (q["photographs"] < p["photographs"] or q["max_de00"] < p["max_de00"]) for q in pts)
+            self.assertEqual(cells(text, f"pareto:{p['what']}")["Pareto front"], 0.0 if dominated else 1.0, p["what"])
+        self.assertIn(html.escape(data["source"]), text)
 
 
 if __name__ == "__main__":
