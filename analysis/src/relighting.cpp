@@ -145,6 +145,7 @@ LampCharacterization characterize_across_lamps(const SensitivityEstimate& s, con
   const ChartData predicted = target.predict(s.curves);
   FitOptions fo;
   fo.input_scale = 1.0;  // white-balanced: the perfect white is 1 in every channel, under any lamp
+  fo.spline_search = o.spline_search;
   const Selection sel = select_method(o.methods, o.targets, predicted, fo, o.cv);
   const FitReport& chosen = sel.candidates[sel.chosen];
   fo.target = chosen.target;

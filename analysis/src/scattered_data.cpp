@@ -77,6 +77,51 @@ Solved solve_at(const Eigen::MatrixXd& K, const Eigen::MatrixXd& P, const Eigen:
   return s;
 }
 
+// Every λ at the cost of one decomposition. With P = [Q₁ Q₂]R (Q₂ spans the coefficients the side condition Pᵀc = 0
+// allows) and D = W⁻², c = Q₂ a solves Q₂ᵀ(K + λD)Q₂ a = Q₂ᵀy. The generalised eigenproblem Q₂ᵀKQ₂ v = μ Q₂ᵀDQ₂ v
+// (VᵀQ₂ᵀDQ₂V = I) diagonalises that system for every λ at once: with G = Q₂V, c = G diag(1/(μ+λ)) Gᵀy, the residual
+// y − f = λDc, and 1 − h_ii = λ D_ii Σ_k G_ik² / (μ_k + λ). A λ then costs O(n²) instead of an LU and an n-column
+// solve, which is what the 41-value search spent its time on (docs/PERFORMANCE.md, issue 26).
+class Smoother {
+ public:
+  Smoother(const Eigen::MatrixXd& K, const Eigen::MatrixXd& P, const Eigen::VectorXd& w, const Eigen::MatrixXd& Y)
+      : K_(K), Y_(Y), qr_(P), d_(w.array().square().inverse().matrix()) {
+    const Eigen::Index n = K.rows(), m = P.cols();
+    const Eigen::MatrixXd Q = qr_.householderQ() * Eigen::MatrixXd::Identity(n, n);
+    const Eigen::MatrixXd Q2 = Q.rightCols(n - m);
+    Eigen::MatrixXd A = Q2.transpose() * K * Q2;
+    A = 0.5 * (A + A.transpose()).eval();
+    Eigen::MatrixXd B = Q2.transpose() * d_.asDiagonal() * Q2;
+    B = 0.5 * (B + B.transpose()).eval();
+    const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(A, B, Eigen::ComputeEigenvectors | Eigen::Ax_lBx);
+    if (eig.info() != Eigen::Success) throw Error(ErrorClass::bad_data, "spline: the smoothing eigenproblem did not converge");
+    mu_ = eig.eigenvalues();
+    G_ = Q2 * eig.eigenvectors();
+    z_ = G_.transpose() * Y;
+    g2_ = G_.array().square().matrix();
+  }
+
+  Solved at(double lambda, bool want_hat, bool want_coefficients) const {
+    const Eigen::VectorXd inv = (mu_.array() + lambda).inverse().matrix();
+    Solved s;
+    s.c = G_ * (inv.asDiagonal() * z_);
+    s.fitted = Y_ - lambda * (d_.asDiagonal() * s.c);
+    if (want_coefficients) s.d = qr_.solve(Eigen::MatrixXd(s.fitted - K_ * s.c));
+    if (want_hat) {
+      s.leverage = Eigen::VectorXd::Ones(Y_.rows()) - lambda * d_.cwiseProduct(g2_ * inv);
+      s.trace = s.leverage.sum();
+    }
+    return s;
+  }
+
+ private:
+  const Eigen::MatrixXd& K_;
+  const Eigen::MatrixXd& Y_;
+  Eigen::HouseholderQR<Eigen::MatrixXd> qr_;
+  Eigen::VectorXd d_, mu_;
+  Eigen::MatrixXd G_, z_, g2_;
+};
+
 double mean_de00(const Eigen::MatrixXd& pred_target, const ChartData& d, FitTarget t) {
   const Eigen::MatrixXd lab = t == FitTarget::lab_direct ? pred_target : xyz_rows_to_lab(pred_target, d.white);
   return evaluate(lab, d.lab).s00.mean;
@@ -102,11 +147,21 @@ SplineOptions spline_options(const std::string& method, const FitOptions& o) {
   term_set_by_name(so.base);  // validates the base's name now, with its own message
   so.target = o.target;
   so.input_scale = o.input_scale;
+  so.search = o.spline_search;
   return so;
 }
 
-SplineModel fit_spline(const ChartData& train, const SplineOptions& o) {
-  train.check();
+// The model and the smoother's solution at the λ used (its leverages give the exact LOO residuals).
+struct FitWithHat {
+  SplineModel model;
+  Solved solved;
+};
+
+struct SplineFitter {
+  static FitWithHat fit(const ChartData& train, const SplineOptions& o);
+};
+
+FitWithHat SplineFitter::fit(const ChartData& train, const SplineOptions& o) {
   SplineModel model;
   model.base_ = term_set_by_name(o.base);
   model.method_ = spline_method(o.base);
@@ -127,6 +182,12 @@ SplineModel fit_spline(const ChartData& train, const SplineOptions& o) {
   const Eigen::VectorXd w = target_weights(train, o.target);
   const Eigen::MatrixXd Y = target_of(train, o.target);
 
+  // A fixed λ is one solve; the search decomposes once (eigen) or solves at every λ (direct, the reference).
+  std::optional<Smoother> smoother;
+  if (!o.smoothing && o.search == SmoothingSearch::eigen) smoother.emplace(K, P, w, Y);
+  auto solve = [&](double l, bool want_coefficients) {
+    return smoother ? smoother->at(l, true, want_coefficients) : solve_at(K, P, w, Y, l, true);
+  };
   double lambda = o.smoothing.value_or(0);
   if (!o.smoothing) {
     double best = std::numeric_limits<double>::infinity();
@@ -134,8 +195,7 @@ SplineModel fit_spline(const ChartData& train, const SplineOptions& o) {
     std::vector<std::pair<double, double>> scores;
     for (int k = 0; k < steps; ++k) {
       const double l = o.smoothing_min * std::pow(o.smoothing_max / o.smoothing_min, k / double(steps - 1));
-      const Solved s = solve_at(K, P, w, Y, l, true);
-      const double e = mean_de00(loo_predictions(s, Y), train, o.target);
+      const double e = mean_de00(loo_predictions(solve(l, false), Y), train, o.target);
       scores.emplace_back(l, e);
       if (e < best) {
         best = e;
@@ -144,8 +204,7 @@ SplineModel fit_spline(const ChartData& train, const SplineOptions& o) {
     }
     double tol = o.smoothing_tolerance.value_or(0);
     if (!o.smoothing_tolerance) {
-      const Solved s = solve_at(K, P, w, Y, lambda, true);
-      const Eigen::MatrixXd pr = loo_predictions(s, Y);
+      const Eigen::MatrixXd pr = loo_predictions(solve(lambda, false), Y);
       const auto ev = evaluate(o.target == FitTarget::lab_direct ? pr : xyz_rows_to_lab(pr, train.white), train.lab);
       tol = ev.s00.stdev / std::sqrt(static_cast<double>(n));
     }
@@ -154,12 +213,17 @@ SplineModel fit_spline(const ChartData& train, const SplineOptions& o) {
     if (!std::isfinite(best))
       throw Error(ErrorClass::bad_data, model.method_ + ": no smoothing value gives finite leave-one-out errors");
   }
-  const Solved s = solve_at(K, P, w, Y, lambda, true);
+  Solved s = solve(lambda, true);
   model.smoothing_ = lambda;
   model.kernel_ = s.c;
   model.poly_ = s.d;
   model.dof_ = s.trace;
-  return model;
+  return {std::move(model), std::move(s)};
+}
+
+SplineModel fit_spline(const ChartData& train, const SplineOptions& o) {
+  train.check();
+  return SplineFitter::fit(train, o).model;
 }
 
 Eigen::MatrixXd SplineModel::predict_target(const Eigen::MatrixXd& rgb) const {
@@ -198,21 +262,15 @@ FitReport spline_report(const ChartData& data, const SplineOptions& o, const CvS
   const Eigen::MatrixXd Y = target_of(data, o.target);
   Eigen::MatrixXd pred = Eigen::MatrixXd::Constant(n, 3, std::numeric_limits<double>::quiet_NaN());
   try {
-    const SplineModel model = fit_spline(data, o);
+    const FitWithHat fitted = SplineFitter::fit(data, o);
+    const SplineModel& model = fitted.model;
     r.terms = model.base_terms();
     r.parameters = model.effective_parameters();
     r.training = evaluate(model.apply(data.rgb), data.lab);
     if (cv.kind == CvSpec::Kind::none) {
       pred = model.predict_target(data.rgb);
     } else if (cv.kind == CvSpec::Kind::leave_one_out) {
-      SplineOptions fixed = o;
-      fixed.smoothing = model.smoothing();
-      fixed.input_scale = o.input_scale > 0 ? o.input_scale : data.rgb.maxCoeff();
-      // Recompute the smoother at the chosen λ for its leverages (fit_spline keeps only the coefficients).
-      const Eigen::MatrixXd u = cube_root_coordinates(data.rgb, fixed.input_scale);
-      const Eigen::MatrixXd K = cubic_kernel(u, u);
-      const Eigen::MatrixXd P = polynomial_part(term_set_by_name(o.base), data.rgb / fixed.input_scale, u);
-      pred = loo_predictions(solve_at(K, P, target_weights(data, o.target), Y, model.smoothing(), true), Y);
+      pred = loo_predictions(fitted.solved, Y);  // at the λ chosen on all patches
     }
   } catch (const Error&) {
     r.rank_deficient = true;

@@ -2,7 +2,13 @@
 // sensitivities, beside today's same-lamp selection and ArgyllCMS colprof -ax / -am, in one run on the same data.
 //
 //   bench_analysis_across_lamps [--quality m] [--cameras Canon_20D,…] [--conditions A,F11] [--draws 40] [--argyll 1]
-//                               [--noise 0.005] [--keep DIR]
+//                               [--noise 0.005] [--keep DIR] [--ab 1] [--remedy 1 [--pareto FILE]]
+//
+// --pareto FILE (with --remedy 1): the photographs-taken against ΔE00-reached averages as JSON, the data of the
+// report's Pareto chart (client/python/colorlab/report/data/across_lamps_pareto.json).
+//
+// --ab 1: the spline's λ search both ways, interleaved case by case (the LU per λ, then one eigendecomposition):
+// today's selection and the across-lamps fit timed and their ΔE00 compared (docs/PERFORMANCE.md, issue 26).
 //
 // Fairness (issue 26): the training photograph is the SG under D65 with 0.5 % multiplicative RAW noise (seed 1); the
 // sensitivities are estimated from it with the camera left out of the prior; the test chart (CC24) is photographed
@@ -18,6 +24,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <map>
 #include <random>
 #include <regex>
 #include <sstream>
@@ -46,6 +53,11 @@ const std::vector<std::string> kCameras = {"Canon_20D",    "Canon_5DMarkII", "Ni
 
 struct Figure {
   double mean = NAN, max = NAN;
+};
+
+// One case of the --ab comparison: today's and the across-lamps model's mean / max ΔE00 on the test chart.
+struct AbFigures {
+  double today_mean = NAN, today_max = NAN, across_mean = NAN, across_max = NAN;
 };
 
 bool colprof(const fs::path& dir, const std::string& base, const std::string& algo, const std::string& quality) {
@@ -87,9 +99,10 @@ struct Timer {
 const std::vector<ca::FitTarget> kTargets = {ca::FitTarget::xyz_then_lab, ca::FitTarget::xyz_lightness_weighted, ca::FitTarget::lab_direct};
 
 // Today's path: every family selected by LOO on the photograph under the training lamp, used as is under the test lamp.
-ca::Characterization select_same_lamp(const ca::ChartData& train) {
+ca::Characterization select_same_lamp(const ca::ChartData& train, ca::SmoothingSearch search = ca::SmoothingSearch::eigen) {
   ca::FitOptions o;
   o.input_scale = 1.0;
+  o.spline_search = search;
   const auto sel = ca::select_method(ca::all_methods(), kTargets, train, o, ca::CvSpec::loo());
   o.target = sel.candidates[sel.chosen].target;
   return ca::fit_method(sel.candidates[sel.chosen].method, train, o);
@@ -130,8 +143,8 @@ int main(int argc, char** argv) {
   std::string quality = "m";
   std::vector<std::string> cameras = kCameras;
   std::vector<std::string> condition_names = {"A", "F11", "F2"};
-  std::optional<fs::path> keep;
-  bool argyll = true, remedy = false;
+  std::optional<fs::path> keep, pareto;
+  bool argyll = true, remedy = false, ab = false;
   int draws = 40;
   double noise = 0.005;
   for (int i = 1; i + 1 < argc; i += 2) {
@@ -144,6 +157,8 @@ int main(int argc, char** argv) {
     else if (a == "--draws") draws = std::stoi(v);
     else if (a == "--noise") noise = std::stod(v);
     else if (a == "--remedy") remedy = v == "1";
+    else if (a == "--ab") ab = v == "1";
+    else if (a == "--pareto") pareto = v;
     else {
       std::cerr << "unknown option " << a << "\n";
       return 2;
@@ -190,7 +205,23 @@ int main(int argc, char** argv) {
   long inside_all = 0, patches_all = 0;
   double worst_case_coverage = 1;
   std::string worst_case;
-  std::vector<std::string> timing_rows, remedy_rows;
+  std::vector<std::string> timing_rows, remedy_rows, ab_rows;
+  double ab_worst = 0;
+  // The Pareto chart's points: per remedy, the sums over cases of mean and max ΔE00, the worst max, the cases.
+  struct Point {
+    int photographs = 0;
+    double mean = 0, max = 0, worst = 0;
+    int cases = 0;
+  };
+  std::map<std::string, Point> points;
+  auto add_point = [&](const std::string& what, int photographs, double mean, double max) {
+    Point& p = points[what];
+    p.photographs = photographs;
+    p.mean += mean;
+    p.max += max;
+    p.worst = std::max(p.worst, max);
+    ++p.cases;
+  };
   for (const auto& cam : cameras) {
     const ca::SpectralSet curves = colorlab::bench::camera_curves(cams, cam);
     // The photograph: white-balanced RGB under D65 with multiplicative noise (the black box takes any scale).
@@ -261,11 +292,49 @@ int main(int argc, char** argv) {
           const auto m = select_same_lamp(stack(charts));
           const std::string ms = tm.ms();
           const auto me = ca::evaluate(m.apply(test.rgb), test.lab);
+          add_point(charts.size() == 2 ? "D65 + booth A, one model" : "D65 + booth A + booth CWF, one model",
+                    static_cast<int>(charts.size()), me.s00.mean, me.s00.max);
           remedy_rows.push_back("| " + cam + " | " + cond.name + " | " + std::to_string(charts.size()) + " (D65 + " +
                                 (charts.size() == 2 ? "booth A" : "booth A + CWF") + ") | " + fmt({me.s00.mean, me.s00.max}) + " | " + ms + " |");
         }
+        add_point("D65, across lamps", 1, e.s00.mean, e.s00.max);
+        add_point("D65, today's same-lamp selection", 1, te.s00.mean, te.s00.max);
         remedy_rows.push_back("| " + cam + " | " + cond.name + " | 1 (D65), across lamps | " + fmt({e.s00.mean, e.s00.max}) + " | |");
         remedy_rows.push_back("| " + cam + " | " + cond.name + " | 1 (D65), today | " + fmt({te.s00.mean, te.s00.max}) + " | |");
+      }
+      if (ab) {
+        // Direct (the reference) and eigen, interleaved; the order alternates so load drift favours neither.
+        const std::vector<ca::SmoothingSearch> order = ab_rows.size() % 2 == 0
+                                                           ? std::vector{ca::SmoothingSearch::direct, ca::SmoothingSearch::eigen}
+                                                           : std::vector{ca::SmoothingSearch::eigen, ca::SmoothingSearch::direct};
+        std::map<ca::SmoothingSearch, std::string> today_t, fit_t, today_e, fit_e, chosen;
+        std::map<ca::SmoothingSearch, AbFigures> figs;
+        for (const auto search : order) {
+          Timer ta;
+          const auto td = select_same_lamp(photo, search);
+          today_t[search] = ta.ms();
+          ca::AcrossLampsOptions ao;
+          ao.draws = 0;
+          ao.spline_search = search;
+          ta = Timer();
+          const auto rl = ca::characterize_across_lamps(est, sg_assumed.at(cond.name), ao);
+          fit_t[search] = ta.ms();
+          const auto tde = ca::evaluate(td.apply(test.rgb), test.lab), rde = ca::evaluate(rl.apply(test.rgb), test.lab);
+          figs[search] = {tde.s00.mean, tde.s00.max, rde.s00.mean, rde.s00.max};
+          chosen[search] = rl.family + " " + ca::to_string(rl.target);
+        }
+        const auto& d = figs[ca::SmoothingSearch::direct];
+        const auto& g = figs[ca::SmoothingSearch::eigen];
+        for (const double diff : {d.today_mean - g.today_mean, d.today_max - g.today_max, d.across_mean - g.across_mean,
+                                  d.across_max - g.across_max})
+          ab_worst = std::max(ab_worst, std::abs(diff));
+        std::ostringstream row;
+        row << "| " << cam << " | " << cond.name << " | " << fmt({d.today_mean, d.today_max}) << " | " << fmt({g.today_mean, g.today_max})
+            << " | " << fmt({d.across_mean, d.across_max}) << " | " << fmt({g.across_mean, g.across_max}) << " | "
+            << chosen[ca::SmoothingSearch::direct] << " / " << chosen[ca::SmoothingSearch::eigen] << " | "
+            << today_t[ca::SmoothingSearch::direct] << " | " << today_t[ca::SmoothingSearch::eigen] << " | "
+            << fit_t[ca::SmoothingSearch::direct] << " | " << fit_t[ca::SmoothingSearch::eigen] << " |";
+        ab_rows.push_back(row.str());
       }
       const Eigen::VectorXd band = relit.uncertainty95(test.rgb);
       long inside = 0;
@@ -309,9 +378,37 @@ int main(int argc, char** argv) {
   std::cout << "\n| camera | today's selection on the D65 photo | the prior (27 cameras) | sensitivity estimation | across lamps, per lamp: fit / fit + "
             << draws << " posterior refits |\n|---|---|---|---|---|\n";
   for (const auto& r : timing_rows) std::cout << r << "\n";
+  if (ab) {
+    std::cout << "\n| camera | test lamp | today, direct λ search | today, eigen | across lamps, direct | across lamps, eigen | chosen "
+                 "(direct / eigen) | today's selection time, direct | eigen | across-lamps fit time, direct | eigen |\n"
+                 "|---|---|---|---|---|---|---|---|---|---|---|\n";
+    for (const auto& r : ab_rows) std::cout << r << "\n";
+    std::cout << "largest |direct − eigen| of the mean and max ΔE00 above: " << std::setprecision(4) << ab_worst << "\n";
+  }
   if (remedy) {
     std::cout << "\n| camera | test lamp | photographs (training lamps) | mean / max ΔE00 | selection time |\n|---|---|---|---|---|\n";
     for (const auto& r : remedy_rows) std::cout << r << "\n";
+    if (pareto) {
+      std::ofstream f(*pareto);
+      f << std::setprecision(17) << "{\n  \"source\": \"bench_analysis_across_lamps --argyll 0 --remedy 1 --cameras ";
+      for (std::size_t i = 0; i < cameras.size(); ++i) f << (i ? "," : "") << cameras[i];
+      f << "\",\n  \"test_lamps\": [";
+      for (std::size_t i = 0; i < conditions.size(); ++i)
+        f << (i ? ", " : "") << "\"" << (conditions[i].measured_column ? *conditions[i].measured_column : "CIE " + conditions[i].assumed) << "\"";
+      f << "],\n  \"noise\": " << noise << ",\n  \"points\": [";
+      bool first = true;
+      for (const auto& [what, p] : points) {
+        f << (first ? "\n" : ",\n") << "    {\"what\": \"" << what << "\", \"photographs\": " << p.photographs
+          << ", \"mean_de00\": " << p.mean / p.cases << ", \"max_de00\": " << p.max / p.cases << ", \"worst_max_de00\": " << p.worst
+          << ", \"cases\": " << p.cases << "}";
+        first = false;
+      }
+      f << "\n  ]\n}\n";
+      if (!f) {
+        std::cerr << "could not write " << pareto->string() << "\n";
+        return 1;
+      }
+    }
   }
   if (!keep) {
     std::error_code ec;

@@ -238,6 +238,37 @@ TEST(AnalysisSpline, LeaveOneOutMatchesExplicitRefitsAndInterpolatesWithoutSmoot
   EXPECT_NEAR((fitted.predict_target(probe) - probe * M.transpose()).cwiseAbs().maxCoeff(), 0, 1e-6);
 }
 
+// The λ search through one generalised eigendecomposition is the same algebra as the LU per λ it replaced (issue 26:
+// the across-lamps fit's speed): the same λ, the same coefficients and the same exact LOO errors, to rounding, under
+// every fit target (their patch weights differ, which is what the eigenproblem's right-hand matrix carries).
+TEST(AnalysisSpline, EigenSmoothingSearchAgreesWithOneSolvePerLambda) {
+  ca::ChartData c = synthetic_chart(90, 5);
+  c.xyz.resize(90, 3);
+  std::mt19937 rng(3);
+  std::normal_distribution<double> noise(0, 0.2);
+  for (Eigen::Index i = 0; i < 90; ++i) {
+    const double r = c.rgb(i, 0), g = c.rgb(i, 1), b = c.rgb(i, 2);
+    c.xyz.row(i) << 40 * r + 30 * g + 15 * b + 5 * std::sin(3 * r * g) + noise(rng),
+        20 * r + 70 * g + 10 * b + 4 * std::cos(2 * b) + noise(rng), 2 * r + 10 * g + 90 * b + 3 * r * b + noise(rng);
+  }
+  c.lab = ca::xyz_rows_to_lab(c.xyz, c.white);
+  for (const auto target : {ca::FitTarget::xyz_then_lab, ca::FitTarget::xyz_lightness_weighted, ca::FitTarget::lab_direct}) {
+    ca::SplineOptions direct;
+    direct.input_scale = 1.0;
+    direct.target = target;
+    direct.search = ca::SmoothingSearch::direct;
+    ca::SplineOptions eigen = direct;
+    eigen.search = ca::SmoothingSearch::eigen;
+    const auto a = ca::fit_spline(c, direct), b = ca::fit_spline(c, eigen);
+    const std::string what = ca::to_string(target);
+    EXPECT_EQ(a.smoothing(), b.smoothing()) << what;
+    EXPECT_NEAR(a.effective_parameters(), b.effective_parameters(), 1e-6) << what;
+    EXPECT_LT((a.apply(c.rgb) - b.apply(c.rgb)).cwiseAbs().maxCoeff(), 1e-6) << what;
+    const auto ra = ca::spline_report(c, direct, ca::CvSpec::loo()), rb = ca::spline_report(c, eigen, ca::CvSpec::loo());
+    for (std::size_t i = 0; i < c.size(); ++i) EXPECT_NEAR(ra.cv.de00[i], rb.cv.de00[i], 1e-6) << what << " patch " << i;
+  }
+}
+
 // §7.4 on synthetic data: Canon 20D sensitivities × D65 × SG spectra, 0.5 % noise.
 TEST(AnalysisBlackBox, RecoversCanon20dCurvesFromNoisyRaw) {
   COLORLAB_REQUIRE_SHARED(ssf_file, "camera_ssf_canon_eos_20d_camspec_10nm_400_720.csv");

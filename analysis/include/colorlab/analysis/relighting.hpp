@@ -74,12 +74,13 @@ SensitivityEstimate estimate_sensitivities(const ChartUnderLamp& photographed, c
 
 struct AcrossLampsOptions {
   // Every family, as under the photographed lamp. (Only the five LOO chose on predicted charts — ccm, rootpoly:2–4,
-  // rbf:ccm — cost the same CPU time: the spline's λ search dominates either way.)
+  // rbf:ccm — cost about the same CPU time: the spline's λ search dominated, before it shared one decomposition.)
   std::vector<std::string> methods = all_methods();
   std::vector<FitTarget> targets = {FitTarget::xyz_then_lab, FitTarget::xyz_lightness_weighted, FitTarget::lab_direct};
   CvSpec cv = CvSpec::loo();
   int draws = 40;      // posterior draws propagated to the per-patch uncertainty
   unsigned seed = 1;   // of the draws: a characterization is reproducible
+  SmoothingSearch spline_search = SmoothingSearch::eigen;  // direct: the reference path (bench A/B)
 };
 
 // One characterization per lamp, named by it.

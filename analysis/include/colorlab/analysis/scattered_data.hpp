@@ -34,6 +34,7 @@ struct SplineOptions {
   // λ is the smoothest grid value whose LOO mean ΔE00 is within this of the best λ's; unset = one standard error of
   // the best λ's mean (the one-standard-error rule of Breiman et al. 1984).
   std::optional<double> smoothing_tolerance;                      // log-spaced grid
+  SmoothingSearch search = SmoothingSearch::eigen;  // same λ and fit either way, to rounding; eigen is ~10× cheaper
 };
 
 class SplineModel {
@@ -49,7 +50,7 @@ class SplineModel {
   std::string describe() const;  // "r³ spline over ccm (λ …, … effective parameters)"
 
  private:
-  friend SplineModel fit_spline(const ChartData&, const SplineOptions&);
+  friend struct SplineFitter;  // scattered_data.cpp: the fit, with the smoother's leverages for the report
   std::string method_;
   TermSet base_;
   FitTarget target_ = FitTarget::xyz_then_lab;

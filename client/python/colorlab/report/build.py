@@ -6,6 +6,7 @@ import sys
 
 from . import appendix, cabinet_grid, characterization, common, exposure, fetch, frame_average, imaging_meter, pareto, stability, summaries
 from . import verification
+from . import across_lamps  # issue 26
 from .html import document, esc
 
 TITLES = {
@@ -45,7 +46,8 @@ def section_for(run) -> str:
 # Speed against accuracy and stability (issue 11): after the campaign's own section, each on its own.
 EXTRAS = {"frame-average": (pareto.frames_section,), "cabinet-grid": (pareto.luminance_section,),
           "luminance-spot": (pareto.luminance_section,),
-          "characterize-camera": (pareto.characterization_section, stability.section, appendix.section)}
+          "characterize-camera": (pareto.characterization_section, stability.section, across_lamps.section,
+                                  appendix.section)}
 
 
 def extras(run, kind) -> str:
