@@ -7,8 +7,8 @@ object of SIZE_MB random bytes under sha256/<hex> and its catalog row. Then, in 
 downloads it to /dev/null:
   A  straight from the bucket (a GET signed with SigV4 here, the headers handed to curl);
   B  through colorlab-central (GET /v1/blobs/<hex>, which relays the bucket's answer as it comes).
-curl's own %{speed_download} is the figure; central's peak resident memory (VmHWM) after all rounds shows
-whether it held the object (it must stay far below SIZE_MB).
+curl's own %{speed_download} is the figure; central's peak resident memory (VmHWM) when started and after all
+rounds shows whether it held the object (the growth must stay far below SIZE_MB).
 
 Usage: nice -n 10 python3 bench/fleet/blob_speed.py --build build [--size-mb 256] [--rounds 3]
 Run as root (initdb runs as the `postgres` user), Swift and memcached installed. Prints one JSON document.
@@ -142,6 +142,12 @@ def main():
                                    stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
         central_url = json.loads(central.stdout.readline())["url"]
 
+        def peak_rss_mb():
+            with open(f"/proc/{central.pid}/status") as f:
+                return round(int(next(line.split()[1] for line in f if line.startswith("VmHWM"))) / 1024, 1)
+
+        idle_rss = peak_rss_mb()
+
         rounds = []
         for _ in range(a.rounds):
             load = os.getloadavg()
@@ -154,11 +160,10 @@ def main():
                     raise SystemExit(f"a download got {r['bytes']} bytes of {size}")
             rounds.append({"bucket_curl": direct, "central": relayed,
                            "ratio": round(relayed["mb_per_s"] / direct["mb_per_s"], 3), "loadavg_before": load})
-        with open(f"/proc/{central.pid}/status") as f:
-            hwm = next(line.split()[1] for line in f if line.startswith("VmHWM"))
         print(json.dumps({"size_mb": a.size_mb, "rounds": rounds,
                           "mean_ratio": round(sum(r["ratio"] for r in rounds) / len(rounds), 3),
-                          "central_peak_rss_mb": round(int(hwm) / 1024, 1), "loadavg_after": os.getloadavg()},
+                          "central_peak_rss_mb": {"started": idle_rss, "after_rounds": peak_rss_mb()},
+                          "loadavg_after": os.getloadavg()},
                          indent=1))
     finally:
         if central:

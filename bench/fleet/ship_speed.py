@@ -49,7 +49,7 @@ def main():
         data, port = start_postgres(root)
         conninfo = f"host=127.0.0.1 port={port} user=postgres"
         for name in ("ak", "sk"):
-            with open(os.path.join(state, name), "w") as f:
+            with open(os.path.join(root, name), "w") as f:  # beside the configs, which name them
                 f.write("unused\n")
 
         def config(db):
