@@ -36,8 +36,9 @@ HttpResponse get_blob(CentralContext& ctx, const HttpRequest& req, const PathPar
   if (req.method == "HEAD") return r;
   // Opened here, so a missing object or a refusing store is still a problem+json; the bytes follow as they come
   // from the store, about one S3Download::kPiece at a time, never the whole object or range in memory.
-  auto download = std::make_shared<S3Download>(ctx.s3, key, partial ? std::optional(std::pair(span.offset, span.offset + length - 1))
-                                                                    : std::nullopt);
+  std::optional<std::pair<std::uint64_t, std::uint64_t>> bytes;
+  if (partial) bytes = std::pair(span.offset, span.offset + length - 1);
+  auto download = std::make_shared<S3Download>(ctx.s3, key, bytes);
   r.stream = [download, length, partial, key, sha256](http::StreamWriter& out) -> boost::asio::awaitable<void> {
     // One piece is held back until the end: a whole object that does not hash to its name, or a body of the
     // wrong length, ends the connection short of its Content-Length, so the client never takes it as complete.
