@@ -79,13 +79,22 @@ def write_central(port, benches, runs, per_run):
       SELECT {ident}, 'bench-' || b, i, 'chart-read', '{{"chart":"sg"}}', 'finished_ok', 1, '[]',
              '2026-11-28T20:00:00.000Z', '2026-11-28T20:00:00.000Z', '2026-11-28T20:10:00.000Z', '{{}}', NULL, NULL, i
       FROM generate_series(1, {benches}) b, generate_series(1, {runs}) i""")
+    # Loaded without its primary key and index, which are built once afterwards (sorted, not row by row: the
+    # "Populating a Database" advice of PostgreSQL's manual), so 10 M rows take minutes rather than an hour; the
+    # table and its indexes end up as central-init defines them, which the check below confirms.
+    psql(port, "central", "ALTER TABLE measurements DROP CONSTRAINT measurements_pkey; "
+                          "DROP INDEX measurements_by_seq")
     psql(port, "central", f"""
+      SET synchronous_commit = off;
       INSERT INTO measurements (run_id, step, seq, instrument_id, simulated, quantity, value, unit, data, measured_at)
       SELECT r.id, 'patch/' || lpad(j::text, 5, '0'), (r.bench_seq - 1) * {per_run} + j, 'meter', 1, 'Y',
              (((r.bench_seq - 1) * {per_run} + j) % 1000)::float8 / 7.0, 'cd/m2', '{{"xyz":[1.5,2.5,3.5]}}',
              '2026-11-28T20:05:00.000Z'
       FROM runs r, generate_series(1, {per_run}) j""")
-    psql(port, "central", "ANALYZE")
+    psql(port, "central", "SET maintenance_work_mem = '1GB'; "
+                          "ALTER TABLE measurements ADD PRIMARY KEY (run_id, step); "
+                          "CREATE INDEX measurements_by_seq ON measurements (run_id, seq)")
+    psql(port, "central", "VACUUM ANALYZE")
 
 
 def write_bench(db_path, runs, per_run):
@@ -190,18 +199,41 @@ def main():
         central, central_url = start_central(build, root, port, a.threads)
         procs.append(central)
         rows = int(psql(port, "central", "SELECT count(*) FROM measurements"))
+        # Bytes per row for docs/fleet.md "Sizing": heap (with TOAST), each index, and the total.
+        sizes = {}
+        for table in ("measurements", "runs"):
+            heap, indexes, total, n = psql(port, "central", f"""
+              SELECT pg_table_size('{table}'), pg_indexes_size('{table}'), pg_total_relation_size('{table}'),
+                     (SELECT count(*) FROM {table})""").strip().split("|")
+            per_index = dict(line.split("|") for line in psql(port, "central", f"""
+              SELECT indexrelid::regclass, pg_relation_size(indexrelid) FROM pg_index
+              WHERE indrelid = '{table}'::regclass""").strip().splitlines())
+            sizes[table] = {"rows": int(n), "table_bytes": int(heap), "index_bytes": int(indexes),
+                            "total_bytes": int(total), "bytes_per_row": round(int(total) / int(n), 1),
+                            "indexes": {k: int(v) for k, v in per_index.items()}}
+        plans = {}
+        for name, sql in (("measurement page", f"SELECT seq, step, instrument_id, simulated, quantity, value, unit, "
+                                               f"data, measured_at FROM measurements WHERE run_id = "
+                                               f"'{run_id(1, a.runs // 2)}' AND seq > 0 ORDER BY seq LIMIT 501"),
+                          ("run listing", "SELECT r.id FROM runs r JOIN benches b ON b.id = r.bench_id "
+                                          "ORDER BY r.id DESC LIMIT 51")):
+            plans[name] = psql(port, "central", "EXPLAIN (ANALYZE, BUFFERS, TIMING OFF) " + sql).strip().splitlines()
         middle = run_id(1, a.runs // 2)
         routes = {"run listing, 50 a page": "/v1/runs?limit=50",
                   "measurement page, 500 a page": f"/v1/runs/{middle}/measurements?limit=500"}
         results = {name: {"bench": [], "central": []} for name in routes}
+        load_before = os.getloadavg()
         for _ in range(a.rounds):
             for name, path in routes.items():
                 for side, url in (("bench", bench_url), ("central", central_url)):
-                    results[name][side].append(wrk(url + path, a.seconds))
+                    r = wrk(url + path, a.seconds)
+                    r["loadavg_1min"] = round(os.getloadavg()[0], 1)  # the machine is shared: say its load
+                    results[name][side].append(r)
         print(json.dumps({"central_measurements": rows, "benches": a.benches, "runs_per_bench": a.runs,
                           "bench_measurements": a.runs * a.measurements, "central_threads": a.threads,
                           "load_seconds": {"central_sql": round(t1 - t0, 1), "bench_sqlite": round(t2 - t1, 1)},
-                          "loadavg_after": os.getloadavg(), "results": results}, indent=1))
+                          "loadavg_before": load_before, "loadavg_after": os.getloadavg(), "sizes": sizes,
+                          "plans": plans, "results": results}, indent=1))
     finally:
         for p in procs:
             p.kill()

@@ -1,13 +1,14 @@
 // GET /v1/blobs/{sha256} on central: the object sha256/<hex> from the bucket, with the bench's headers and rules
 // (daemon/api/src/routes/blob_routes.cpp): a strong ETag that is the name, If-None-Match answered from the
-// catalog without touching the bucket, one Range passed on to the store as a ranged GET, If-Range, 416.
+// catalog without touching the bucket, one Range passed on to the store as a ranged GET, If-Range, 416. The body
+// is relayed as the store sends it (S3Download), with the catalog's length as its Content-Length.
 
 #include "central_routes.hpp"
-#include "colorlab/api/conditional.hpp"
-#include "colorlab/api/problem.hpp"
 #include "colorlab/core/error.hpp"
 #include "blob_headers.hpp"
 #include "colorlab/store/blob_store.hpp"
+
+#include <memory>
 
 namespace colorlab::fleet::central_routes {
 
@@ -23,48 +24,43 @@ HttpResponse get_blob(CentralContext& ctx, const HttpRequest& req, const PathPar
     blob = central_blob(*pg, sha256);
   }
   if (!blob) throw Error(ErrorClass::not_found, "central holds no blob " + sha256, "GET /v1/runs/{id}/blobs lists a run's blobs");
-  const std::uint64_t size = blob->size;
-  const std::string etag = "\"" + sha256 + "\"";
-  HttpResponse r;
-  r.content_type = blob->media_type;
-  daemon::describe_blob(r, *blob, etag);
-  if (auto inm = req.header("if-none-match"); inm && daemon::none_match_hits(*inm, etag)) {
-    r.status = 304;
-    return r;
-  }
-  daemon::ByteRange range;
-  if (auto h = req.header("range")) {
-    range = daemon::parse_byte_range(*h, size);
-    if (auto ir = req.header("if-range"); ir && daemon::trim_ows(*ir) != etag) range.kind = daemon::ByteRange::Kind::whole;
-  }
-  if (range.kind == daemon::ByteRange::Kind::unsatisfiable) {
-    auto p = daemon::problem_response(416, "range-not-satisfiable", "Range not satisfiable",
-                                      "blob " + sha256 + " has " + std::to_string(size) +
-                                          " bytes; the range asked for starts beyond them");
-    daemon::describe_blob(p, *blob, etag);
-    p.headers["Content-Range"] = "bytes */" + std::to_string(size);
-    return p;
-  }
   const std::string key = "sha256/" + sha256;
-  // A HEAD fetches the bytes too: the server sets Content-Length from the body it then drops.
-  if (range.kind == daemon::ByteRange::Kind::partial) {
-    r.status = 206;
-    r.headers["Content-Range"] =
-        "bytes " + std::to_string(range.first) + "-" + std::to_string(range.last) + "/" + std::to_string(size);
-    r.body = ctx.s3.get_part(key, std::pair(range.first, range.last));
-    if (r.body.size() != range.last - range.first + 1) {
-      throw Error(ErrorClass::io_error, "the bucket answered " + std::to_string(r.body.size()) + " bytes of " + key +
-                                            " for a range of " + std::to_string(range.last - range.first + 1));
+  HttpResponse r;
+  const daemon::BlobSpan span = daemon::answer_blob(r, req, *blob, blob->size);
+  if (!span.body_needed) return r;
+  const bool partial = span.partial;
+  const std::uint64_t length = span.length;
+  // The length is the catalog's (the server sends the stream unchunked with it); a HEAD is answered without
+  // touching the bucket.
+  r.headers["Content-Length"] = std::to_string(length);
+  if (req.method == "HEAD") return r;
+  // Opened here, so a missing object or a refusing store is still a problem+json; the bytes follow as they come
+  // from the store, about one S3Download::kPiece at a time, never the whole object or range in memory.
+  std::optional<std::pair<std::uint64_t, std::uint64_t>> bytes;
+  if (partial) bytes = std::pair(span.offset, span.offset + length - 1);
+  auto download = std::make_shared<S3Download>(ctx.s3, key, bytes);
+  r.stream = [download, length, partial, key, sha256](http::StreamWriter& out) -> boost::asio::awaitable<void> {
+    // One piece is held back until the end: a whole object that does not hash to its name, or a body of the
+    // wrong length, ends the connection short of its Content-Length, so the client never takes it as complete.
+    // Central never hands out bytes the bucket let rot.
+    std::string held;
+    for (;;) {
+      std::string piece = download->next();
+      if (piece.empty()) break;
+      if (download->delivered() > length) break;
+      if (!held.empty() && !co_await out.send(held)) co_return;
+      held = std::move(piece);
     }
-    return r;
-  }
-  r.status = 200;
-  r.body = ctx.s3.get_part(key, std::nullopt);
-  // The whole object is checked against its name: central never hands out bytes the bucket let rot.
-  if (r.body.size() != size || sha256_hex(r.body) != sha256) {
-    throw Error(ErrorClass::io_error, "the bucket's object " + key + " does not hash to its name",
-                "re-ship it from a bench that holds it (colorlab-ship uploads a missing or damaged object again)");
-  }
+    if (download->delivered() != length) {
+      throw Error(ErrorClass::io_error, "the bucket answered " + std::to_string(download->delivered()) +
+                                            " bytes or more of " + key + " for " + std::to_string(length));
+    }
+    if (!partial && download->sha256_hex() != sha256) {
+      throw Error(ErrorClass::io_error, "the bucket's object " + key + " does not hash to its name",
+                  "re-ship it from a bench that holds it (colorlab-ship uploads a missing or damaged object again)");
+    }
+    co_await out.send(held);
+  };
   return r;
 }
 

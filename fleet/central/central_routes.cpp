@@ -104,8 +104,10 @@ HttpResponse get_run_measurements(CentralContext& ctx, const HttpRequest& req, c
   store::MeasurementFilter filter{query_or_empty(req, "step_prefix"), query_or_empty(req, "quantity"),
                                   query_or_empty(req, "instrument")};
   auto pg = ctx.pool.lease();
-  require_run(*pg, id);  // an unknown run is a 404, not an empty page
   auto page = central_measurements_page(*pg, id, filter, after, limit);
+  // An unknown run is a 404, not an empty page; a page with rows names a run central holds (measurements reference
+  // runs), so only an empty one costs the second query.
+  if (page.items.empty()) require_run(*pg, id);
   json items = json::array();
   for (const auto& m : page.items) items.push_back(m.to_json());
   json next = nullptr, next_link = nullptr;

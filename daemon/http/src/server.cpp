@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <charconv>
 #include <optional>
 #include <thread>
 #include <type_traits>
@@ -98,6 +99,17 @@ class Deadline {
   std::shared_ptr<bool> armed_;
 };
 
+// The Content-Length a handler named itself: a streaming response with one (a blob relayed from a bucket) is
+// sent with that length, unframed, its connection kept; a HEAD answers with it and never runs a stream.
+std::optional<std::uint64_t> stream_length(const HttpResponse& r) {
+  auto it = r.headers.find("Content-Length");
+  if (it == r.headers.end()) return std::nullopt;
+  std::uint64_t n = 0;
+  auto [end, ec] = std::from_chars(it->second.data(), it->second.data() + it->second.size(), n);
+  if (ec != std::errc() || end != it->second.data() + it->second.size()) return std::nullopt;
+  return n;
+}
+
 template <class Message>
 void set_common(Message& res, const HttpResponse& r, bool keep_alive, const std::string& server_name) {
   res.set(bhttp::field::server, server_name);
@@ -119,7 +131,7 @@ asio::awaitable<void> write_response(Stream& stream, const HttpResponse& r, unsi
   if (head) {
     bhttp::response<bhttp::empty_body> res{static_cast<bhttp::status>(r.status), version};
     set_common(res, r, keep_alive, shared.options.server_name);
-    res.content_length(r.body.size());
+    res.content_length(stream_length(r).value_or(r.body.size()));
     bhttp::response_serializer<bhttp::empty_body> sr{res};
     co_await bhttp::async_write_header(stream, sr, asio::redirect_error(asio::use_awaitable, ec));
     co_return;
@@ -211,43 +223,68 @@ asio::awaitable<void> write_file_response(Stream& stream, const HttpResponse& r,
 template <class Stream>
 class ChunkWriter final : public StreamWriter {
  public:
-  ChunkWriter(Stream& stream, std::chrono::milliseconds timeout) : stream_(stream), timeout_(timeout) {}
+  // `length`: a body of known length is written as it comes, unframed; never more than announced.
+  ChunkWriter(Stream& stream, std::chrono::milliseconds timeout, std::optional<std::uint64_t> length = std::nullopt)
+      : stream_(stream), timeout_(timeout), length_(length) {}
 
   asio::awaitable<bool> send(std::string_view chunk) override {
     if (!ok_) co_return false;
     if (chunk.empty()) co_return true;
     Deadline<Stream> deadline(stream_, timeout_);
     error_code ec;
-    co_await asio::async_write(stream_, bhttp::make_chunk(asio::buffer(chunk.data(), chunk.size())),
-                               asio::redirect_error(asio::use_awaitable, ec));
+    if (length_) {
+      if (chunk.size() > *length_ - sent_) {
+        ok_ = false;
+        co_return false;
+      }
+      co_await asio::async_write(stream_, asio::buffer(chunk.data(), chunk.size()),
+                                 asio::redirect_error(asio::use_awaitable, ec));
+    } else {
+      co_await asio::async_write(stream_, bhttp::make_chunk(asio::buffer(chunk.data(), chunk.size())),
+                                 asio::redirect_error(asio::use_awaitable, ec));
+    }
     if (ec) ok_ = false;
+    sent_ += chunk.size();
     co_return ok_;
   }
   bool ok() const { return ok_; }
+  bool complete() const { return ok_ && length_ && sent_ == *length_; }
 
  private:
   Stream& stream_;
   std::chrono::milliseconds timeout_;
+  std::optional<std::uint64_t> length_;
+  std::uint64_t sent_ = 0;
   bool ok_ = true;
 };
 
 template <class Stream>
-asio::awaitable<void> write_stream_response(Stream& stream, const HttpResponse& r, unsigned version,
+asio::awaitable<void> write_stream_response(Stream& stream, const HttpResponse& r, unsigned version, bool keep_alive,
                                             const Shared& shared, error_code& ec) {
+  const std::optional<std::uint64_t> length = stream_length(r);
   bhttp::response<bhttp::empty_body> res{static_cast<bhttp::status>(r.status), version};
-  set_common(res, r, false, shared.options.server_name);
-  res.chunked(true);
+  set_common(res, r, length && keep_alive, shared.options.server_name);
+  if (length) {
+    res.content_length(*length);
+  } else {
+    res.chunked(true);
+  }
   bhttp::response_serializer<bhttp::empty_body> sr{res};
   {
     Deadline<Stream> deadline(stream, shared.options.idle_timeout);
     co_await bhttp::async_write_header(stream, sr, asio::redirect_error(asio::use_awaitable, ec));
   }
   if (ec) co_return;
-  ChunkWriter<Stream> writer(stream, shared.options.stream_write_timeout);
+  ChunkWriter<Stream> writer(stream, shared.options.stream_write_timeout, length);
   try {
     co_await r.stream(writer);
   } catch (const std::exception& e) {
     log::warning("http", std::string("a streaming response ended early: ") + e.what());
+  }
+  if (length) {
+    // Short of its Content-Length, the body can only end by closing: the client sees it truncated.
+    if (!writer.complete()) ec = asio::error::eof;
+    co_return;
   }
   if (writer.ok()) {
     Deadline<Stream> deadline(stream, shared.options.idle_timeout);
@@ -328,7 +365,7 @@ asio::awaitable<void> session(Stream stream, Peer peer, std::shared_ptr<Shared> 
       r.headers.try_emplace("Strict-Transport-Security", "max-age=31536000");
     }
     if (r.stream && !head) {
-      co_await write_stream_response(stream, r, version, *shared, ec);
+      co_await write_stream_response(stream, r, version, keep_alive, *shared, ec);
     } else if (r.file) {
       co_await write_file_response(stream, r, version, keep_alive, head, *shared, ec);
     } else {

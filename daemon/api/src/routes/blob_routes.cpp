@@ -50,37 +50,9 @@ HttpResponse serve_blob(ApiContext& ctx, const HttpRequest& req, const std::stri
     throw Error(ErrorClass::not_found, "the file of blob " + sha256 + " is missing from the blob store",
                 "GET /v1/blobs/check lists what the store lacks");
   }
-  const std::string etag = "\"" + sha256 + "\"";
   HttpResponse r;
-  r.content_type = blob.media_type;
-  describe_blob(r, blob, etag);
-  if (auto inm = req.header("if-none-match"); inm && none_match_hits(*inm, etag)) {
-    r.status = 304;
-    return r;
-  }
-  ByteRange range;
-  if (auto h = req.header("range")) {
-    range = parse_byte_range(*h, size);
-    // If-Range compares strongly: a weak or another tag (or a date: ours never changes, yet we
-    // have no Last-Modified to compare with) means "send it whole".
-    if (auto ir = req.header("if-range"); ir && trim_ows(*ir) != etag) range.kind = ByteRange::Kind::whole;
-  }
-  if (range.kind == ByteRange::Kind::unsatisfiable) {
-    auto p = problem_response(416, "range-not-satisfiable", "Range not satisfiable",
-                                   "blob " + sha256 + " has " + std::to_string(size) + " bytes; the range asked for starts beyond them");
-    describe_blob(p, blob, etag);
-    p.headers["Content-Range"] = "bytes */" + std::to_string(size);
-    return p;
-  }
-  r.status = 200;
-  std::uint64_t offset = 0, length = size;
-  if (range.kind == ByteRange::Kind::partial) {
-    r.status = 206;
-    offset = range.first;
-    length = range.last - range.first + 1;
-    r.headers["Content-Range"] = "bytes " + std::to_string(range.first) + "-" + std::to_string(range.last) + "/" + std::to_string(size);
-  }
-  r.file = http::FileSpan{path, offset, length};
+  const BlobSpan span = answer_blob(r, req, blob, size);
+  if (span.body_needed) r.file = http::FileSpan{path, span.offset, span.length};
   return r;
 }
 

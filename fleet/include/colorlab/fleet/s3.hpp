@@ -4,6 +4,7 @@
 // (a SigV4 store answers 400 BadDigest on a mismatch). Keys are held only here and never appear in messages.
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -36,6 +37,7 @@ class S3Client {
   void remove(const std::string& key);
 
  private:
+  friend class S3Download;
   struct Reply {
     long status = 0;
     std::string body;
@@ -46,6 +48,29 @@ class S3Client {
   std::string endpoint_, bucket_, region_;
   S3Credentials credentials_;
   long stall_timeout_s_ = 30;
+};
+
+// One GET read piece by piece, so colorlab-central relays an object of any size holding about kPiece bytes of it
+// at a time (never the whole object or range). One thread at a time; next() blocks that thread until a piece has
+// come or the transfer ended (a stall below 1 KiB/s for 30 s ends it, as every request of S3Client).
+class S3Download {
+ public:
+  static constexpr std::size_t kPiece = 256 * 1024;
+  // Starts the GET and waits for the store's status: Error{not_found} on 404, and as S3Client::get_part for any
+  // status other than 200 (206 with a range).
+  S3Download(S3Client& client, const std::string& key, std::optional<std::pair<std::uint64_t, std::uint64_t>> range);
+  ~S3Download();
+  S3Download(const S3Download&) = delete;
+  S3Download& operator=(const S3Download&) = delete;
+  // The next piece of the body (up to about kPiece bytes), empty at its end; Error{no_comms} when the transfer broke.
+  std::string next();
+  // SHA-256 (hex) of every byte next() has handed out: after the last piece, the object's hash.
+  std::string sha256_hex() const;
+  std::uint64_t delivered() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
 };
 
 // SHA-256 of bytes, lower-case hex.
