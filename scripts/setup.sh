@@ -46,6 +46,8 @@ packages=(
   blender python3-openimageio
   # renderings verified against the lab (verify/io, issue 23): OpenEXR 3.1, and OpenImageIO as the independent reader
   libopenexr-dev libimath-dev openimageio-tools python3-openimageio
+  # verify/io's own ZIP chunk decoder (docs/PERFORMANCE.md "Verifying a rendering"): libdeflate inflates them
+  libdeflate-dev
 )
 
 missing=()
