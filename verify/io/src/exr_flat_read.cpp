@@ -13,6 +13,10 @@
 #include <mutex>
 #include <thread>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "io_detail.hpp"
 
 namespace colorlab::verify::detail {
@@ -26,18 +30,55 @@ struct Wanted {
   std::size_t index;   // its place in the Rendering's pixel
 };
 
-// OpenEXR's ZIP chunk after inflating: bytes as differences (+128) and split into even and odd halves
-// (OpenEXR's Zip::uncompress, the file format's definition). Undoes both into `out`.
+// OpenEXR's ZIP chunk after inflating: each byte stored as its difference from the previous one, + 128, and the
+// bytes split into the even-indexed half followed by the odd-indexed half (OpenEXR's Zip::uncompress, the format's
+// definition). Undoes both into `out`. The running sum is the serial part, so it goes 16 bytes at a time: a prefix
+// sum inside the vector by shifted adds, plus the previous vector's last byte (arithmetic mod 256 throughout).
 void unpredict_and_interleave(unsigned char* t, std::size_t n, unsigned char* out) {
-  for (std::size_t i = 1; i < n; ++i) t[i] = static_cast<unsigned char>(t[i - 1] + t[i] - 128);
+  if (n == 0) return;
+  std::size_t i = 1;
+#if defined(__SSE2__)
+  // (t − 128) mod 256 is t ^ 0x80; byte 0 is stored as it is, so it starts the sum unflipped.
+  __m128i carry = _mm_set1_epi8(static_cast<char>(t[0]));
+  const __m128i flip = _mm_set1_epi8(static_cast<char>(0x80));
+  for (; i + 16 <= n; i += 16) {
+    __m128i v = _mm_xor_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(t + i)), flip);
+    v = _mm_add_epi8(v, _mm_slli_si128(v, 1));
+    v = _mm_add_epi8(v, _mm_slli_si128(v, 2));
+    v = _mm_add_epi8(v, _mm_slli_si128(v, 4));
+    v = _mm_add_epi8(v, _mm_slli_si128(v, 8));
+    v = _mm_add_epi8(v, carry);
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(t + i), v);
+    carry = _mm_set1_epi8(static_cast<char>(t[i + 15]));
+  }
+#endif
+  for (; i < n; ++i) t[i] = static_cast<unsigned char>(t[i - 1] + t[i] - 128);
   const unsigned char* a = t;
   const unsigned char* b = t + (n + 1) / 2;
-  std::size_t i = 0;
-  for (; i + 1 < n; i += 2) {
-    out[i] = *a++;
-    out[i + 1] = *b++;
+  const std::size_t pairs = n / 2;
+  std::size_t k = 0;
+#if defined(__SSE2__)
+  for (; k + 16 <= pairs; k += 16) {
+    const __m128i va = _mm_loadu_si128(reinterpret_cast<const __m128i*>(a + k));
+    const __m128i vb = _mm_loadu_si128(reinterpret_cast<const __m128i*>(b + k));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(out + 2 * k), _mm_unpacklo_epi8(va, vb));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(out + 2 * k + 16), _mm_unpackhi_epi8(va, vb));
   }
-  if (i < n) out[i] = *a;
+#endif
+  for (; k < pairs; ++k) {
+    out[2 * k] = a[k];
+    out[2 * k + 1] = b[k];
+  }
+  if (n % 2) out[n - 1] = a[pairs];
+}
+
+// One scanline's wanted channels into the Rendering's interleaved pixels (stride `xs` bytes per pixel).
+void scatter(const unsigned char* line, const std::vector<Wanted>& wanted, std::size_t width, char* row, std::size_t xs) {
+  for (const auto& w : wanted) {
+    const unsigned char* src = line + w.offset;
+    char* dst = row + w.index * sizeof(float);
+    for (std::size_t x = 0; x < width; ++x) std::memcpy(dst + x * xs, src + x * sizeof(float), sizeof(float));
+  }
 }
 
 }  // namespace
@@ -126,11 +167,7 @@ bool read_flat_float_scanlines(Imf::InputPart& in, const Imf::Header& header, co
         for (std::size_t l = 0; l < lines; ++l) {
           char* row = base + static_cast<std::ptrdiff_t>(y0 + static_cast<long long>(l)) * static_cast<std::ptrdiff_t>(ys) +
                       static_cast<std::ptrdiff_t>(dw.min.x) * static_cast<std::ptrdiff_t>(xs);
-          for (const auto& w : wanted) {
-            const unsigned char* src = chunk + l * line_bytes + w.offset;
-            char* dst = row + w.index * sizeof(float);
-            for (std::size_t x = 0; x < width; ++x) std::memcpy(dst + x * xs, src + x * sizeof(float), sizeof(float));
-          }
+          scatter(chunk + l * line_bytes, wanted, width, row, xs);
         }
       }
     } catch (...) {
