@@ -15,6 +15,7 @@ using http::HttpResponse;
 HttpResponse get_root(ApiContext& ctx, const HttpRequest& req, const PathParams& params);
 HttpResponse get_instruments(ApiContext& ctx, const HttpRequest& req, const PathParams& params);
 HttpResponse get_ports(ApiContext& ctx, const HttpRequest& req, const PathParams& params);
+HttpResponse get_lab_cabinet(ApiContext& ctx, const HttpRequest& req, const PathParams& params);
 HttpResponse get_campaigns(ApiContext& ctx, const HttpRequest& req, const PathParams& params);
 
 // event_routes.cpp: the event log, paged and live.
