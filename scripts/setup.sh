@@ -48,6 +48,8 @@ packages=(
   libopenexr-dev libimath-dev openimageio-tools python3-openimageio
   # colorlab-ship's fault tests (tests/fleet/ship_faults_test.cpp): the network cut by killing a socat TCP proxy
   socat
+  # verify/io's own ZIP chunk decoder (docs/PERFORMANCE.md "Verifying a rendering"): libdeflate inflates them
+  libdeflate-dev
 )
 
 missing=()

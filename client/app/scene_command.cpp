@@ -1,5 +1,6 @@
 #include "scene_command.hpp"
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -8,6 +9,7 @@
 
 #include "client_support.hpp"
 #include "colorlab/core/error.hpp"
+#include "colorlab/verify/cabinet_json.hpp"
 #include "colorlab/verify/cabinet_toml.hpp"
 #include "colorlab/verify/scene_export.hpp"
 
@@ -45,6 +47,23 @@ json load_run(const GlobalOptions& g, const std::string& run) {
   return json::parse(r.body);
 }
 
+bool is_file(const std::string& run) {
+  std::error_code ec;
+  return fs::is_regular_file(run, ec);
+}
+
+// --lab FILE; else the daemon's own [cabinet] when the runs come from it (the lab's box, not a guess); else, for
+// run files made away from the daemon, the built-in cabinet. Says which.
+std::pair<verify::CabinetGeometry, std::string> choose_cabinet(const GlobalOptions& g, const SceneOptions& o) {
+  if (!o.lab.empty()) return {verify::cabinet_from_file(o.lab), "lab file " + o.lab};
+  if (std::all_of(o.runs.begin(), o.runs.end(), is_file)) return {verify::default_cabinet(), "built-in"};
+  const json answer = json::parse(fetch_bytes(g, "/v1/lab/cabinet").body);
+  if (!answer.is_object() || !answer.contains("cabinet"))
+    throw Error(ErrorClass::bad_data, "GET /v1/lab/cabinet: no cabinet in the daemon's answer", "give the cabinet with --lab FILE");
+  return {verify::cabinet_from_json(answer["cabinet"], "GET /v1/lab/cabinet"),
+          "daemon (" + answer.value("source", std::string("?")) + ")"};
+}
+
 }  // namespace
 
 void add_scene_command(CLI::App& app, GlobalOptions& global) {
@@ -56,13 +75,15 @@ void add_scene_command(CLI::App& app, GlobalOptions& global) {
   cmd->add_option("runs", o->runs, "a chart-read run and, for the lamps' levels, a cabinet-grid run (ids or JSON export files)")
       ->required();
   cmd->add_option("-o,--output", o->output, "directory to write (created)")->required();
-  cmd->add_option("--lab", o->lab, "TOML file whose [cabinet] table describes the cabinet (default: the built-in cabinet)");
+  cmd->add_option("--lab", o->lab,
+                  "TOML file whose [cabinet] table describes the cabinet (default: the daemon's [cabinet] when runs come "
+                  "from it, else the built-in cabinet)");
   cmd->add_option("--lamp", o->lamps, "lamp to light (repeatable; default: those the cabinet-grid run measured)");
   cmd->add_option("--dimmer", o->dimmer, "dimmer level whose LS-110 readings set the lamps' levels (%)")
       ->check(CLI::Range(0.0, 100.0))
       ->capture_default_str();
   cmd->callback([&global, o] {
-    const verify::CabinetGeometry cabinet = o->lab.empty() ? verify::default_cabinet() : verify::cabinet_from_file(o->lab);
+    const auto [cabinet, cabinet_source] = choose_cabinet(global, *o);
     std::vector<json> runs;
     for (const auto& r : o->runs) runs.push_back(load_run(global, r));
     const json scene = verify::export_scene(cabinet, runs, {o->lamps, o->dimmer});
@@ -71,13 +92,14 @@ void add_scene_command(CLI::App& app, GlobalOptions& global) {
     for (const auto& l : scene["lamps"]) lamps.push_back({{"name", l["name"]}, {"luminance_cd_m2", l["luminance_cd_m2"]},
                                                            {"level", l["level"]["source"]}});
     json done{{"directory", o->output}, {"files", {"scene.json", "build_scene.py"}}, {"lamps", lamps},
-              {"patches", scene["chart"]["patches"].size()}};
+              {"patches", scene["chart"]["patches"].size()}, {"cabinet", cabinet_source}};
     print(global, done, [](const json& j) {
       std::string s = "wrote " + j["directory"].get<std::string>() + "/scene.json and build_scene.py (" +
                       std::to_string(j["patches"].get<std::size_t>()) + " patches";
       for (const auto& l : j["lamps"])
         s += ", " + l["name"].get<std::string>() + " " + std::to_string(l["luminance_cd_m2"].get<double>()) + " cd/m² (" +
              l["level"].get<std::string>() + ")";
+      s += "; cabinet: " + j["cabinet"].get<std::string>();
       return s + ")\nrender: blender -b --factory-startup -noaudio -P " + j["directory"].get<std::string>() +
              "/build_scene.py -- --mode bands\n";
     });

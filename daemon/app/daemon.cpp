@@ -39,6 +39,7 @@
 #include "colorlab/daemon/worker_pool.hpp"
 #include "colorlab/drivers/discovery_monitor.hpp"
 #include "colorlab/http/server.hpp"
+#include "colorlab/verify/cabinet_json.hpp"
 
 namespace colorlab::daemon {
 
@@ -221,6 +222,8 @@ Daemon::Daemon(DaemonConfig config) : impl_(std::make_unique<Impl>()) {
   d.api->control = d.access.lock.get();
   d.api->blobs = d.blobs.get();
   d.api->console_dir = shipped_console_dir();
+  d.api->cabinet = {{"source", d.config.cabinet ? "config" : "default"},
+                    {"cabinet", verify::cabinet_to_json(d.config.cabinet.value_or(verify::default_cabinet()))}};
   ReportService::Options report_options;
   report_options.directory = d.config.state_dir / "reports";
   report_options.unix_socket = d.config.socket_path();

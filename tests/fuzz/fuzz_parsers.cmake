@@ -67,6 +67,8 @@ function(colorlab_fuzz_group group)
     # table header such as `[)x]` (marzer/tomlplusplus PR #301; the shipped build answers a parse_error)
     # and an "unreachable" in its Unicode whitespace table (issues #190, #295; PR #305).
     list(APPEND libs colorlab::protocol colorlab_asio nlohmann_json::nlohmann_json PkgConfig::TOMLPP)
+    # [cabinet]: verify/scene's parser and validation, linked as built (not fuzzed here; its own tests cover it).
+    list(APPEND libs colorlab::verify_scene)
   elseif(group STREQUAL "campaign_engine")
     # The declaration sandbox and the `lab` table a script's top level sees, with the catalogue's
     # sequences: the engine's sources, fuzzed. The table is built from the lab's registry of calls

@@ -8,6 +8,7 @@
 
 #include "colorlab/core/error.hpp"
 #include "colorlab/protocol/api.hpp"
+#include "colorlab/verify/cabinet_toml.hpp"
 
 namespace colorlab::daemon {
 
@@ -309,6 +310,11 @@ static DaemonConfig from_toml(const toml::table& root, const std::filesystem::pa
       if (c.access.tls_certificate.has_value() != c.access.tls_private_key.has_value()) {
         bad(file, node.source(), "[access] needs both tls_certificate and tls_private_key, or neither");
       }
+    } else if (k == "cabinet") {
+      // The same table colorlab-sim's lab file and `colorlab scene --lab` read: one parser, one set of refusals.
+      auto t = node.as_table();
+      if (!t) bad(file, node.source(), "[cabinet] must be a table");
+      c.cabinet = verify::cabinet_from_toml(*t, file);
     } else if (k == "blobs") {
       parse_blobs(node, c.blobs, file);
     } else if (k == "ship") {

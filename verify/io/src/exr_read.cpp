@@ -1,5 +1,5 @@
-// OpenEXR → Rendering: every channel is a slice of one interleaved float buffer, so OpenEXR's own threads
-// decompress straight into the Rendering with no copy.
+// OpenEXR → Rendering: every channel is a slice of one interleaved float buffer, so the chunks decompress straight
+// into the Rendering with no copy — flat float ZIP/uncompressed files by exr_flat_read, the rest by OpenEXR's threads.
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
@@ -15,6 +15,7 @@
 #include <set>
 
 #include "colorlab/core/error.hpp"
+#include "exr_flat_read.hpp"
 #include "exr_threads.hpp"
 #include "io_detail.hpp"
 
@@ -154,12 +155,14 @@ Rendering read(const std::filesystem::path& file) {
   // OpenEXR addresses slices by absolute pixel coordinates: base + x·xs + y·ys must land on pixel (x − disp.min).
   char* base = reinterpret_cast<char*>(r.pixels.data()) - static_cast<std::ptrdiff_t>(disp.min.x) * static_cast<std::ptrdiff_t>(xs) -
                static_cast<std::ptrdiff_t>(disp.min.y) * static_cast<std::ptrdiff_t>(ys);
-  Imf::FrameBuffer fb;
-  for (std::size_t c = 0; c < layout.channels.size(); ++c)
-    fb.insert(layout.channels[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), xs, ys));
   Imf::InputPart in(mp, part);
-  in.setFrameBuffer(fb);
-  in.readPixels(dw.min.y, dw.max.y);
+  if (!read_flat_float_scanlines(in, header, layout.channels, base, xs, ys, file)) {
+    Imf::FrameBuffer fb;
+    for (std::size_t c = 0; c < layout.channels.size(); ++c)
+      fb.insert(layout.channels[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), xs, ys));
+    in.setFrameBuffer(fb);
+    in.readPixels(dw.min.y, dw.max.y);
+  }
 
   switch (r.encoding) {
     case Encoding::spectral:

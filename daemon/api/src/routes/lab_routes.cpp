@@ -1,4 +1,4 @@
-// The daemon and the lab as they are now: GET /v1, /v1/instruments, /v1/ports, /v1/campaigns.
+// The daemon and the lab as they are now: GET /v1, /v1/instruments, /v1/ports, /v1/campaigns, /v1/lab/cabinet.
 #include <nlohmann/json.hpp>
 
 #include "colorlab/daemon/executions.hpp"
@@ -66,6 +66,11 @@ HttpResponse get_ports(ApiContext& ctx, const HttpRequest&, const PathParams&) {
     for (const auto& d : ctx.discovery->present()) items.push_back(discovered_json(d));
   }
   return HttpResponse::json(200, {{"items", items}, {"hotplug", ctx.hotplug_status}});
+}
+
+// The cabinet's geometry from colorlabd's configuration (validated at start), for `colorlab scene`.
+HttpResponse get_lab_cabinet(ApiContext& ctx, const HttpRequest&, const PathParams&) {
+  return HttpResponse::json(200, ctx.cabinet);
 }
 
 }  // namespace colorlab::daemon::routes

@@ -4,6 +4,8 @@
 #include <filesystem>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "colorlab/campaigns/catalogue.hpp"
 #include "colorlab/campaigns/operator_desk.hpp"
 #include "colorlab/daemon/executions.hpp"
@@ -41,6 +43,8 @@ struct ApiContext {
   ControlLock* control = nullptr;  // /v1/control (control_routes.cpp)
   std::filesystem::path console_dir;  // the web console's static files, served at / (console_files.cpp)
   ReportService* reports = nullptr;   // GET /v1/runs/{id}/report (report_response.hpp)
+  // GET /v1/lab/cabinet: {source: "config" | "default", cabinet: cabinet_to_json(...)} (lab_routes.cpp)
+  nlohmann::json cabinet;
 };
 
 }  // namespace colorlab::daemon

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "colorlab/drivers/factory.hpp"
+#include "colorlab/verify/cabinet.hpp"
 
 namespace colorlab::daemon {
 
@@ -96,6 +97,10 @@ struct DaemonConfig {
   ApiConfig api;
   BlobConfig blobs;
   AccessConfig access;
+  // The light cabinet's geometry ([cabinet], docs/verify.md "The cabinet in the lab configuration"), validated when
+  // the file is read and served at GET /v1/lab/cabinet, so `colorlab scene` gets the lab's box without --lab.
+  // Absent: the built-in cabinet.
+  std::optional<verify::CabinetGeometry> cabinet;
 
   std::filesystem::path database_path() const;
   std::filesystem::path socket_path() const;
