@@ -28,7 +28,39 @@ pid_t pid_of(const std::string& name) {
   return static_cast<pid_t>(value);
 }
 
+// The pid in "colorlab-sim-<pid>.sock" or "colorlab-sim-<pid>-<name>.sock", or 0.
+pid_t socket_pid_of(const std::string& name) {
+  constexpr std::string_view kSock = ".sock";
+  if (name.size() <= kPrefix.size() + kSock.size()) return 0;
+  if (name.compare(0, kPrefix.size(), kPrefix) != 0) return 0;
+  if (name.compare(name.size() - kSock.size(), kSock.size(), kSock) != 0) return 0;
+  const char* first = name.data() + kPrefix.size();
+  const char* last = name.data() + name.size() - kSock.size();
+  long value = 0;
+  auto [end, ec] = std::from_chars(first, last, value);
+  if (ec != std::errc() || value <= 0 || (end != last && *end != '-')) return 0;
+  return static_cast<pid_t>(value);
+}
+
 }  // namespace
+
+std::vector<std::filesystem::path> reclaim_dead_sockets(const std::filesystem::path& dir) {
+  std::vector<std::filesystem::path> removed;
+  std::error_code ec;
+  std::filesystem::directory_iterator it(dir, ec), end;
+  if (ec) return removed;
+  const pid_t self = ::getpid();
+  for (; it != end; it.increment(ec)) {
+    if (ec) break;
+    const pid_t pid = socket_pid_of(it->path().filename().string());
+    if (pid == 0 || pid == self) continue;
+    std::error_code type_ec;
+    if (!it->is_socket(type_ec) || !process_is_gone(pid)) continue;
+    std::error_code rm_ec;
+    if (std::filesystem::remove(it->path(), rm_ec)) removed.push_back(it->path());
+  }
+  return removed;
+}
 
 std::filesystem::path default_capture_dir(const std::filesystem::path& root, pid_t pid) {
   return root / (std::string(kPrefix) + std::to_string(pid) + std::string(kSuffix));

@@ -11,6 +11,7 @@
 
 #include "colorlab/core/error.hpp"
 #include "colorlab/core/log.hpp"
+#include "colorlab/sim/capture_scratch.hpp"
 #include "colorlab/sim/control_channel.hpp"
 #include "colorlab/sim/lab.hpp"
 
@@ -45,6 +46,8 @@ int main(int argc, char** argv) {
     if (!control.empty()) config.control_socket = control;
     if (!scratch.empty()) config.scratch_dir = scratch;
 
+    // A simulator killed with SIGKILL leaves its default sockets behind; the next one removes them.
+    colorlab::sim::reclaim_dead_sockets(default_control_path().parent_path());
     boost::asio::io_context io{1};
     colorlab::sim::Lab lab(io, config);
     colorlab::sim::ControlChannel channel(io, config.control_socket.value_or(default_control_path()),

@@ -15,6 +15,7 @@
 #include "colorlab/sim/capture_scratch.hpp"
 #include "colorlab/testing/process.hpp"
 #include "colorlab/testing/temp_dir.hpp"
+#include "scoped_env.hpp"
 
 namespace fs = std::filesystem;
 using colorlab::testing::Process;
@@ -29,8 +30,13 @@ struct Sim {
   std::unique_ptr<Process> process;
   fs::path capture_dir;
 
+  fs::path dslr_socket;
+
   Sim(const TempDir& dir, const std::string& name) {
     std::ofstream(dir / "lab.toml") << kLab;
+    // The DSLR's socket goes to $XDG_RUNTIME_DIR when the configuration names none: this test's own.
+    fs::create_directories(dir / "run");
+    colorlab::testing::ScopedEnv env{{"XDG_RUNTIME_DIR", (dir / "run").string()}};
     process = std::make_unique<Process>(
         std::vector<std::string>{colorlab::testing::bin_path("colorlab-sim"), "--config", (dir / "lab.toml").string(),
                                  "--control", (dir / (name + ".sock")).string(), "--scratch-dir", (dir / "scratch").string()},
@@ -39,7 +45,10 @@ struct Sim {
     if (!line) throw std::runtime_error("colorlab-sim " + name + " did not announce itself (see " + (dir / (name + ".log")).string() + ")");
     const auto announcement = nlohmann::json::parse(*line);
     for (const auto& i : announcement["instruments"]) {
-      if (i.contains("capture_dir")) capture_dir = i["capture_dir"].get<std::string>();
+      if (i.contains("capture_dir")) {
+        capture_dir = i["capture_dir"].get<std::string>();
+        dslr_socket = i["port"].get<std::string>();
+      }
     }
     if (capture_dir.empty()) throw std::runtime_error("colorlab-sim " + name + " announced no DSLR capture_dir: " + *line);
   }
@@ -61,10 +70,14 @@ TEST(SimCaptureScratch, ASuccessorReclaimsAKilledSimulatorsFolderAndKeepsALiveOn
   killed.process->signal(SIGKILL);
   ASSERT_TRUE(killed.process->wait(std::chrono::seconds(20))) << "colorlab-sim did not die of SIGKILL within 20 s";
   ASSERT_TRUE(fs::is_directory(killed.capture_dir)) << "a SIGKILLed simulator cannot have removed its own folder";
+  ASSERT_EQ(killed.dslr_socket.parent_path(), dir / "run");
+  ASSERT_TRUE(fs::exists(killed.dslr_socket)) << "a SIGKILLed simulator cannot have removed its socket";
 
   Sim successor(dir, "successor");
   EXPECT_FALSE(fs::exists(killed.capture_dir)) << "the killed simulator's folder was not reclaimed";
   EXPECT_TRUE(fs::is_directory(live.capture_dir)) << "a live simulator's folder was removed";
+  EXPECT_FALSE(fs::exists(killed.dslr_socket)) << "the killed simulator's socket was not reclaimed";
+  EXPECT_TRUE(fs::exists(live.dslr_socket)) << "a live simulator's socket was removed";
   EXPECT_TRUE(fs::is_directory(successor.capture_dir));
   EXPECT_TRUE(fs::is_directory(dir / "scratch" / "colorlab-sim-12x-dslr"));
   EXPECT_TRUE(fs::exists(dir / "scratch" / "notes.txt"));

@@ -21,4 +21,9 @@ bool process_is_gone(pid_t pid);
 // Errors (a folder of another user, a vanished root) leave the folder and are not thrown.
 std::vector<std::filesystem::path> reclaim_dead_capture_dirs(const std::filesystem::path& root);
 
+// The same for the sockets a simulator makes when none is configured: <dir>/colorlab-sim-<pid>.sock (control)
+// and <dir>/colorlab-sim-<pid>-<name>.sock (dslr, relay), $XDG_RUNTIME_DIR or the temporary directory.
+// Only sockets are removed.
+std::vector<std::filesystem::path> reclaim_dead_sockets(const std::filesystem::path& dir);
+
 }  // namespace colorlab::sim
