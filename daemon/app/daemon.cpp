@@ -126,7 +126,7 @@ Daemon::Daemon(DaemonConfig config) : impl_(std::make_unique<Impl>()) {
 
   auto instrument_configs = d.config.instruments;
   if (d.config.simulator.enabled) {
-    d.sim = std::make_unique<EmbeddedSim>(default_sim_binary(), d.config.simulator);
+    d.sim = std::make_unique<EmbeddedSim>(default_sim_binary(), d.config.simulator, d.config.state_dir / "sim");
     for (auto& c : d.sim->instruments()) instrument_configs.push_back(std::move(c));
   }
   for (const auto& c : instrument_configs) {

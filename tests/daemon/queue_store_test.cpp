@@ -93,7 +93,7 @@ TEST(queue_store, MigrationFromVersionTwoKeepsTheDataAndAddsAStoppedEmptyQueue) 
     execution_id = store.create_execution(run).execution.id;
   }
   // The file as version 2 left it: no queue tables (nor the later call timings, nor executions' suspension).
-  exec_sql(path, "DROP TABLE queue_groups; DROP TABLE queue_items; DROP TABLE queue_state; DROP TABLE call_timings; DROP TABLE run_blobs; DROP TABLE blobs; DROP TABLE api_keys; ALTER TABLE executions DROP COLUMN suspension; PRAGMA user_version = 2;");
+  exec_sql(path, "DROP INDEX runs_by_campaign; DROP INDEX runs_by_status; ALTER TABLE runs DROP COLUMN list_summary; DROP TABLE queue_groups; DROP TABLE queue_items; DROP TABLE queue_state; DROP TABLE call_timings; DROP TABLE run_blobs; DROP TABLE blobs; DROP TABLE api_keys; ALTER TABLE executions DROP COLUMN suspension; PRAGMA user_version = 2;");
   Store store(path);
   {
     colorlab::store::Database db(path.string(), true);
@@ -329,7 +329,7 @@ TEST(queue_store, MigrationFromVersionFiveKeepsQueuedItemsWithoutReferences) {
   exec_sql(path,
            "DROP INDEX queue_items_by_group; DROP TABLE queue_groups; ALTER TABLE queue_items DROP COLUMN param_refs; "
            "ALTER TABLE queue_items DROP COLUMN group_id; ALTER TABLE queue_items DROP COLUMN step; "
-           "ALTER TABLE executions DROP COLUMN suspension; PRAGMA user_version = 5;");
+           "DROP INDEX runs_by_campaign; DROP INDEX runs_by_status; ALTER TABLE runs DROP COLUMN list_summary; ALTER TABLE executions DROP COLUMN suspension; PRAGMA user_version = 5;");
   Store store(path);
   {
     colorlab::store::Database db(path.string(), true);

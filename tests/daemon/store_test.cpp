@@ -349,7 +349,7 @@ TEST(Store, ASuspensionIsStoredWhileSuspendedAndClearedAfter) {
   }
   sqlite3* h = nullptr;
   ASSERT_EQ(sqlite3_open(path.c_str(), &h), SQLITE_OK);
-  ASSERT_EQ(sqlite3_exec(h, "ALTER TABLE executions DROP COLUMN suspension; PRAGMA user_version = 6;", nullptr, nullptr, nullptr),
+  ASSERT_EQ(sqlite3_exec(h, "DROP INDEX runs_by_campaign; DROP INDEX runs_by_status; ALTER TABLE runs DROP COLUMN list_summary; ALTER TABLE executions DROP COLUMN suspension; PRAGMA user_version = 6;", nullptr, nullptr, nullptr),
             SQLITE_OK);
   sqlite3_close(h);
   Store migrated(path);

@@ -7,6 +7,7 @@
 
 #include "colorlab/api/conditional.hpp"
 #include "colorlab/api/problem.hpp"
+#include "content_security.hpp"
 #include "colorlab/protocol/api.hpp"
 
 namespace colorlab::daemon {
@@ -82,6 +83,7 @@ std::optional<http::HttpResponse> serve_console(const http::HttpRequest& req, co
   // Revalidate every time: after an upgrade the browser must not mix old scripts with a new API.
   r.headers["Cache-Control"] = "no-cache";
   r.headers["X-Content-Type-Options"] = "nosniff";
+  r.headers["Content-Security-Policy"] = kConsolePolicy;
   if (auto inm = req.header("if-none-match"); inm && none_match_hits(*inm, etag)) {
     r.status = 304;
     r.content_type.clear();

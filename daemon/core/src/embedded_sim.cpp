@@ -29,8 +29,13 @@ std::filesystem::path default_sim_binary() {
 }
 
 EmbeddedSim::EmbeddedSim(const std::filesystem::path& sim_binary, const SimulatorConfig& config,
-                         std::chrono::milliseconds startup_timeout) {
+                         const std::filesystem::path& scratch_dir, std::chrono::milliseconds startup_timeout) {
   std::vector<std::string> args{sim_binary.string()};
+  if (!scratch_dir.empty()) {
+    std::error_code ec;
+    args.push_back("--scratch-dir");
+    args.push_back(std::filesystem::absolute(scratch_dir, ec).string());
+  }
   if (config.config) {
     args.push_back("--config");
     args.push_back(config.config->string());

@@ -182,6 +182,16 @@ CREATE TABLE queue_groups (
     R"sql(
 ALTER TABLE executions ADD COLUMN suspension TEXT;
 )sql",
+    // 7 -> 8: GET /v1/runs costs the same however many runs are kept (issue 27). The list reads a run's
+    // summary without the campaign script's own result (list_summary), which can be far larger than the
+    // rest of the row and was parsed and re-serialised for every listed run; and a filtered list walks an
+    // index of its campaign or status (newest first) instead of every run.
+    R"sql(
+ALTER TABLE runs ADD COLUMN list_summary TEXT;  -- JSON: summary without "script" (GET /v1/runs/{id} has that)
+UPDATE runs SET list_summary = json_remove(summary, '$.script') WHERE summary IS NOT NULL AND json_valid(summary);
+CREATE INDEX runs_by_campaign ON runs(campaign, seq);
+CREATE INDEX runs_by_status ON runs(status, seq);
+)sql",
 };
 
 int read_pragma_int(Database& db, const char* pragma) {

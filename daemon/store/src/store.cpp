@@ -486,12 +486,19 @@ nlohmann::json Store::measurement_summary(const std::string& run_id) {
 
 void Store::finish_run(const std::string& run_id, ExecutionStatus status, const nlohmann::json& summary,
                        const nlohmann::json& error) {
-  db_.prepare("UPDATE runs SET status = ?2, finished_at = ?3, summary = ?4, error = ?5 WHERE id = ?1")
+  std::optional<std::string> listed;
+  if (!summary.is_null()) {
+    nlohmann::json slim = summary;
+    if (slim.is_object()) slim.erase("script");
+    listed = slim.dump();
+  }
+  db_.prepare("UPDATE runs SET status = ?2, finished_at = ?3, summary = ?4, error = ?5, list_summary = ?6 WHERE id = ?1")
       .bind(1, std::string_view(run_id))
       .bind(2, protocol::to_string(status))
       .bind(3, std::string_view(now_iso8601()))
       .bind(4, summary.is_null() ? std::optional<std::string>() : std::optional<std::string>(summary.dump()))
       .bind(5, error.is_null() ? std::optional<std::string>() : std::optional<std::string>(error.dump()))
+      .bind(6, listed)
       .run();
 }
 
@@ -557,6 +564,10 @@ RunRecord Store::read_run(Statement& st) {
 
 static constexpr const char* kRunColumns =
     "seq, id, campaign, params, status, simulated, instruments, created_at, started_at, finished_at, summary, error, "
+    "script_sha256";
+// The list's: the same fields, the summary without the script's result (schema 7 -> 8).
+static constexpr const char* kRunListColumns =
+    "seq, id, campaign, params, status, simulated, instruments, created_at, started_at, finished_at, list_summary, error, "
     "script_sha256";
 
 std::optional<RunRecord> Store::run(const std::string& id) {
@@ -648,16 +659,21 @@ std::int64_t cursor_before(const std::optional<std::string>& cursor) {
 
 }  // namespace
 
+std::string run_list_sql(const RunFilter& filter) {
+  // Keyset paging on seq (the rowid): a page's cost does not grow with how far back it is. A filter is
+  // a plain equality (never "?3 = '' OR ..."), so SQLite can walk runs_by_campaign or runs_by_status.
+  std::string sql = std::string("SELECT ") + kRunListColumns + " FROM runs WHERE seq < ?1";
+  if (!filter.campaign.empty()) sql += " AND campaign = ?3";
+  if (!filter.status.empty()) sql += " AND status = ?4";
+  return sql + " ORDER BY seq DESC LIMIT ?2";
+}
+
 RunPage Store::runs(unsigned limit, const std::optional<std::string>& cursor, const RunFilter& filter) {
   std::int64_t before = cursor_before(cursor);
-  // Keyset paging: the cost of a page does not grow with how far back it is.
-  auto st = db_.prepare(std::string("SELECT ") + kRunColumns +
-                        " FROM runs WHERE seq < ?1 AND (?3 = '' OR campaign = ?3) AND (?4 = '' OR status = ?4)"
-                        " ORDER BY seq DESC LIMIT ?2");
-  st.bind(1, before)
-      .bind(2, static_cast<std::int64_t>(limit) + 1)
-      .bind(3, std::string_view(filter.campaign))
-      .bind(4, std::string_view(filter.status));
+  auto st = db_.prepare(run_list_sql(filter));
+  st.bind(1, before).bind(2, static_cast<std::int64_t>(limit) + 1);
+  if (!filter.campaign.empty()) st.bind(3, std::string_view(filter.campaign));
+  if (!filter.status.empty()) st.bind(4, std::string_view(filter.status));
   RunPage page;
   while (st.step()) page.runs.push_back(read_run(st));
   if (page.runs.size() > limit) {

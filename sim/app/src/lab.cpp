@@ -10,6 +10,7 @@
 
 #include "colorlab/core/log.hpp"
 #include "colorlab/sim/aravis/gv_fake_camera.hpp"
+#include "colorlab/sim/capture_scratch.hpp"
 #include "colorlab/sim/aravis/scene_fill.hpp"
 #include "colorlab/sim/camera/camera_model.hpp"
 #include "colorlab/sim/clock.hpp"
@@ -286,7 +287,14 @@ void Lab::start_dslr() {
   if (dc.capture_dir) {
     bc.capture_dir = *dc.capture_dir;
   } else {
-    d.dslr_temp_dir = std::filesystem::temp_directory_path() / ("colorlab-sim-" + std::to_string(::getpid()) + "-dslr");
+    const auto root = d.config.scratch_dir.value_or(std::filesystem::temp_directory_path());
+    std::error_code ec;
+    std::filesystem::create_directories(root, ec);
+    if (ec) throw Error(ErrorClass::io_error, "simulated DSLR: cannot create the scratch directory " + root.string() + ": " + ec.message(),
+                        "check colorlab-sim --scratch-dir (colorlabd: its state directory) and its permissions");
+    // A simulator killed with SIGKILL could not remove its card folder; its successor does.
+    for (const auto& gone : reclaim_dead_capture_dirs(root)) log::info("sim", "removed a killed simulator's DSLR folder " + gone.string());
+    d.dslr_temp_dir = default_capture_dir(root, ::getpid());
     bc.capture_dir = d.dslr_temp_dir;
   }
   d.dslr_model = std::make_shared<camera::CameraModel>(scene, cc);

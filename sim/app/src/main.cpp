@@ -11,6 +11,7 @@
 
 #include "colorlab/core/error.hpp"
 #include "colorlab/core/log.hpp"
+#include "colorlab/sim/capture_scratch.hpp"
 #include "colorlab/sim/control_channel.hpp"
 #include "colorlab/sim/lab.hpp"
 
@@ -30,10 +31,12 @@ int main(int argc, char** argv) {
   double time_scale = 0;
   long long seed = -1;
   std::string control;
+  std::string scratch;
   app.add_option("--config", config_file, "lab configuration (TOML); default: every instrument")->check(CLI::ExistingFile);
   app.add_option("--time-scale", time_scale, "simulated seconds per real second (overrides the config)");
   app.add_option("--seed", seed, "random seed (overrides the config)");
   app.add_option("--control", control, "control socket path");
+  app.add_option("--scratch-dir", scratch, "where the DSLR's card folder goes when [dslr] capture_dir is not set (default: the temporary directory)");
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -41,7 +44,10 @@ int main(int argc, char** argv) {
     if (time_scale > 0) config.time_scale = time_scale;
     if (seed >= 0) config.seed = static_cast<std::uint64_t>(seed);
     if (!control.empty()) config.control_socket = control;
+    if (!scratch.empty()) config.scratch_dir = scratch;
 
+    // A simulator killed with SIGKILL leaves its default sockets behind; the next one removes them.
+    colorlab::sim::reclaim_dead_sockets(default_control_path().parent_path());
     boost::asio::io_context io{1};
     colorlab::sim::Lab lab(io, config);
     colorlab::sim::ControlChannel channel(io, config.control_socket.value_or(default_control_path()),

@@ -7,6 +7,7 @@
 #include "colorlab/core/error.hpp"
 #include "colorlab/api/conditional.hpp"
 #include "colorlab/api/problem.hpp"
+#include "../content_security.hpp"
 
 namespace colorlab::daemon {
 
@@ -28,6 +29,7 @@ HttpResponse report_response(ReportService* reports, const HttpRequest& req, con
     g.status = 202;
     g.headers["Retry-After"] = "2";
     g.headers["Cache-Control"] = "no-store";
+    g.headers["Content-Security-Policy"] = kReportPolicy;
     if (req.header("accept").value_or("").find("text/html") != std::string::npos) {
       g.content_type = "text/html; charset=utf-8";
       g.body = "<!doctype html><meta charset=utf-8><meta http-equiv=refresh content=2><link rel=icon href=\"data:,\"><title>Making the report…</title>"
@@ -45,6 +47,7 @@ HttpResponse report_response(ReportService* reports, const HttpRequest& req, con
   ok.headers["ETag"] = etag;
   ok.headers["Cache-Control"] = "no-cache";
   ok.headers["Content-Disposition"] = "inline; filename=\"report-" + key + ".html\"";
+  ok.headers["Content-Security-Policy"] = kReportPolicy;
   if (auto inm = req.header("if-none-match"); inm && none_match_hits(*inm, etag)) {
     ok.status = 304;
     ok.content_type.clear();

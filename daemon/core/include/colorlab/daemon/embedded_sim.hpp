@@ -18,7 +18,9 @@ namespace colorlab::daemon {
 class EmbeddedSim {
  public:
   // Starts the simulator and waits for its one-line JSON announcement. Throws Error{no_comms}.
-  EmbeddedSim(const std::filesystem::path& sim_binary, const SimulatorConfig& config,
+  // `scratch_dir` (colorlabd: <state_dir>/sim) holds the simulated DSLR's card folder, so a simulator
+  // killed with the daemon leaves it in the state directory, where the next one reclaims it.
+  EmbeddedSim(const std::filesystem::path& sim_binary, const SimulatorConfig& config, const std::filesystem::path& scratch_dir,
               std::chrono::milliseconds startup_timeout = std::chrono::seconds(20));
   ~EmbeddedSim();
   EmbeddedSim(const EmbeddedSim&) = delete;

@@ -5,7 +5,7 @@
 
 namespace colorlab::store {
 
-inline constexpr int kSchemaVersion = 7;
+inline constexpr int kSchemaVersion = 8;
 // 'CLAB' — marks the file as colorlab's (PRAGMA application_id).
 inline constexpr int kApplicationId = 0x434c4142;
 

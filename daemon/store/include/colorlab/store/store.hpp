@@ -124,6 +124,10 @@ struct RunFilter {
   std::string status;    // exact status
 };
 
+// The SQL of a page of GET /v1/runs (?1 the cursor, ?2 the limit, ?3 campaign, ?4 status when filtered):
+// public so that a test can check its query plan.
+std::string run_list_sql(const RunFilter& filter);
+
 struct RunPage {
   std::vector<RunRecord> runs;
   std::optional<std::string> next_cursor;
@@ -236,7 +240,8 @@ class Store {
     Database& db_;
     bool open_ = false;
   };
-  // Newest first; `cursor` is the opaque next_cursor of the previous page.
+  // Newest first; `cursor` is the opaque next_cursor of the previous page. A listed run's summary leaves
+  // out "script" (the campaign's own result, unbounded in size); run(id) has the whole summary.
   RunPage runs(unsigned limit, const std::optional<std::string>& cursor, const RunFilter& filter = {});
   // Newest first (in the order they were created); `cursor` as for runs().
   ExecutionPage executions(unsigned limit, const std::optional<std::string>& cursor, const ExecutionFilter& filter = {});

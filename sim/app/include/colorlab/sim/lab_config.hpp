@@ -63,7 +63,7 @@ struct DslrLabConfig {
   std::optional<std::uint64_t> pose_seed;  // default: derived from the lab seed
   camera::ChartPose given_pose;
   std::optional<std::filesystem::path> socket;       // default: beside the control socket
-  std::optional<std::filesystem::path> capture_dir;  // default: a fresh directory, removed at exit
+  std::optional<std::filesystem::path> capture_dir;  // default: <scratch_dir>/colorlab-sim-<pid>-dslr, removed at exit
   double transfer_s = 1.2;                           // card write + USB transfer of the raw (simulated s)
   nlohmann::json faults = nlohmann::json::object();
 };
@@ -91,6 +91,9 @@ struct LabConfig {
   bool geometric_floor = false;
   verify::CabinetGeometry cabinet = verify::default_cabinet();  // [cabinet]
   std::optional<std::filesystem::path> control_socket;  // default: a fresh path under $XDG_RUNTIME_DIR or /tmp
+  // Where the DSLR's default card folder goes (colorlab-sim --scratch-dir; colorlabd passes <state_dir>/sim):
+  // default the temporary directory. Killed simulators' folders there are reclaimed at start.
+  std::optional<std::filesystem::path> scratch_dir;
   Ls110SimConfig ls110;
   SpectrolinoLabConfig spectrolino;
   DmxLabConfig dmx;
