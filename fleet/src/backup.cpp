@@ -1,6 +1,7 @@
 #include "colorlab/fleet/backup.hpp"
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -35,8 +36,32 @@ std::string snapshot_name() {
 // backup starts clean rather than letting them pile up on the bench's disk.
 void clear_leftovers(const fs::path& dir) {
   std::error_code ec;
-  for (const auto& e : fs::directory_iterator(dir, ec)) fs::remove(e.path(), ec);
+  for (const auto& e : fs::directory_iterator(dir, ec))
+    if (e.path().filename() != ".lock") fs::remove(e.path(), ec);
 }
+
+// One backup at a time on a bench: the timer's and a person's would clear each other's temporary snapshot in the
+// middle of VACUUM INTO, and their read-modify-write of the bucket's index would drop one snapshot's entry.
+class BackupLock {
+ public:
+  explicit BackupLock(const fs::path& dir) {
+    const fs::path path = dir / ".lock";
+    fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0600);
+    if (fd_ < 0)
+      throw Error(ErrorClass::io_error, "cannot open " + path.string(), "free space (or fix the disk) under " + dir.string());
+    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      ::close(fd_);
+      throw Error(ErrorClass::conflict, "another colorlab backup is running on this bench (" + path.string() + " is locked)",
+                  "wait for it to finish; its snapshot is as good as this one would be");
+    }
+  }
+  ~BackupLock() { ::close(fd_); }  // closing releases the lock, also when the process dies
+  BackupLock(const BackupLock&) = delete;
+  BackupLock& operator=(const BackupLock&) = delete;
+
+ private:
+  int fd_ = -1;
+};
 
 struct Snapshot {
   fs::path file;
@@ -107,6 +132,7 @@ BackupReport backup(const ShipConfig& c) {
     throw Error(ErrorClass::io_error, "cannot write the snapshot directory " + c.backup_dir().string() + ": " + e.code().message(),
                 "free space (or fix the disk) under " + c.backup_dir().string() + "; nothing of this snapshot was kept");
   }
+  const BackupLock lock(c.backup_dir());
   clear_leftovers(c.backup_dir());
   BackupReport report;
   report.name = snapshot_name();

@@ -22,7 +22,9 @@ using nlohmann::json;
 S3Client bucket_for(const ShipConfig& c) {
   S3Credentials k{read_secret_file(c.access_key_file, "S3 access key"),
                   read_secret_file(c.secret_key_file, "S3 secret key")};
-  return S3Client(c.s3_endpoint, c.bucket, c.region, std::move(k));
+  S3Client s3(c.s3_endpoint, c.bucket, c.region, std::move(k));
+  s3.set_stall_timeout(c.stall_timeout_s);
+  return s3;
 }
 
 std::string backup_prefix(const ShipConfig& c) { return "backups/" + c.bench_id + "/"; }

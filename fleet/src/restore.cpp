@@ -59,9 +59,12 @@ void write_file(const fs::path& p, const std::string& bytes) {
 
 RestoreReport restore(const ShipConfig& c, const std::string& name, const fs::path& into) {
   const fs::path database = into / "colorlab.db";
-  if (fs::exists(database)) {
-    throw Error(ErrorClass::conflict, into.string() + " already holds a bench database",
-                "restore into an empty directory (--into), or move the old state directory away first");
+  // A stale -wal beside the restored file would be replayed onto it when colorlabd opens it.
+  for (const char* name : {"colorlab.db", "colorlab.db-wal", "colorlab.db-shm"}) {
+    if (fs::exists(into / name)) {
+      throw Error(ErrorClass::conflict, into.string() + " already holds a bench database (" + name + ")",
+                  "restore into an empty directory (--into), or move the old state directory away first");
+    }
   }
   S3Client s3 = bucket_for(c);
   json index = read_index(s3, c);

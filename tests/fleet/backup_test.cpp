@@ -208,7 +208,9 @@ TEST_F(Backup, SnapshotUnderLoadRestoresIntoADaemonServingTheSameRuns) {
       EXPECT_EQ(copy.digest(id), source.digest(id)) << "run " << id;
       ++ended;
     } else {
-      EXPECT_EQ(status, "running") << "run " << id;  // the one the writer was in when the snapshot was taken
+      // The one the writer was in when the snapshot was taken: a run is created 'waiting' and set 'running' in
+      // the next commit, and the snapshot's moment can fall between the two.
+      EXPECT_TRUE(status == "running" || status == "waiting") << "run " << id << ": " << status;
     }
   }
   EXPECT_GE(ended, 3);
