@@ -146,19 +146,35 @@ for p in adduser colord-data python3 python3-numpy python3-pandas python3-reques
 done
 needed_pkgs=()
 libraries=$(ldconfig -p | awk '/x86-64|x86_64/ { print $1, $NF }')
+# Each library once, however many binaries need it: every dpkg -S reads dpkg's whole file database.
+declare -A needed_by=()
 while read -r elf; do
   while read -r soname; do
-    lib=$(awk -v s="$soname" '$1 == s && !found { print $2; found = 1 }' <<<"$libraries")
-    [[ -n $lib ]] || fail "${elf#"$x"} needs $soname, which this machine does not have"
-    owner=""
-    for candidate in "$lib" "$(realpath "$lib")" "/usr${lib#/usr}" "${lib#/usr}"; do
-      owner=$(dpkg -S "$candidate" 2>/dev/null | sed -n '1s/:.*//p' || true)
-      [[ -n $owner ]] && break
-    done
-    [[ -n $owner ]] || fail "no Debian package owns $lib ($soname, needed by ${elf#"$x"})"
-    needed_pkgs+=("$owner")
+    [[ -n ${needed_by[$soname]:-} ]] || needed_by[$soname]=${elf#"$x"}
   done < <(objdump -p "$elf" | awk '$1 == "NEEDED" { print $2 }')
 done < <(find "$x/usr/bin" "$x/usr/sbin" -type f)
+declare -A candidates=()
+for soname in "${!needed_by[@]}"; do
+  lib=$(awk -v s="$soname" '$1 == s && !found { print $2; found = 1 }' <<<"$libraries")
+  [[ -n $lib ]] || fail "${needed_by[$soname]} needs $soname, which this machine does not have"
+  # The names dpkg may know it by: merged /usr, and the file behind the soname's link.
+  candidates[$soname]="$lib $(realpath "$lib") /usr${lib#/usr} ${lib#/usr}"
+done
+# One dpkg -S for them all ("package[:arch][, …]: path" per file it knows; the rest it reports on stderr).
+declare -A owner_of=()
+while IFS= read -r line; do
+  [[ $line == diversion* ]] && continue
+  owner_of[${line##*: }]=${line%%[:,]*}
+done < <(printf '%s\n' "${candidates[@]}" | tr ' ' '\n' | sort -u | xargs dpkg -S 2>/dev/null || true)
+for soname in "${!needed_by[@]}"; do
+  owner=""
+  for candidate in ${candidates[$soname]}; do
+    owner=${owner_of[$candidate]:-}
+    [[ -n $owner ]] && break
+  done
+  [[ -n $owner ]] || fail "no Debian package owns any of ${candidates[$soname]} ($soname, needed by ${needed_by[$soname]})"
+  needed_pkgs+=("$owner")
+done
 for p in $(printf '%s\n' "${needed_pkgs[@]}" | sort -u); do
   grep -qx "$p" <<<"$dep_names" || fail "the binaries need a library from $p, which Depends does not name"
 done
