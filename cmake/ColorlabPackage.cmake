@@ -37,8 +37,12 @@ meter, lamps and dimmer, tethered cameras), runs scripted capture campaigns
 unattended, analyses what they capture, stores it in SQLite and serves it over
 an HTTP API. This package holds the daemon colorlabd, the command-line client
 colorlab, the simulated lab colorlab-sim, the Python client, the web console,
-the shipped campaigns, the systemd unit and the udev rules.")
-# Shared libraries through dpkg-shlibdeps on the stripped binaries; the rest is what the binaries and scripts use
+the shipped campaigns, the systemd unit and the udev rules; and for a lab of
+several benches the shipping agent colorlab-ship (ended runs to PostgreSQL
+and an S3 store) and the central read API colorlab-central, whose units are
+installed but not enabled.")
+# Shared libraries through dpkg-shlibdeps on the stripped binaries (libpq5 and libcurl for the fleet's programs);
+# the rest is what the binaries and scripts use
 # at run time: CIE tables (colord-data), the Python client's imports, the user's creation (adduser).
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
 set(CPACK_DEBIAN_PACKAGE_DEPENDS

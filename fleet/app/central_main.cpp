@@ -106,6 +106,7 @@ int main(int argc, char** argv) {
   CLI::App app{"colorlab-central: the lab's read-only API over the central PostgreSQL and S3 bucket"};
   std::string config_file = "/etc/colorlab/central.toml";
   app.add_option("--config", config_file, "colorlab-central's TOML ([central] and state_dir)")->capture_default_str();
+  app.set_version_flag("--version", std::string("colorlab-central ") + COLORLAB_VERSION);
   app.require_subcommand(1);
   auto* serve_cmd = app.add_subcommand("serve", "serve the read API until SIGTERM (the systemd service)");
   auto* keys = app.add_subcommand("keys", "API keys of this central server (as a bench's: read scope suffices)");

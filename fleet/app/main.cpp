@@ -61,6 +61,7 @@ int main(int argc, char** argv) {
   CLI::App app{"colorlab-ship: ships this bench's ended runs to the lab's PostgreSQL and S3 store"};
   std::string config_file = "/etc/colorlab/colorlabd.toml";
   app.add_option("--config", config_file, "colorlabd's TOML, with its [ship] section")->capture_default_str();
+  app.set_version_flag("--version", std::string("colorlab-ship ") + COLORLAB_SHIP_VERSION);
   app.require_subcommand(1);
   auto* init = app.add_subcommand("central-init", "create or upgrade the central schema in PostgreSQL");
   auto* once = app.add_subcommand("once", "ship what has ended, print a JSON report, exit");

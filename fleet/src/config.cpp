@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <cstdlib>
 #include <fstream>
 #include <string>
 
@@ -101,7 +102,22 @@ ShipConfig load_ship_config(const fs::path& file) {
   return c;
 }
 
-std::string read_secret_file(const fs::path& file, const char* what) {
+namespace {
+
+// Under systemd the units pass each key file as a credential of the file's own name (LoadCredential=), so the
+// original can stay root's alone (0600) and only the service sees its copy; run by hand, the configured path.
+fs::path credential_or(const fs::path& file) {
+  const char* dir = std::getenv("CREDENTIALS_DIRECTORY");
+  if (dir == nullptr || *dir == '\0') return file;
+  std::error_code ec;
+  const fs::path passed = fs::path(dir) / file.filename();
+  return fs::is_regular_file(passed, ec) ? passed : file;
+}
+
+}  // namespace
+
+std::string read_secret_file(const fs::path& configured, const char* what) {
+  const fs::path file = credential_or(configured);
   std::ifstream in(file);
   std::string line;
   if (!in || !std::getline(in, line)) {

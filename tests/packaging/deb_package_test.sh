@@ -2,9 +2,11 @@
 # The Debian package end to end (issue 25, docs/packaging.md): cpack builds it from the tree already built; its
 # contents are held to the source tree's install rules, its Depends to the libraries objdump finds in its binaries;
 # lintian judges it; then it is installed with apt into a throwaway Debian chroot made by mmdebstrap from the
-# archive, where the installed colorlabd runs its embedded simulated lab as the colorlab user and the installed
-# colorlab runs a campaign; a second build with a higher version upgrades it (data and configuration kept); it is
-# removed and purged, and the chroot's file list afterwards differs from before only by the measured data.
+# archive, where the fleet's programs (colorlab-ship, colorlab-central) answer --help and --version, every unit
+# passes systemd-analyze verify and none is enabled, the installed colorlabd runs its embedded simulated lab as the
+# colorlab user and the installed colorlab runs a campaign; a second build with a higher version upgrades it (data
+# and configuration kept); it is removed and purged, and the chroot's file list afterwards differs from before only
+# by the measured data.
 # Nothing outside build/packaging-test changes: the chroot has its own mount, PID and network namespaces.
 #
 #   deb_package_test.sh BUILD_DIR SOURCE_DIR CPACK
@@ -109,7 +111,9 @@ for f in "$source_dir"/campaigns/scripts/*.lua; do has "/usr/share/colorlab/camp
 shopt -s nullglob
 for f in "$source_dir"/systemd/*.rules "$source_dir"/udev/*.rules; do has "/usr/lib/udev/rules.d/$(basename "$f")"; done
 shopt -u nullglob
-for f in /usr/lib/systemd/system/colorlabd.service /usr/lib/sysusers.d/colorlab.conf /usr/lib/tmpfiles.d/colorlab.conf \
+units=(colorlabd.service colorlab-ship.service colorlab-central.service)
+for f in "${units[@]/#//usr/lib/systemd/system/}" /usr/share/doc/colorlab/fleet.md \
+         /usr/lib/sysusers.d/colorlab.conf /usr/lib/tmpfiles.d/colorlab.conf \
          /usr/share/bash-completion/completions/colorlab /usr/share/colorlab/colorlabd.default.toml \
          /usr/share/doc/colorlab/copyright /usr/share/doc/colorlab/changelog.Debian.gz \
          /usr/share/lintian/overrides/colorlab; do
@@ -118,9 +122,13 @@ done
 outside=$(grep -v '^/usr/' <<<"$files" || true)
 [[ -z $outside ]] || fail "files outside /usr (configuration is written by postinst): $outside"
 grep -q '^/usr/local/' <<<"$files" && fail "files under /usr/local"
-unit=$x/usr/lib/systemd/system/colorlabd.service
-grep -qx 'ExecStart=/usr/sbin/colorlabd --config /etc/colorlab/colorlabd.toml' "$unit" ||
-  fail "the unit's ExecStart does not name the packaged /usr/sbin/colorlabd: $(grep ExecStart "$unit")"
+for exec_start in 'colorlabd.service /usr/sbin/colorlabd --config /etc/colorlab/colorlabd.toml' \
+                  'colorlab-ship.service /usr/sbin/colorlab-ship --config /etc/colorlab/colorlabd.toml run' \
+                  'colorlab-central.service /usr/sbin/colorlab-central --config /etc/colorlab/central.toml serve'; do
+  unit=$x/usr/lib/systemd/system/${exec_start%% *}
+  grep -qxF "ExecStart=${exec_start#* }" "$unit" ||
+    fail "${exec_start%% *}'s ExecStart does not name the packaged program: $(grep ExecStart "$unit")"
+done
 leaked=$(grep -rlF "$build" "$x" --exclude-dir=bin --exclude-dir=sbin || true)
 [[ -z $leaked ]] || fail "files naming the build tree $build: $leaked"
 control=$(dpkg-deb --ctrl-tarfile "$deb1" | tar -tv)
@@ -138,19 +146,35 @@ for p in adduser colord-data python3 python3-numpy python3-pandas python3-reques
 done
 needed_pkgs=()
 libraries=$(ldconfig -p | awk '/x86-64|x86_64/ { print $1, $NF }')
+# Each library once, however many binaries need it: every dpkg -S reads dpkg's whole file database.
+declare -A needed_by=()
 while read -r elf; do
   while read -r soname; do
-    lib=$(awk -v s="$soname" '$1 == s && !found { print $2; found = 1 }' <<<"$libraries")
-    [[ -n $lib ]] || fail "${elf#"$x"} needs $soname, which this machine does not have"
-    owner=""
-    for candidate in "$lib" "$(realpath "$lib")" "/usr${lib#/usr}" "${lib#/usr}"; do
-      owner=$(dpkg -S "$candidate" 2>/dev/null | sed -n '1s/:.*//p' || true)
-      [[ -n $owner ]] && break
-    done
-    [[ -n $owner ]] || fail "no Debian package owns $lib ($soname, needed by ${elf#"$x"})"
-    needed_pkgs+=("$owner")
+    [[ -n ${needed_by[$soname]:-} ]] || needed_by[$soname]=${elf#"$x"}
   done < <(objdump -p "$elf" | awk '$1 == "NEEDED" { print $2 }')
 done < <(find "$x/usr/bin" "$x/usr/sbin" -type f)
+declare -A candidates=()
+for soname in "${!needed_by[@]}"; do
+  lib=$(awk -v s="$soname" '$1 == s && !found { print $2; found = 1 }' <<<"$libraries")
+  [[ -n $lib ]] || fail "${needed_by[$soname]} needs $soname, which this machine does not have"
+  # The names dpkg may know it by: merged /usr, and the file behind the soname's link.
+  candidates[$soname]="$lib $(realpath "$lib") /usr${lib#/usr} ${lib#/usr}"
+done
+# One dpkg -S for them all ("package[:arch][, …]: path" per file it knows; the rest it reports on stderr).
+declare -A owner_of=()
+while IFS= read -r line; do
+  [[ $line == diversion* ]] && continue
+  owner_of[${line##*: }]=${line%%[:,]*}
+done < <(printf '%s\n' "${candidates[@]}" | tr ' ' '\n' | sort -u | xargs dpkg -S 2>/dev/null || true)
+for soname in "${!needed_by[@]}"; do
+  owner=""
+  for candidate in ${candidates[$soname]}; do
+    owner=${owner_of[$candidate]:-}
+    [[ -n $owner ]] && break
+  done
+  [[ -n $owner ]] || fail "no Debian package owns any of ${candidates[$soname]} ($soname, needed by ${needed_by[$soname]})"
+  needed_pkgs+=("$owner")
+done
 for p in $(printf '%s\n' "${needed_pkgs[@]}" | sort -u); do
   grep -qx "$p" <<<"$dep_names" || fail "the binaries need a library from $p, which Depends does not name"
 done
@@ -203,13 +227,26 @@ for g in colorlab dialout plugdev; do id -nG colorlab | tr ' ' '\n' | grep -qx \
 [[ \$(stat -c '%U:%G %a' /etc/colorlab/colorlabd.toml) == "root:colorlab 640" ]] || fail "config: \$(stat -c '%U:%G %a' /etc/colorlab/colorlabd.toml)"
 cmp /etc/colorlab/colorlabd.toml /usr/share/colorlab/colorlabd.default.toml || fail "the first configuration is not the default"
 [[ \$(stat -c '%U:%G %a' \$state) == "colorlab:colorlab 750" ]] || fail "\$state: \$(stat -c '%U:%G %a' \$state)"
-[[ -z \$(daemons_running) ]] || fail "installing started colorlabd"
-[[ -z \$(find /etc/systemd/system -name colorlabd.service) ]] || fail "installing enabled colorlabd.service"
+[[ -z \$(daemons_running) ]] || fail "installing started colorlabd or a fleet program"
+[[ -z \$(find /etc/systemd/system -name 'colorlab*.service') ]] || fail "installing enabled a colorlab unit"
 for b in ${executables[*]}; do
   ldd "\$b" | grep 'not found' && fail "\$b: libraries missing in a chroot holding only what Depends names"
   true
 done
 python3 -c 'import colorlab; print("python client", colorlab.__version__)'
+# The fleet's programs run, and their units are valid for this systemd (a unit an older or newer systemd would
+# half-ignore only warns, hence "no output at all") and installed, not enabled: a bench without a fleet never
+# starts them.
+for p in colorlab-ship colorlab-central; do
+  help=\$(/usr/sbin/\$p --help) || fail "\$p --help failed: \$help"
+  grep -q -- --config <<<"\$help" || fail "\$p --help names no --config: \$help"
+  [[ \$(/usr/sbin/\$p --version) == "\$p ${v1%-*}" ]] || fail "\$p --version: \$(/usr/sbin/\$p --version 2>&1)"
+done
+for u in ${units[*]}; do
+  out=\$(systemd-analyze verify /usr/lib/systemd/system/\$u 2>&1) || fail "systemd-analyze verify \$u: \$out"
+  [[ -z \$out ]] || fail "systemd-analyze verify \$u warns: \$out"
+  [[ \$(systemctl is-enabled \$u || true) == disabled ]] || fail "\$u is \$(systemctl is-enabled \$u) after install"
+done
 bash -c 'source /usr/share/bash-completion/completions/colorlab && declare -F _colorlab >/dev/null' || fail "bash completion"
 SH
 echo "install took $(elapsed "$t" "$(now)") s"

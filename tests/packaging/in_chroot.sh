@@ -29,4 +29,7 @@ stop_daemon() {
   kill -0 "$daemon" 2>/dev/null && { cat /tmp/colorlabd.log; fail "colorlabd did not stop within 60 s of SIGTERM"; }
   wait "$daemon" || { cat /tmp/colorlabd.log; fail "colorlabd exited with $? on SIGTERM"; }
 }
-daemons_running() { grep -lx -e colorlabd -e colorlab-sim /proc/[0-9]*/comm 2>/dev/null || true; }
+# comm holds 15 characters: colorlab-central is colorlab-centra there.
+daemons_running() {
+  grep -lx -e colorlabd -e colorlab-sim -e colorlab-ship -e colorlab-centra /proc/[0-9]*/comm 2>/dev/null || true
+}

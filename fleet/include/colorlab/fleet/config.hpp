@@ -38,7 +38,8 @@ struct ShipConfig {
 ShipConfig load_ship_config(const std::filesystem::path& toml_file);
 
 // The first line of a credential file, without its line ending; Error{bad_parameter} when it cannot be
-// read or is empty. The message names the file, never its content.
+// read or is empty. The message names the file, never its content. When systemd passed a credential of the
+// file's name ($CREDENTIALS_DIRECTORY/<file name>, the units' LoadCredential=), that copy is read instead.
 std::string read_secret_file(const std::filesystem::path& file, const char* what);
 
 // The position the agent last saw central accept for this bench (0 when it never shipped).
