@@ -241,7 +241,16 @@ class ShipFaults : public ::testing::Test {
 // status` against a real colorlabd. Runs an old daemon left running without a script end as `interrupted` when
 // colorlabd opens the store and ship marked as such.
 TEST_F(ShipFaults, TheBenchShowsItsLagAndTheAgentsLastError) {
-  const fs::path state = dir_ / "state";
+  // A short state directory: colorlabd's Unix socket lives in it, and a socket path has at most 107 bytes.
+  struct Short {
+    fs::path dir = fs::temp_directory_path() / ("clf-" + std::to_string(::getpid()));
+    ~Short() {
+      std::error_code ec;
+      fs::remove_all(dir, ec);
+    }
+  } short_dir;
+  fs::remove_all(short_dir.dir);
+  const fs::path state = short_dir.dir / "state";
   fs::path ship_config;
   std::string left_running, old_marked;
   {
@@ -263,7 +272,14 @@ TEST_F(ShipFaults, TheBenchShowsItsLagAndTheAgentsLastError) {
   }
   fs::create_directories(dir_ / "daemon");
   const auto daemon_config = ct::write_daemon_config(dir_ / "daemon", 500, 41, "\n[ship]\nbench_id = \"bench-v\"\n");
-  ct::DaemonProcess daemon(state, daemon_config, dir_ / "colorlabd.log");
+  std::unique_ptr<ct::DaemonProcess> started;
+  try {
+    started = std::make_unique<ct::DaemonProcess>(state, daemon_config, dir_ / "colorlabd.log");
+  } catch (const std::exception& e) {
+    std::ifstream log(dir_ / "colorlabd.log");
+    FAIL() << e.what() << "\ncolorlabd's log:\n" << std::string(std::istreambuf_iterator<char>(log), {});
+  }
+  auto& daemon = *started;
   auto api = ct::api_for(daemon);
 
   json s = api.get("/v1/shipping");
