@@ -48,7 +48,9 @@ double seconds_since(clock_type::time_point t0) {
 
 int free_port_run(int count) {
   std::mt19937 rng(std::random_device{}());
-  std::uniform_int_distribution<int> pick(20000, 60000);
+  // Below Linux's ephemeral range (32768–60999 by default): a port the tests' own outgoing connections can take as
+  // their source port would make a restarted listener (socat, a server) fail to bind.
+  std::uniform_int_distribution<int> pick(20000, 32000);
   for (int attempt = 0; attempt < 200; ++attempt) {
     int base = pick(rng);
     bool all = true;

@@ -70,6 +70,14 @@ HttpResponse get_shipping(ApiContext& ctx, const HttpRequest&, const PathParams&
   const fs::path dir = state_dir / "ship";
   const double now = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
   const std::int64_t position = shipped_position(dir / "shipped-position");
+  json agent = agent_status(dir / "status.json");
+  // A bench that does not ship has nothing to count, and the console asks every few seconds: without a position
+  // the backlog would read the whole event log each time.
+  if (!ctx.blobs->config().keep_unshipped && agent.is_null()) {
+    return HttpResponse::json(200, json{{"enabled", false}, {"shipped_position", position}, {"last_event", nullptr},
+                                        {"lag", nullptr}, {"agent", nullptr}, {"last_error", nullptr},
+                                        {"agent_seen_s_ago", nullptr}});
+  }
   // A read-only connection of its own: the pool's connections belong to their threads' snapshots, and this one
   // reads the log after the agent's position only.
   store::Database db((state_dir / std::string(protocol::kDatabaseName)).string(), true);
@@ -83,7 +91,6 @@ HttpResponse get_shipping(ApiContext& ctx, const HttpRequest&, const PathParams&
            {"oldest_unshipped_ended_at", backlog.oldest_ended_at.empty() ? json(nullptr) : json(backlog.oldest_ended_at)},
            // How long the oldest unshipped run has waited since it ended; 0 when nothing waits.
            {"age_s", backlog.runs == 0 ? json(0) : seconds_since(backlog.oldest_ended_at, now)}};
-  json agent = agent_status(dir / "status.json");
   json out{{"enabled", ctx.blobs->config().keep_unshipped},
            {"shipped_position", position},
            {"last_event", backlog.last_event},
