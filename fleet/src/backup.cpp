@@ -36,19 +36,18 @@ std::string snapshot_name() {
 // backup starts clean rather than letting them pile up on the bench's disk.
 void clear_leftovers(const fs::path& dir) {
   std::error_code ec;
-  for (const auto& e : fs::directory_iterator(dir, ec))
-    if (e.path().filename() != ".lock") fs::remove(e.path(), ec);
+  for (const auto& e : fs::directory_iterator(dir, ec)) fs::remove(e.path(), ec);
 }
 
 // One backup at a time on a bench: the timer's and a person's would clear each other's temporary snapshot in the
 // middle of VACUUM INTO, and their read-modify-write of the bucket's index would drop one snapshot's entry.
 class BackupLock {
  public:
-  explicit BackupLock(const fs::path& dir) {
-    const fs::path path = dir / ".lock";
+  // Beside backup/, not in it: backup/ holds a snapshot or nothing.
+  explicit BackupLock(const fs::path& path) {
     fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0600);
     if (fd_ < 0)
-      throw Error(ErrorClass::io_error, "cannot open " + path.string(), "free space (or fix the disk) under " + dir.string());
+      throw Error(ErrorClass::io_error, "cannot open " + path.string(), "free space (or fix the disk) under " + path.parent_path().string());
     if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
       ::close(fd_);
       throw Error(ErrorClass::conflict, "another colorlab backup is running on this bench (" + path.string() + " is locked)",
@@ -132,7 +131,7 @@ BackupReport backup(const ShipConfig& c) {
     throw Error(ErrorClass::io_error, "cannot write the snapshot directory " + c.backup_dir().string() + ": " + e.code().message(),
                 "free space (or fix the disk) under " + c.backup_dir().string() + "; nothing of this snapshot was kept");
   }
-  const BackupLock lock(c.backup_dir());
+  const BackupLock lock(c.backup_dir().parent_path() / "backup.lock");
   clear_leftovers(c.backup_dir());
   BackupReport report;
   report.name = snapshot_name();

@@ -52,8 +52,11 @@ add_subdirectory(drivers/core)
 add_library(colorlab::sim_camera INTERFACE IMPORTED)
 add_subdirectory(drivers/camera)
 add_subdirectory(campaigns)
+# colorlabd's configuration reads [cabinet] through verify/scene (its parser and validation): linked by the
+# daemon_config group, not fuzzed here, so built plain like the lab.
+add_subdirectory(verify/scene)
 foreach(lib colorlab_drivers_core colorlab_drivers_camera colorlab_chart_locate colorlab_campaign_lab
-            colorlab_campaign_procedures)
+            colorlab_campaign_procedures colorlab_verify_scene)
   target_compile_options(${lib} PRIVATE -O0 -g0)
 endforeach()
 
