@@ -6,13 +6,16 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <csignal>
+#include <iostream>
 #include <random>
 #include <stdexcept>
 #include <thread>
 
 #include "colorlab/core/error.hpp"
 #include "colorlab/fleet/s3.hpp"
+#include "gtest/gtest.h"
 
 namespace colorlab::fleet_test {
 
@@ -195,6 +198,41 @@ void SwiftServer::create_bucket(const std::string& bucket, std::chrono::seconds 
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(200));
   }
+}
+
+SharedServers::~SharedServers() {
+  swift.reset();
+  pg.reset();
+  std::error_code ec;
+  fs::remove_all(root, ec);  // the Swift storage and the tests' benches
+}
+
+std::string SharedServers::fresh_for_current_test() {
+  std::string name = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+  for (auto& c : name) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  pg->psql("postgres", "DROP DATABASE IF EXISTS " + name);
+  pg->psql("postgres", "CREATE DATABASE " + name);
+  swift->create_bucket(name);
+  fs::remove_all(root / name);
+  return name;
+}
+
+SharedServers& shared_servers(const fs::path& scratch, const std::string& pg_name) {
+  static SharedServers s;
+  if (!s.swift) {  // first use, or a previous start that failed
+    s.swift.reset();
+    s.pg.reset();
+    const std::string pid = std::to_string(::getpid());
+    s.root = scratch / pid;
+    fs::remove_all(s.root);
+    fs::create_directories(s.root);
+    s.pg = std::make_unique<PostgresServer>(fs::temp_directory_path() / (pg_name + "-" + pid));
+    s.pg->start();
+    s.swift = std::make_unique<SwiftServer>(s.root / "swift");
+    std::cerr << "fleet servers: PostgreSQL initdb + start " << s.pg->start_seconds << " s, Swift s3api ready in "
+              << s.swift->start_seconds << " s\n";
+  }
+  return s;
 }
 
 }  // namespace colorlab::fleet_test

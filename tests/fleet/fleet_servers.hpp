@@ -57,4 +57,20 @@ class SwiftServer {
 // A free TCP port on 127.0.0.1 with `count` consecutive free ports from it.
 int free_port_run(int count);
 
+// The PostgreSQL and Swift one fleet test program shares: started on first use (again after a start that failed)
+// with their scratch under `scratch`/<pid> — under the build tree, on disk, since Swift keeps metadata in extended
+// attributes, which tmpfs lacks — and removed at exit with everything the tests put there.
+struct SharedServers {
+  std::filesystem::path root;
+  std::unique_ptr<PostgresServer> pg;
+  std::unique_ptr<SwiftServer> swift;
+  ~SharedServers();
+  // A fresh database and bucket named after the running gtest test (lower case), and its empty folder under
+  // root; returns the name.
+  std::string fresh_for_current_test();
+};
+// `pg_name` names PostgreSQL's cluster directory under the system's temporary directory (its socket path must stay
+// short).
+SharedServers& shared_servers(const std::filesystem::path& scratch, const std::string& pg_name);
+
 }  // namespace colorlab::fleet_test

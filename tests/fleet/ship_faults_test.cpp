@@ -43,35 +43,8 @@ using steady = std::chrono::steady_clock;
 
 namespace {
 
-struct Servers {
-  fs::path root;
-  std::unique_ptr<PostgresServer> pg;
-  std::unique_ptr<SwiftServer> swift;
-  ~Servers() {
-    swift.reset();
-    pg.reset();
-    std::error_code ec;
-    fs::remove_all(root, ec);
-  }
-};
-
-Servers& servers() {
-  static Servers s;
-  if (!s.swift) {
-    s.swift.reset();
-    s.pg.reset();
-    // Under the build tree, on disk: Swift needs extended attributes, which tmpfs lacks.
-    s.root = fs::path(COLORLAB_BIN_DIR).parent_path() / "tests" / "fleet-faults-scratch" / std::to_string(::getpid());
-    fs::remove_all(s.root);
-    fs::create_directories(s.root);
-    s.pg = std::make_unique<PostgresServer>(fs::temp_directory_path() /
-                                            ("colorlab-faults-pg-" + std::to_string(::getpid())));
-    s.pg->start();
-    s.swift = std::make_unique<SwiftServer>(s.root / "swift");
-    std::cerr << "fleet servers: PostgreSQL initdb + start " << s.pg->start_seconds << " s, Swift s3api ready in "
-              << s.swift->start_seconds << " s\n";
-  }
-  return s;
+SharedServers& servers() {
+  return shared_servers(fs::path(COLORLAB_BIN_DIR).parent_path() / "tests" / "fleet-faults-scratch", "colorlab-faults-pg");
 }
 
 int port_of(const std::string& text, const std::string& prefix) {
@@ -143,14 +116,8 @@ class ShipFaults : public ::testing::Test {
     const std::string missing = missing_tools() + (ct::on_path("socat") ? "" : " socat");
     // Not a skip: a CI machine without the servers has lost a feature's tests, which must show.
     if (!missing.empty()) FAIL() << "the fleet fault tests need:" << missing << " (scripts/setup.sh installs them)";
-    auto& s = servers();
-    name_ = ::testing::UnitTest::GetInstance()->current_test_info()->name();
-    for (auto& c : name_) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    s.pg->psql("postgres", "DROP DATABASE IF EXISTS " + name_);
-    s.pg->psql("postgres", "CREATE DATABASE " + name_);
-    s.swift->create_bucket(name_);
-    dir_ = s.root / name_;
-    fs::remove_all(dir_);
+    name_ = servers().fresh_for_current_test();
+    dir_ = servers().root / name_;
   }
 
   ShipTarget target() const {

@@ -33,40 +33,8 @@ using ct::run_command;
 
 namespace {
 
-struct Servers {
-  fs::path root;
-  std::unique_ptr<PostgresServer> pg;
-  std::unique_ptr<SwiftServer> swift;
-  ~Servers() {
-    swift.reset();
-    pg.reset();
-    std::error_code ec;
-    fs::remove_all(root, ec);  // the Swift storage and the benches' state directories
-  }
-};
-
-// Under the build tree, on disk: Swift needs extended attributes, which tmpfs lacks.
-fs::path scratch_root() {
-  fs::path p = fs::path(COLORLAB_BIN_DIR).parent_path() / "tests" / "fleet-scratch" / std::to_string(::getpid());
-  fs::remove_all(p);
-  fs::create_directories(p);
-  return p;
-}
-
-Servers& servers() {
-  static Servers s;
-  if (!s.swift) {  // first use, or a previous start that failed
-    s.swift.reset();
-    s.pg.reset();
-    s.root = scratch_root();
-    s.pg = std::make_unique<PostgresServer>(fs::temp_directory_path() /
-                                            ("colorlab-fleet-pg-" + std::to_string(::getpid())));
-    s.pg->start();
-    s.swift = std::make_unique<SwiftServer>(s.root / "swift");
-    std::cerr << "fleet servers: PostgreSQL initdb + start " << s.pg->start_seconds << " s, Swift s3api ready in "
-              << s.swift->start_seconds << " s\n";
-  }
-  return s;
+SharedServers& servers() {
+  return shared_servers(fs::path(COLORLAB_BIN_DIR).parent_path() / "tests" / "fleet-scratch", "colorlab-fleet-pg");
 }
 
 class Fleet : public ::testing::Test {
@@ -77,14 +45,8 @@ class Fleet : public ::testing::Test {
       if (std::getenv("CI")) FAIL() << "fleet tests need:" << missing << " (scripts/setup.sh installs them)";
       GTEST_SKIP() << "needs" << missing << " (scripts/setup.sh installs them)";
     }
-    auto& s = servers();
-    name_ = ::testing::UnitTest::GetInstance()->current_test_info()->name();
-    for (auto& c : name_) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    s.pg->psql("postgres", "DROP DATABASE IF EXISTS " + name_);
-    s.pg->psql("postgres", "CREATE DATABASE " + name_);
-    s.swift->create_bucket(name_);
-    dir_ = s.root / name_;
-    fs::remove_all(dir_);
+    name_ = servers().fresh_for_current_test();
+    dir_ = servers().root / name_;
   }
 
   ShipTarget target() const {
