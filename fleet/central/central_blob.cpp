@@ -24,7 +24,7 @@ HttpResponse get_blob(CentralContext& ctx, const HttpRequest& req, const PathPar
     blob = central_blob(*pg, sha256);
   }
   if (!blob) throw Error(ErrorClass::not_found, "central holds no blob " + sha256, "GET /v1/runs/{id}/blobs lists a run's blobs");
-  const std::string key = "sha256/" + sha256;
+  const std::string key = blob_key(sha256);
   HttpResponse r;
   const daemon::BlobSpan span = daemon::answer_blob(r, req, *blob, blob->size);
   if (!span.body_needed) return r;

@@ -144,7 +144,7 @@ BackupReport backup(const ShipConfig& c) {
   // Blobs first: a snapshot in the bucket never names a blob the bucket lacks (unless the bench lost it).
   store::BlobStore files(c.blob_root());
   for (const auto& sha : snap.blobs) {
-    const std::string key = "sha256/" + sha;
+    const std::string key = blob_key(sha);
     if (s3.exists(key)) continue;
     const fs::path path = files.path_of(sha);
     if (!fs::exists(path)) {

@@ -1,6 +1,7 @@
 #pragma once
-// What backup.cpp and restore.cpp share: where a bench's backups live in the bucket, their index, and the
-// durable-file steps (backup.hpp describes the layout).
+// The bucket as [ship] configures it (the shipper, backups and restores all use it), and what backup.cpp and
+// restore.cpp share: where a bench's backups live in the bucket, their index, and the durable-file steps
+// (backup.hpp describes the layout).
 #include <filesystem>
 #include <string>
 
@@ -11,6 +12,7 @@
 
 namespace colorlab::fleet {
 
+// Its keys read from their files, its stall limit from [ship] stall_timeout_s.
 S3Client bucket_for(const ShipConfig& c);
 // "backups/<bench_id>/"
 std::string backup_prefix(const ShipConfig& c);

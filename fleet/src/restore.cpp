@@ -122,7 +122,7 @@ RestoreReport restore(const ShipConfig& c, const std::string& name, const fs::pa
   for (const auto& sha : blobs) {
     std::string bytes;
     try {
-      bytes = s3.get_part("sha256/" + sha, std::nullopt);
+      bytes = s3.get_part(blob_key(sha), std::nullopt);
     } catch (const Error& e) {
       if (e.cls() != ErrorClass::not_found) throw;
       report.blobs_missing.push_back(sha);

@@ -12,6 +12,7 @@
 #include "colorlab/fleet/s3.hpp"
 #include "colorlab/store/blob_store.hpp"
 #include "colorlab/store/schema.hpp"
+#include "backup_bucket.hpp"
 
 #ifndef COLORLAB_SHIP_VERSION
 #define COLORLAB_SHIP_VERSION "unknown"
@@ -52,14 +53,6 @@ const std::string& batch_part(const RunBatch& b, int i) {
     case 4: return b.run_blobs;
     default: return b.events;
   }
-}
-
-S3Client make_s3(const ShipConfig& c) {
-  S3Credentials k{read_secret_file(c.access_key_file, "S3 access key"),
-                  read_secret_file(c.secret_key_file, "S3 secret key")};
-  S3Client s3(c.s3_endpoint, c.bucket, c.region, std::move(k));
-  s3.set_stall_timeout(c.stall_timeout_s);
-  return s3;
 }
 
 void check_bench_schema(BenchReader& bench) {
@@ -216,7 +209,7 @@ CycleReport ship_cycle(const ShipConfig& c) {
   check_bench_schema(bench);
   Pg pg(c.postgres);
   central_require(pg);
-  S3Client s3 = make_s3(c);
+  S3Client s3 = bucket_for(c);
   store::BlobStore files(c.blob_root());
   const int bench_schema = bench.schema_version();
 
@@ -236,7 +229,7 @@ CycleReport ship_cycle(const ShipConfig& c) {
       RunBatch b = bench.read(c.bench_id, run, position);
       // Blobs before the rows that reference them: central never names an object the bucket lacks.
       for (const auto& blob : b.blob_files) {
-        const std::string key = "sha256/" + blob.sha256;
+        const std::string key = blob_key(blob.sha256);
         if (s3.exists(key)) continue;
         const auto path = files.path_of(blob.sha256);
         if (!std::filesystem::exists(path)) {

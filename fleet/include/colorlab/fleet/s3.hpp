@@ -50,6 +50,10 @@ class S3Client {
   long stall_timeout_s_ = 30;
 };
 
+// The object a blob is stored under, content-addressed: the bucket's one naming of blobs, which the shipper, backups,
+// restores and colorlab-central all read.
+inline std::string blob_key(const std::string& sha256) { return "sha256/" + sha256; }
+
 // One GET read piece by piece, so colorlab-central relays an object of any size holding about kPiece bytes of it
 // at a time (never the whole object or range). One thread at a time; next() blocks that thread until a piece has
 // come or the transfer ended (a stall below 1 KiB/s for 30 s ends it, as every request of S3Client).
