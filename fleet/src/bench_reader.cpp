@@ -6,6 +6,7 @@
 #include "colorlab/core/error.hpp"
 #include "colorlab/fleet/digest.hpp"
 #include "colorlab/fleet/pg.hpp"
+#include "colorlab/store/ship_log.hpp"
 
 namespace colorlab::fleet {
 
@@ -33,28 +34,8 @@ std::optional<std::string> exact(std::optional<double> v) {
   return exact(*v);
 }
 
-// A read transaction: the run, its rows and the events come from one snapshot of the WAL.
-class ReadTx {
- public:
-  explicit ReadTx(store::Database& db) : db_(db) { db_.exec("BEGIN DEFERRED"); }
-  ~ReadTx() {
-    try {
-      db_.exec("COMMIT");
-    } catch (...) {
-    }
-  }
-  ReadTx(const ReadTx&) = delete;
-  ReadTx& operator=(const ReadTx&) = delete;
-
- private:
-  store::Database& db_;
-};
-
-constexpr const char* kEnded =
-    "SELECT seq, json_extract(payload, '$.run_id'), json_extract(payload, '$.status') FROM event_log "
-    "WHERE seq > ?1 AND topic = 'execution' AND json_extract(payload, '$.run_id') IS NOT NULL AND "
-    "json_extract(payload, '$.status') IN ('finished_ok', 'finished_error', 'aborted', 'interrupted') "
-    "ORDER BY seq LIMIT ?2";
+const std::string kEnded = "SELECT seq, json_extract(payload, '$.run_id'), json_extract(payload, '$.status') FROM "
+                          "event_log WHERE seq > ?1 AND " + store::kEndEventSql + " ORDER BY seq LIMIT ?2";
 
 }  // namespace
 
@@ -89,26 +70,11 @@ std::vector<EndedRun> BenchReader::ended_after(std::int64_t position, int limit)
   return out;
 }
 
-Backlog BenchReader::backlog(std::int64_t position) {
-  ReadTx tx(db_);
-  Backlog b;
-  auto count = db_.prepare(
-      "SELECT count(*) FROM event_log WHERE seq > ?1 AND topic = 'execution' AND "
-      "json_extract(payload, '$.run_id') IS NOT NULL AND "
-      "json_extract(payload, '$.status') IN ('finished_ok', 'finished_error', 'aborted', 'interrupted')");
-  count.bind(1, position);
-  if (count.step()) b.runs = count.int64(0);
-  auto first = ended_after(position, 1);
-  if (first.empty()) return b;
-  b.oldest_run_id = first.front().run_id;
-  auto st = db_.prepare("SELECT finished_at FROM runs WHERE id = ?1");
-  st.bind(1, std::string_view(b.oldest_run_id));
-  if (st.step() && !st.is_null(0)) b.oldest_ended_at = st.text(0);
-  return b;
-}
+// The bench's own count (GET /v1/shipping), so central's lag and the bench's cannot disagree.
+Backlog BenchReader::backlog(std::int64_t position) { return store::ShipLog(db_).backlog(position); }
 
 RunBatch BenchReader::read(const std::string& bench_id, const EndedRun& run, std::int64_t position) {
-  ReadTx tx(db_);
+  store::ReadTransaction tx(db_);
   RunBatch b;
   b.run = run;
   std::string line;
@@ -214,7 +180,7 @@ RunBatch BenchReader::read(const std::string& bench_id, const EndedRun& run, std
 }
 
 std::string BenchReader::digest(const std::string& run_id) {
-  ReadTx tx(db_);
+  store::ReadTransaction tx(db_);
   return digest_locked(run_id);
 }
 

@@ -2,44 +2,19 @@
 
 namespace colorlab::store {
 
-namespace {
-
-const std::string kIsEnd = std::string("topic = 'execution' AND json_extract(payload, '$.run_id') IS NOT NULL AND "
-                                       "json_extract(payload, '$.status') IN ") +
-                           kEndedStatusesSql;
-
-// The count, the oldest run and the newest event from one snapshot.
-class ReadTx {
- public:
-  explicit ReadTx(Database& db) : db_(db) { db_.exec("BEGIN DEFERRED"); }
-  ~ReadTx() {
-    try {
-      db_.exec("COMMIT");
-    } catch (...) {
-    }
-  }
-  ReadTx(const ReadTx&) = delete;
-  ReadTx& operator=(const ReadTx&) = delete;
-
- private:
-  Database& db_;
-};
-
-}  // namespace
-
 ShipBacklog ShipLog::backlog(std::int64_t position) {
-  ReadTx tx(db_);
+  ReadTransaction tx(db_);
   ShipBacklog b;
   {
     // seq is the key: only the log after the position is read, which is short while the agent keeps up.
-    auto st = db_.prepare("SELECT count(*) FROM event_log WHERE seq > ?1 AND " + kIsEnd);
+    auto st = db_.prepare("SELECT count(*) FROM event_log WHERE seq > ?1 AND " + kEndEventSql);
     st.bind(1, position);
     if (st.step()) b.runs = st.int64(0);
   }
   if (b.runs > 0) {
     auto st = db_.prepare(
         "SELECT r.id, r.status, r.finished_at FROM event_log e JOIN runs r ON r.id = json_extract(e.payload, '$.run_id') "
-        "WHERE e.seq > ?1 AND " + kIsEnd + " ORDER BY e.seq LIMIT 1");
+        "WHERE e.seq > ?1 AND " + kEndEventSql + " ORDER BY e.seq LIMIT 1");
     st.bind(1, position);
     if (st.step()) {
       b.oldest_run_id = st.text(0);
@@ -62,7 +37,7 @@ int record_missing_end_events(Database& db, const std::string& now) {
                  "'ended before this colorlabd started; recorded at start-up so that it ships', 'recorded_at_open', "
                  "json('true')) FROM runs r WHERE r.status IN ") +
              kEndedStatusesSql + " AND r.id NOT IN (SELECT json_extract(payload, '$.run_id') FROM event_log WHERE " +
-             kIsEnd + ") ORDER BY r.seq")
+             kEndEventSql + ") ORDER BY r.seq")
       .bind(1, std::string_view(now))
       .run();
   return db.changes();

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "colorlab/store/ship_log.hpp"
 #include "colorlab/store/sqlite.hpp"
 
 namespace colorlab::fleet {
@@ -19,11 +20,8 @@ struct EndedRun {
 };
 
 // What the bench holds ended but not yet shipped after a position: central shows it as the bench's lag.
-struct Backlog {
-  std::int64_t runs = 0;
-  std::string oldest_run_id;    // empty when runs == 0
-  std::string oldest_ended_at;  // the oldest run's finished_at (ISO 8601, the bench's clock)
-};
+// Ended runs not yet shipped after a position, as the bench itself counts them (store::ShipLog).
+using Backlog = store::ShipBacklog;
 
 struct BlobToShip {
   std::string sha256;

@@ -11,6 +11,10 @@ namespace colorlab::store {
 
 // The statuses that end a run; the same list the agent and blob retention use.
 inline constexpr const char* kEndedStatusesSql = "('finished_ok', 'finished_error', 'aborted', 'interrupted')";
+// An event_log row that ends a run: where colorlab-ship picks what to ship and the bench counts its backlog.
+inline const std::string kEndEventSql = std::string("topic = 'execution' AND json_extract(payload, '$.run_id') IS NOT NULL "
+                                                    "AND json_extract(payload, '$.status') IN ") +
+                                        kEndedStatusesSql;
 
 // What the bench holds ended but not yet shipped after a position.
 struct ShipBacklog {

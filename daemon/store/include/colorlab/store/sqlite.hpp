@@ -66,6 +66,25 @@ class Statement {
   sqlite3_stmt* stmt_;
 };
 
+// BEGIN DEFERRED ... COMMIT around reads, so they all come from one snapshot of the WAL (a reader beside colorlabd's
+// writer: the shipping agent, the bench's own shipping lag). Ending a read-only transaction cannot lose anything, so
+// a failed COMMIT in the destructor is ignored.
+class ReadTransaction {
+ public:
+  explicit ReadTransaction(Database& db) : db_(db) { db_.exec("BEGIN DEFERRED"); }
+  ~ReadTransaction() {
+    try {
+      db_.exec("COMMIT");
+    } catch (...) {
+    }
+  }
+  ReadTransaction(const ReadTransaction&) = delete;
+  ReadTransaction& operator=(const ReadTransaction&) = delete;
+
+ private:
+  Database& db_;
+};
+
 // BEGIN IMMEDIATE ... COMMIT, rolled back unless commit() was called.
 class Transaction {
  public:
