@@ -95,7 +95,8 @@ std::vector<LabCall> by_name(std::vector<LabCall> calls) {
 // Friend of Lab and DryLab: the rows name their private handlers.
 const std::vector<LabCall>& lab_calls() {
   using K = CallKind;
-  // clang-format off  (one row per call)
+  // Kept as laid out by hand: one row per call.
+  // clang-format off
   static const std::vector<LabCall> calls = by_name({
       {"camera.capture", K::reading, {optional_table}, "camera", nullptr, &Lab::call_camera_capture, &DryLab::call_camera_capture,
        nullptr, {.nominal_s = 1.5, .key_detail = per_frame, .units = frames_captured}},

@@ -66,7 +66,8 @@ constexpr Entry kComErrors[] = {
     {0x10, "no access (user identification failed)", ArgyllClass::comms_fail, ErrorClass::unsupported},
 };
 
-// clang-format off  (two bits a row)
+// Kept as laid out by hand: two bits a row.
+// clang-format off
 constexpr RemoteBit kRemoteBits[] = {
     {0x0001, "no valid density standard"}, {0x0002, "no valid white standard"},
     {0x0004, "no valid illuminant"},       {0x0008, "no valid observer"},

@@ -20,7 +20,8 @@ constexpr double grid_depth_mm = floor_rows * floor_spot_pitch_y_mm;
 }
 
 LuminanceField::LuminanceField(Lamp lamp, std::uint64_t seed) {
-  // clang-format off  (one lamp a row)
+  // Kept as laid out by hand: one lamp a row.
+  // clang-format off
   switch (lamp) {
     case Lamp::d65:  peak_ = 322; side_ = 0.33; depth_ = 0.12; cross_ = 0.05; centre_y_ = 0.0; flatten_ = 0.03; break;
     // TL84 and CWF tubes in this cabinet are older and sit differently: steeper side fall-off (TL84) and a

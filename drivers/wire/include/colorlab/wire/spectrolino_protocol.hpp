@@ -157,7 +157,8 @@ std::optional<std::uint8_t> baud_ctt(int baud);
 std::optional<int> scan_bt_baud(std::uint8_t bt);
 std::optional<std::uint8_t> baud_scan_bt(int baud);
 
-// clang-format off  (the manual's code tables, one line each)
+// Kept as laid out by hand: the manual's code tables, one line each.
+// clang-format off
 enum class Illuminant : std::uint8_t {
   A = 0x00, C = 0x01, D65 = 0x02, D50 = 0x03, User = 0x08, Dxx = 0x10,
   F1 = 0x18, F2 = 0x19, F3 = 0x1A, F4 = 0x1B, F5 = 0x1C, F6 = 0x1D, F7 = 0x1E, F8 = 0x1F,
