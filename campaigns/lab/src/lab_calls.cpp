@@ -95,6 +95,8 @@ std::vector<LabCall> by_name(std::vector<LabCall> calls) {
 // Friend of Lab and DryLab: the rows name their private handlers.
 const std::vector<LabCall>& lab_calls() {
   using K = CallKind;
+  // Kept as laid out by hand: one row per call.
+  // clang-format off
   static const std::vector<LabCall> calls = by_name({
       {"camera.capture", K::reading, {optional_table}, "camera", nullptr, &Lab::call_camera_capture, &DryLab::call_camera_capture,
        nullptr, {.nominal_s = 1.5, .key_detail = per_frame, .units = frames_captured}},
@@ -143,6 +145,7 @@ const std::vector<LabCall>& lab_calls() {
       {"wait_stable", K::reading, {optional_table}, "luminance_meter", nullptr, &Lab::call_wait_stable, &DryLab::call_wait_stable,
        nullptr, {.lamps = LampEffect::settle}},
   });
+  // clang-format on
   return calls;
 }
 

@@ -66,6 +66,8 @@ constexpr Entry kComErrors[] = {
     {0x10, "no access (user identification failed)", ArgyllClass::comms_fail, ErrorClass::unsupported},
 };
 
+// Kept as laid out by hand: two bits a row.
+// clang-format off
 constexpr RemoteBit kRemoteBits[] = {
     {0x0001, "no valid density standard"}, {0x0002, "no valid white standard"},
     {0x0004, "no valid illuminant"},       {0x0008, "no valid observer"},
@@ -76,6 +78,7 @@ constexpr RemoteBit kRemoteBits[] = {
     {0x1000, "colour value 2 out of range"}, {0x2000, "colour value 3 out of range"},
     {0x4000, "not an SR or boolean"},      {0x8000, "no valid value or reference"},
 };
+// clang-format on
 
 template <std::size_t N>
 CodeInfo lookup(const Entry (&table)[N], std::uint8_t code) {

@@ -20,6 +20,8 @@ constexpr double grid_depth_mm = floor_rows * floor_spot_pitch_y_mm;
 }
 
 LuminanceField::LuminanceField(Lamp lamp, std::uint64_t seed) {
+  // Kept as laid out by hand: one lamp a row.
+  // clang-format off
   switch (lamp) {
     case Lamp::d65:  peak_ = 322; side_ = 0.33; depth_ = 0.12; cross_ = 0.05; centre_y_ = 0.0; flatten_ = 0.03; break;
     // TL84 and CWF tubes in this cabinet are older and sit differently: steeper side fall-off (TL84) and a
@@ -29,6 +31,7 @@ LuminanceField::LuminanceField(Lamp lamp, std::uint64_t seed) {
     case Lamp::a:    peak_ = 240; side_ = 0.26; depth_ = 0.14; cross_ = 0.03; centre_y_ = 0.0; flatten_ = 0.02; break;
     case Lamp::uv:   peak_ = 4.0; side_ = 0.30; depth_ = 0.15; cross_ = 0.04; centre_y_ = 0.0; flatten_ = 0.0; break;
   }
+  // clang-format on
   std::mt19937_64 rng(seed ^ (0x9E3779B97F4A7C15ull * (static_cast<std::uint64_t>(lamp) + 1)));
   std::uniform_real_distribution<double> ux(100.0, cabinet_width_mm - 100.0), uy(0.0, grid_depth_mm),
       us(120.0, 220.0), ua(-0.012, 0.012);

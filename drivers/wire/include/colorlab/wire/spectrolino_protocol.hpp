@@ -157,6 +157,8 @@ std::optional<std::uint8_t> baud_ctt(int baud);
 std::optional<int> scan_bt_baud(std::uint8_t bt);
 std::optional<std::uint8_t> baud_scan_bt(int baud);
 
+// Kept as laid out by hand: the manual's code tables, one line each.
+// clang-format off
 enum class Illuminant : std::uint8_t {
   A = 0x00, C = 0x01, D65 = 0x02, D50 = 0x03, User = 0x08, Dxx = 0x10,
   F1 = 0x18, F2 = 0x19, F3 = 0x1A, F4 = 0x1B, F5 = 0x1C, F6 = 0x1D, F7 = 0x1E, F8 = 0x1F,
@@ -181,6 +183,7 @@ enum class NewMeasurement : std::uint8_t { None = 0x00, Measurement = 0x01, Whit
 enum class ScanRef : std::uint8_t { Sensor = 0x00, Sight = 0x01 };
 enum class TableMode : std::uint8_t { Reflectance = 0x00, Transmission = 0x01 };
 enum class ScanHandshake : std::uint8_t { None = 0x00, XonXoff = 0x01, Hardware = 0x02 };
+// clang-format on
 
 inline constexpr std::uint8_t kDeviceNoSpectrolino = 0x20, kDeviceNoVideolino = 0x30, kDeviceNoSpectroScan = 0x40;
 inline constexpr std::uint8_t kTargetTechSpectrolino = 0x02;
