@@ -5,7 +5,7 @@ the floor map's cells and the LS-110's measuring discs where the floor homograph
 beyond the k = 2 band; a black dot: the measurement cannot tell.
 
 Places come from the stored geometry only: the locator's four outer corners of the patch grid (chart_layout.hpp:
-A1's, N1's, N10's, A10's, patch pitch 1, patch side 0.8 of it) and the floor's four corners (1200 × 600 mm).
+A1's, N1's, N10's, A10's, patch pitch 1, patch side 15/19 of it) and the floor's four corners (1200 × 600 mm).
 """
 from __future__ import annotations
 
@@ -19,7 +19,7 @@ from . import verification_data as vd
 from .plots import subplots, to_svg
 from .verification_photo import FLOOR_MM, apply, homography
 
-SG_COLUMNS, SG_ROWS, PATCH_SIDE = 14, 10, 0.8  # the SG's grid (chart_layout.hpp), in patch pitches
+SG_COLUMNS, SG_ROWS, PATCH_SIDE = 14, 10, 15.0 / 19.0  # the SG's grid (chart_layout.cpp): 15 mm patches, 19 mm pitch
 RATIO_ALPHA = 0.6    # the ratio layer over the floor: the photograph shows through
 DIFFERS = dict(edgecolor="#d00000", linewidth=1.6)
 CHART_CMAP, RATIO_CMAP = "magma_r", "RdBu_r"

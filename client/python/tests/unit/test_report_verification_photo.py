@@ -29,7 +29,8 @@ from colorlab.report.fetch import RunData
 from colorlab.tables import measurements_frame
 
 W, H = 1600, 1200  # the photograph's full size; its kept preview is half that (the daemon's mosaic preview)
-PITCH_MM = 20.0
+PITCH_MM = 19.0
+SIDE = 15.0 / 19.0  # an SG's patch side in pitches: 15 mm patches on a 19 mm pitch
 DEFECT_PATCH = "F5"
 DEFECT_RATIO = 1.10
 
@@ -115,7 +116,7 @@ def build():
     photo = np.full((H, W), 0.25)
     photo[40:120, 60:140] = 1.0
     client.docs["cc"] = {"id": "cc", "campaign": "characterize-camera"}
-    gw, gh = 13.8, 9.8
+    gw, gh = 13 + SIDE, 9 + SIDE
     corners = [list(chart_px(x, y)) for x, y in ((0, 0), (gw, 0), (gw, gh), (0, gh))]
     client.rows["cc"] = [measurement(1, "chart/raw", 1.0, {"format": "raw", "corners": corners, "width": W,
                                                           "height": H, "reprojection_rms_px": 0.1})]
@@ -205,14 +206,14 @@ class MapsOverThePhotograph(unittest.TestCase):
         img = raster(fig)
         for pid in (DEFECT_PATCH, "E5", "G5", "F4", "F6", "N10"):
             col, row = ord(pid[0]) - ord("A"), int(pid[1:]) - 1
-            centre = chart_px(col + 0.4, row + 0.4)  # the test's own camera, not the report's homography
+            centre = chart_px(col + SIDE / 2, row + SIDE / 2)  # the test's own camera, not the report's homography
             want = np.array(cmap(norm(self.values[pid]))[:3])
             got = pixel(img, ax, centre)
             self.assertLess(np.abs(got - want).max(), 3 / 255, (pid, got, want))
-        v, dist = value_of(pixel(img, ax, chart_px(5.4, 4.4)), cmap, norm)
+        v, dist = value_of(pixel(img, ax, chart_px(5 + SIDE / 2, 4 + SIDE / 2)), cmap, norm)
         self.assertAlmostEqual(v, 3.1, delta=0.02)
         # The red outline: on the defect patch's edge, half way along its top.
-        edge = pixel(img, ax, chart_px(5.4, 4.0))
+        edge = pixel(img, ax, chart_px(5 + SIDE / 2, 4.0))
         self.assertGreater(edge[0], 0.6)
         self.assertLess(edge[1], 0.35)
 
