@@ -131,7 +131,7 @@ def _floor_row(rows, floor_items):
 
 def floor_photo(client, run_id, floor_items) -> Photo | None:
     """A floor-luminance run's floor photograph for the lamp and level compared, with the floor's corners."""
-    rows = _rows(client, run_id, "")
+    rows = _rows(client, run_id, None)
     row = _floor_row(rows, floor_items)
     if row is None:
         return None
