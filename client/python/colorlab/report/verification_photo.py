@@ -140,10 +140,13 @@ def floor_photo(client, run_id, floor_items) -> Photo | None:
     if not corners or len(corners) != 4 or not data.get("width") or not data.get("height"):
         return None
     level = str(row["step"])[2:]  # "<lamp>/D<level>"
+    lamp, _, dimmer = level.partition("/D")
     calls = _kept(client, run_id, "camera.photograph_floor")
-    # The frame committed with this level's steps (its calibration spots or its photograph row); else, when no
-    # level was photographed twice (a lamp change retakes it), the level's place among the P rows.
-    tagged = [c for c in calls if any(str(it.get("step", "")).startswith((f"P/{level}", f"C/{level}/")) for it in c)]
+    # A kept frame's step is the run's progress label when it was committed: floor-luminance labels each level
+    # "<lamp> <level>%" before photographing it. The last frame under this level's label (a lamp change retakes the
+    # level); else, when every level was photographed once, the level's place among the P rows.
+    tags = (f"{lamp} {dimmer}%", f"P/{level}", f"C/{level}/")
+    tagged = [c for c in calls if any(str(it.get("step", "")).startswith(tags) for it in c)]
     ps = [r for r in rows if str(r.get("step", "")).startswith("P/")]
     if tagged:
         chosen = tagged[-1]

@@ -142,10 +142,11 @@ def build():
     client.rows["fl"] = rows
     client.bytes["b" * 64] = png(np.full((H // 2, W // 2), 0.1))  # D100's frame: darker, must not be shown
     client.bytes["c" * 64] = png(np.full((H // 2, W // 2), 0.6))
+    # Kept frames carry the run's progress label as their step, as colorlabd commits them.
     client.kept["fl"] = [{"name": "camera.photograph_floor#2/preview", "sha256": "b" * 64, "kind": "preview",
-                          "step": "C/D65/D100/r4c4", "media_type": "image/png"},
+                          "step": "D65 100%", "media_type": "image/png"},
                          {"name": "camera.photograph_floor#40/preview", "sha256": "c" * 64, "kind": "preview",
-                          "step": "C/D65/D50/r4c4", "media_type": "image/png"}]
+                          "step": "D65 50%", "media_type": "image/png"}]
     # The verification: every patch, one 3.1 ΔE00 off; the floor map at D65 50 %, rows 0–2 × cols 0–3 10 % bright.
     comps = []
     values = {}
