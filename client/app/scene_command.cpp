@@ -5,7 +5,11 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "client_support.hpp"
 #include "colorlab/core/error.hpp"
@@ -26,7 +30,31 @@ struct SceneOptions {
   std::string lab;
   std::vector<std::string> lamps;
   double dimmer = 100.0;
+  std::string lens;
 };
+
+// --lens fx,fy,cx,cy[,k1,k2]: the lab's lens calibration, as `colorlab analyze locate-chart --lens` takes it.
+std::optional<verify::CameraIntrinsics> parse_lens(const std::string& text) {
+  if (text.empty()) return std::nullopt;
+  std::vector<double> v;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    try {
+      std::size_t used = 0;
+      v.push_back(std::stod(item, &used));
+      if (used != item.size()) throw std::invalid_argument(item);
+    } catch (const std::exception&) {
+      throw Error(ErrorClass::bad_parameter, "--lens: \"" + item + "\" is not a number", "--lens fx,fy,cx,cy[,k1,k2] in pixels");
+    }
+  }
+  if (v.size() != 4 && v.size() != 6)
+    throw Error(ErrorClass::bad_parameter, "--lens needs 4 or 6 numbers, got " + std::to_string(v.size()),
+                "--lens fx,fy,cx,cy[,k1,k2] (OpenCV's model, pixels of the located photograph)");
+  verify::CameraIntrinsics k{v[0], v[1], v[2], v[3], 0, 0};
+  if (v.size() == 6) k.k1 = v[4], k.k2 = v[5];
+  return k;
+}
 
 // A run is its id (fetched as the daemon's JSON export) or a file holding that export, so a scene can be made
 // where the daemon is not, from `colorlab export RUN -f json` files.
@@ -72,7 +100,7 @@ void add_scene_command(CLI::App& app, GlobalOptions& global) {
       "scene",
       "Export the measured scene for a renderer: DIR/scene.json (cabinet, lamps, chart spectra, camera, LS-110 "
       "scale) and DIR/build_scene.py (Blender: blender -b --factory-startup -noaudio -P DIR/build_scene.py)");
-  cmd->add_option("runs", o->runs, "a chart-read run and, for the lamps' levels, a cabinet-grid run (ids or JSON export files)")
+  cmd->add_option("runs", o->runs, "a chart-read run, for the lamps' levels a cabinet-grid run, for the camera's pose a characterize-camera run (ids or JSON export files)")
       ->required();
   cmd->add_option("-o,--output", o->output, "directory to write (created)")->required();
   cmd->add_option("--lab", o->lab,
@@ -82,11 +110,16 @@ void add_scene_command(CLI::App& app, GlobalOptions& global) {
   cmd->add_option("--dimmer", o->dimmer, "dimmer level whose LS-110 readings set the lamps' levels (%)")
       ->check(CLI::Range(0.0, 100.0))
       ->capture_default_str();
+  cmd->add_option("--lens", o->lens,
+                  "the lab's lens calibration fx,fy,cx,cy[,k1,k2] (pixels of the located photograph), for the camera's "
+                  "intrinsics with a characterize-camera run's pose (default: a nominal 50 mm lens, said so in scene.json)");
   cmd->callback([&global, o] {
     const auto [cabinet, cabinet_source] = choose_cabinet(global, *o);
     std::vector<json> runs;
     for (const auto& r : o->runs) runs.push_back(load_run(global, r));
-    const json scene = verify::export_scene(cabinet, runs, {o->lamps, o->dimmer});
+    verify::SceneExportOptions so{o->lamps, o->dimmer, parse_lens(o->lens), ""};
+    if (so.lens) so.lens_source = "lens calibration given with --lens";
+    const json scene = verify::export_scene(cabinet, runs, so);
     verify::write_scene(scene, o->output);
     json lamps = json::array();
     for (const auto& l : scene["lamps"]) lamps.push_back({{"name", l["name"]}, {"luminance_cd_m2", l["luminance_cd_m2"]},

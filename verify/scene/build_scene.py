@@ -12,7 +12,8 @@
 # luminance: one render per lamp, its emitter's luminance as emission and each surface's luminous reflectance
 #            under that lamp as albedo: the image is the floor's and chart's luminance in cd/m² (exact for one
 #            lamp, because every surface is grey in luminance under it). Files: luminance_<lamp>.exr.
-# The view: "camera" is scene.json's camera; "top" looks straight down from just below the lamps with an
+# The view: "camera" is scene.json's camera — with a pose from the located chart, its axes, position and principal
+#            point (give --size with the photograph's aspect, resolution_px, for the photograph's frame); "top" looks straight down from just below the lamps with an
 #            orthographic lens whose frame spans the cabinet's width, pixel (i, j) centred on floor point
 #            ((i + ½)·w/W, depth − (j + ½)·w/W) — the floor as an imaging luminance meter.
 # Every image: 32-bit float OpenEXR, RGB all equal, view transform Standard, no denoising, fixed seed.
@@ -197,10 +198,22 @@ def build(scene_doc, args):
         cam_data.sensor_fit = "HORIZONTAL"
         cam_data.sensor_width = k["sensor_mm"][0]
         cam_data.clip_start = 1e-3
-        cam.location = k["position_m"]
-        look = [k["look_at_m"][i] - k["position_m"][i] for i in range(3)]
         import mathutils
-        cam.rotation_euler = mathutils.Vector(look).to_track_quat("-Z", "Y").to_euler()
+        if "axes" in k:
+            # The pose from the located chart: OpenCV's camera axes (x right, y down, z forward) in the cabinet;
+            # Blender's camera looks down its -Z with +Y up, so its axes are (x, -y, -z).
+            x, y, z = (mathutils.Vector(a) for a in k["axes"])
+            rot = mathutils.Matrix((x, -y, -z)).transposed()
+            cam.matrix_world = mathutils.Matrix.Translation(k["position_m"]) @ rot.to_4x4()
+            # The principal point off the frame's centre: Blender's shift, in units of the frame's larger side.
+            w_px, h_px = k["resolution_px"]
+            ip = k["intrinsics_px"]
+            cam_data.shift_x = ((w_px - 1) / 2.0 - ip["cx"]) / max(w_px, h_px)
+            cam_data.shift_y = (ip["cy"] - (h_px - 1) / 2.0) / max(w_px, h_px)
+        else:
+            cam.location = k["position_m"]
+            look = [k["look_at_m"][i] - k["position_m"][i] for i in range(3)]
+            cam.rotation_euler = mathutils.Vector(look).to_track_quat("-Z", "Y").to_euler()
     return scene, lamps, patches, floor_mat
 
 

@@ -1,6 +1,7 @@
 #include "colorlab/verify/scene_export.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -75,6 +76,7 @@ double photopic(const Tabulated& s, const Tabulated& ybar) {
 struct Runs {
   const json* chart = nullptr;
   const json* grid = nullptr;
+  const json* camera = nullptr;  // characterize-camera: the located chart
 };
 
 std::string run_id(const json& doc) {
@@ -89,9 +91,13 @@ Runs classify(const std::vector<json>& runs) {
         !doc["measurements"].is_array())
       malformed(run_id(doc), "not a run export ({run, measurements})");
     const std::string campaign = doc["run"].value("campaign", std::string());
-    const json** slot = campaign == "chart-read" ? &out.chart : campaign == "cabinet-grid" ? &out.grid : nullptr;
+    const json** slot = campaign == "chart-read"            ? &out.chart
+                        : campaign == "cabinet-grid"        ? &out.grid
+                        : campaign == "characterize-camera" ? &out.camera
+                                                            : nullptr;
     if (!slot) bad("run " + run_id(doc) + " is a " + (campaign.empty() ? "run of no campaign" : campaign) +
-                   " run; a scene is made of one chart-read and at most one cabinet-grid run");
+                   " run; a scene is made of one chart-read, at most one cabinet-grid and at most one "
+                   "characterize-camera run");
     if (*slot) bad("two " + campaign + " runs (" + run_id(**slot) + ", " + run_id(doc) + "): give one");
     *slot = &doc;
   }
@@ -227,7 +233,7 @@ std::optional<GridFit> fit_luminance(const CabinetGeometry& cab, const CabinetEm
   return f;
 }
 
-json camera_part(const CabinetGeometry& cab) {
+json nominal_camera(const CabinetGeometry& cab) {
   // Estimated, not measured: the dissertation's setup (Figs. 27–29) aims the camera at the chart's centre at
   // 48° from its normal, from the open front; the distance and lens are assumed (a 50 mm lens on the EOS
   // 20D's 22.5 × 15 mm sensor, the chart across ~70 % of the frame width).
@@ -243,8 +249,104 @@ json camera_part(const CabinetGeometry& cab) {
           {"distortion", {{"k1", 0.0}, {"k2", 0.0}}},
           {"estimated", true},
           {"how", "nominal: the dissertation's camera geometry (aimed at the chart centre, 48° from the chart's "
-                  "normal, from the front; Figs. 27–29) with an assumed 50 mm lens and distance; not yet from the "
-                  "located chart or a lens calibration (docs/verify.md)"}};
+                  "normal, from the front; Figs. 27–29) with an assumed 50 mm lens and distance; give a "
+                  "characterize-camera run for the pose from the located chart (docs/verify.md)"}};
+}
+
+// The located chart of a characterize-camera run: its chart/<format> row (raw preferred: §7.3 and §7.4 use it).
+const json* located_chart(const json& doc) {
+  const json* found = nullptr;
+  for (const auto& m : doc["measurements"]) {
+    const std::string step = m.value("step", std::string());
+    if (step.rfind("chart/", 0) != 0 || !m.contains("data") || !m["data"].is_object() || !m["data"].contains("corners"))
+      continue;
+    if (step == "chart/raw") return &m;
+    if (!found) found = &m;
+  }
+  return found;
+}
+
+double number_in(const json& d, const char* key, const std::string& run) {
+  if (!d.contains(key) || !d[key].is_number()) malformed(run, std::string("the located chart has no number '") + key + "'");
+  return d[key].get<double>();
+}
+
+// The locator's grid corners (chart_layout.cpp: patch pitch 1, the SG's patches 15/19 of it, a CC24's 0.9): their
+// places on the floor, the chart lying as chart_part puts it (row 1 at the back, column A at the left).
+std::array<std::array<double, 3>, 4> grid_corners_mm(const CabinetGeometry& cab, const Layout& layout, double pitch) {
+  const double fraction = layout.columns == 14 ? 15.0 / 19.0 : 0.9;
+  const double hw = (layout.columns - 1 + fraction) * pitch / 2, hh = (layout.rows - 1 + fraction) * pitch / 2;
+  const double cx = cab.chart_center_x_mm, cy = cab.chart_center_y_mm;
+  return {{{cx - hw, cy + hh, 0.0}, {cx + hw, cy + hh, 0.0}, {cx + hw, cy - hh, 0.0}, {cx - hw, cy - hh, 0.0}}};
+}
+
+json camera_part(const CabinetGeometry& cab, const json& chart_doc, const json* camera_doc, const SceneExportOptions& o) {
+  if (!camera_doc) return nominal_camera(cab);
+  const std::string id = run_id(*camera_doc);
+  const json* row = located_chart(*camera_doc);
+  if (!row) malformed(id, "no chart/<format> row with corners: the characterize-camera run located no chart");
+  const json& d = (*row)["data"];
+  const std::string format = d.value("format", std::string("raw"));
+  const double width = number_in(d, "width", id), height = number_in(d, "height", id);
+  if (!(width > 0 && height > 0)) malformed(id, "the located chart's photograph has no size");
+  ChartSighting s;
+  const json& c = d["corners"];
+  if (!c.is_array() || c.size() != 4) malformed(id, "the located chart has not four corners");
+  for (std::size_t i = 0; i < 4; ++i) {
+    if (!c[i].is_array() || c[i].size() != 2 || !c[i][0].is_number() || !c[i][1].is_number())
+      malformed(id, "corner " + std::to_string(i) + " of the located chart is not [x, y]");
+    s.corners_px[i] = {c[i][0].get<double>(), c[i][1].get<double>()};
+  }
+  // The locator's stated accuracy: the RMS of the detected patch centres against its fit (what verify's
+  // misregistration source uses); a corner extrapolated from 140 centres is known better, so this bounds it.
+  s.accuracy_px = d.contains("reprojection_rms_px") && d["reprojection_rms_px"].is_number()
+                      ? d["reprojection_rms_px"].get<double>()
+                      : 0.5;
+  const json params = chart_doc["run"].value("params", json::object());
+  const Layout layout = layout_of(params.value("chart", std::string("sg")), run_id(chart_doc));
+  s.corners_mm = grid_corners_mm(cab, layout, params.value("pitch_mm", 19.0));
+
+  // Intrinsics: the lab's lens calibration when given; else the EOS 20D's nominal 50 mm on its 22.5 mm-wide sensor
+  // (no run stores the photograph's EXIF), principal point at the centre, no distortion.
+  const double sensor_w = 22.5;
+  CameraIntrinsics k;
+  std::string source;
+  if (o.lens) {
+    k = *o.lens;
+    source = o.lens_source.empty() ? "the lab's lens calibration" : o.lens_source;
+  } else {
+    k.fx = k.fy = 50.0 * width / sensor_w;
+    k.cx = width / 2 - 0.5, k.cy = height / 2 - 0.5;
+    source = "nominal: an assumed 50 mm lens on the EOS 20D's 22.5 mm-wide sensor (no lens calibration given; no "
+             "run stores the photograph's EXIF focal length)";
+  }
+  const CameraPose p = pose_from_chart(s, k);
+  const auto& z = p.axes[2];
+  // Where the optical axis meets the floor (z = 0), for renderers that aim by a target.
+  const double t = z[2] < 0 ? -p.position_mm[2] / z[2] : 1000.0;
+  json axes = json::array();
+  for (const auto& a : p.axes) axes.push_back({a[0], a[1], a[2]});
+  json corners = json::array();
+  for (const auto& q : s.corners_px) corners.push_back({q[0], q[1]});
+  return {{"position_m", {p.position_mm[0] * mm, p.position_mm[1] * mm, p.position_mm[2] * mm}},
+          {"look_at_m", {(p.position_mm[0] + t * z[0]) * mm, (p.position_mm[1] + t * z[1]) * mm, (p.position_mm[2] + t * z[2]) * mm}},
+          {"up", {-p.axes[1][0], -p.axes[1][1], -p.axes[1][2]}},
+          {"axes", axes},
+          {"axes_note", "the camera's x (image right), y (image down) and z (optical axis, forward) in the cabinet's frame: OpenCV's camera"},
+          {"focal_length_mm", k.fx * sensor_w / width},
+          {"sensor_mm", {sensor_w, sensor_w * height / width}},
+          {"resolution_px", {width, height}},
+          {"intrinsics_px", {{"fx", k.fx}, {"fy", k.fy}, {"cx", k.cx}, {"cy", k.cy}}},
+          {"distortion", {{"k1", k.k1}, {"k2", k.k2}}},
+          {"intrinsics_source", source},
+          {"estimated", !o.lens},
+          {"pose", {{"source", "located chart"}, {"run", id}, {"format", format}, {"corners_px", corners},
+                    {"corner_accuracy_px", s.accuracy_px}, {"reprojection_px", p.reprojection_px},
+                    {"position_sigma_m", {p.position_sigma_mm[0] * mm, p.position_sigma_mm[1] * mm, p.position_sigma_mm[2] * mm}},
+                    {"axis_sigma_deg", p.axis_sigma_deg}}},
+          {"how", "solvePnP (OpenCV, IPPE) of the chart locator's four outer grid corners on the " + format +
+                      " photograph against the chart's geometry where the cabinet puts it, with the intrinsics above; "
+                      "σ from the corners' stated accuracy through the solution's Jacobian"}};
 }
 
 }  // namespace
@@ -332,7 +434,7 @@ json export_scene(const CabinetGeometry& cab, const std::vector<json>& runs, con
                        {"grid_pitch_m", {cab.grid_pitch_x_mm * mm, cab.grid_pitch_y_mm * mm}}}},
           {"lamps", lamp_parts},
           {"chart", chart},
-          {"camera", camera_part(cab)},
+          {"camera", camera_part(cab, *r.chart, r.camera, o)},
           {"luminance_scale", {{"instrument", "LS-110"},
                                {"source_run", r.grid ? json(run_id(*r.grid)) : json(nullptr)},
                                {"dimmer_percent", o.dimmer_percent},

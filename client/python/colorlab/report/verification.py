@@ -11,6 +11,8 @@ from __future__ import annotations
 from . import chapter8, fetch
 from . import verification_data as vd
 from . import verification_maps as maps
+from . import verification_overlay as overlay
+from . import verification_photo as photos
 from .html import cell, esc, figure
 
 PATCH_KINDS = ("colour_7_3", "colour_7_4")
@@ -31,6 +33,7 @@ def link(client, runs) -> None:
         if found is None and client is not None:
             found = _chart_read_of(client, against)
         run.extra["chart_read"] = found
+        run.extra["photos"] = photos.load(client, run, vd.by_kind(vd.comparisons(run)))
 
 
 def _chart_read_of(client, against):
@@ -174,6 +177,31 @@ def spot_table(run, kind, items) -> str:
                    "cannot tell", "largest source"], rows)
 
 
+def photo_maps(run, kinds) -> list[str]:
+    out = []
+    shot = run.extra.get("photos") or {}
+    if "chart" in shot:
+        p = shot["chart"]
+        svg = overlay.chart_over_photo(p, kinds, f"{run.short}-verify-chart-photo")
+        if svg:
+            out.append(figure(f"{run.short}-fig-verify-chart-photo", svg,
+                              f"Over the chart photograph (run {esc(p.run_id)}, frame {esc(p.blob[:12])}…, shown in grey): "
+                              "each patch's difference in false colour where the chart locator found the patch; "
+                              "outlined in red where it differs beyond the measurement's k = 2 band, a dot where the "
+                              "measurement cannot tell.", "verify-chart-photo"))
+    if "floor" in shot:
+        p = shot["floor"]
+        svg = overlay.floor_over_photo(p, kinds, f"{run.short}-verify-floor-photo")
+        if svg:
+            out.append(figure(f"{run.short}-fig-verify-floor-photo", svg,
+                              f"Over the floor photograph ({esc(p.what)} of run {esc(p.run_id)}, shown in grey): the "
+                              "luminance ratio rendered / measured as a translucent layer on the floor map's cells, "
+                              "the LS-110's measuring discs opaque, placed through the floor's four corners; outlined "
+                              "in red where it differs beyond k = 2, a dot where the measurement cannot tell.",
+                              "verify-floor-photo"))
+    return out
+
+
 def section(run) -> str:
     items = vd.comparisons(run)
     s = vd.summary(run, items)
@@ -190,6 +218,7 @@ def section(run) -> str:
                           "(1 = agree; the floor map's cells are the difference image; the LS-110's spots drawn at "
                           "their places over the measured floor luminance in grey, lighter = brighter): outlined in red where it differs beyond k = 2, a dot where the measurement "
                           "cannot tell.", "verify-floor"))
+    out += photo_maps(run, kinds)
     for kind in PATCH_KINDS:
         if kind in kinds:
             out.append(patch_table(run, kind, kinds[kind]))

@@ -4,6 +4,7 @@
 // placement with every patch's measured reflectance, the camera, the LS-110's absolute scale) and
 // build_scene.py, which builds that scene in Blender 3.4 and renders it with Cycles.
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -11,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "colorlab/verify/cabinet.hpp"
+#include "colorlab/verify/camera_pose.hpp"
 
 namespace colorlab::verify {
 
@@ -19,13 +21,18 @@ struct SceneExportOptions {
   // there is no cabinet-grid run).
   std::vector<std::string> lamps;
   double dimmer_percent = 100.0;
+  // The lab's lens calibration (OpenCV's model, pixels of the located photograph) and where it comes from; without
+  // it the camera's intrinsics are the nominal EOS 20D's (stated so in scene.json).
+  std::optional<CameraIntrinsics> lens;
+  std::string lens_source;
 };
 
 inline constexpr std::string_view scene_schema = "colorlab-scene/1";
 
 // Builds scene.json from run documents as `GET /v1/runs/{id}/export?format=json` returns them ({run,
-// measurements}): exactly one chart-read run (the patch spectra) and at most one cabinet-grid run (each
-// lamp's luminance, fitted to its LS-110 readings). Throws Error(bad_parameter) for a run of another
+// measurements}): exactly one chart-read run (the patch spectra), at most one cabinet-grid run (each
+// lamp's luminance, fitted to its LS-110 readings) and at most one characterize-camera run (the located chart on
+// its photograph: the camera's pose). Throws Error(bad_parameter) for a run of another
 // campaign, a missing chart-read, a lamp with neither readings nor a configured luminance, a UV lamp (no
 // named spectrum to give a renderer), and Error(bad_data) for a malformed run.
 nlohmann::json export_scene(const CabinetGeometry& cabinet, const std::vector<nlohmann::json>& runs,

@@ -1,0 +1,170 @@
+// The camera in `colorlab scene` from the located chart (issue 23): the simulator photographs its chart at seeded
+// poses, the chart locator finds it on the raw mosaic as characterize-camera runs it (no lens given), and the
+// exported camera must be where the simulator's camera is. The bound is the pose's own stated uncertainty: the
+// locator's stated accuracy (its reprojection RMS, one σ per corner coordinate) carried through the solution's
+// Jacobian, at 4 σ per axis — not a number fitted to today's output. A lens 10 % off must miss it.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <numbers>
+
+#include "colorlab/analysis/chart_locate.hpp"
+#include "colorlab/sim/camera/camera_model.hpp"
+#include "colorlab/verify/cabinet.hpp"
+#include "colorlab/verify/scene_export.hpp"
+#include "simulated_runs.hpp"
+
+namespace colorlab::verify {
+namespace {
+
+namespace cam = colorlab::sim::camera;
+namespace ca = colorlab::analysis;
+using nlohmann::json;
+
+constexpr double kSigmas = 4.0;
+
+ca::PhotoView raw_view(const cam::RawFrame& f) {
+  ca::PhotoView v;
+  v.data = f.pixels.data();
+  v.width = f.width;
+  v.height = f.height;
+  v.channels = 1;
+  v.type = ca::SampleType::u16;
+  v.bit_depth = 12;
+  v.black_level = f.black_level;
+  v.cfa = ca::CfaPattern::rggb;
+  return v;
+}
+
+// The SG's look for the locator (which way up), from the scene's own patches, as characterize-camera passes
+// the chart-read's Y per patch.
+ca::ChartReference reference_of(const sim::Scene& scene) {
+  ca::ChartReference r;
+  for (std::size_t k = 0; k < scene.chart().patches.size(); ++k) r.luminance.push_back(scene.patch_xyz(static_cast<int>(k))[1]);
+  return r;
+}
+
+struct Truth {
+  Eigen::Vector3d position_mm, axis;
+};
+
+// Where the simulator's camera is (chart_pose.cpp's definition: chart point (X, Y) mm from the board's top-left →
+// camera R·(X − W/2, Y − H/2, 0) + t), carried to the cabinet by the simulator's own chart placement
+// (Scene::chart_to_floor_mm: x along the board's width, y against its rows, z up out of the floor).
+Truth truth_of(const cam::ChartPose& p, const cam::CameraConfig& cc, const sim::Scene& scene) {
+  const double deg = std::numbers::pi / 180;
+  const Eigen::Matrix3d R = (Eigen::AngleAxisd(p.rotation_deg * deg, Eigen::Vector3d::UnitZ()) *
+                             Eigen::AngleAxisd(p.tilt_deg * deg, Eigen::Vector3d::UnitX()) *
+                             Eigen::AngleAxisd(p.swing_deg * deg, Eigen::Vector3d::UnitY())).toRotationMatrix();
+  const double f = cc.chart_height_fraction * cc.height * p.distance_mm / sim::chart_height_mm;
+  const Eigen::Vector3d t = R * Eigen::Vector3d(-sim::chart_width_mm / 2, -sim::chart_height_mm / 2, 0) +
+                            Eigen::Vector3d(p.shift_x * cc.width * p.distance_mm / f, p.shift_y * cc.height * p.distance_mm / f,
+                                            p.distance_mm);
+  const Eigen::Vector3d c = -R.transpose() * t;  // camera centre, board coordinates (z into the board)
+  const auto [fx, fy] = scene.chart_to_floor_mm(c.x(), c.y());
+  const Eigen::Vector3d a = R.transpose() * Eigen::Vector3d::UnitZ();
+  return {{fx, fy, -c.z()}, {a.x(), -a.y(), -a.z()}};
+}
+
+json characterize_run(const ca::ChartLocation& loc, int width, int height) {
+  json corners = json::array();
+  for (const auto& c : loc.corners) corners.push_back({c.x, c.y});
+  json row{{"step", "chart/raw"}, {"quantity", "chart_location"}, {"value", loc.confidence},
+           {"data", {{"format", "raw"}, {"corners", corners}, {"width", width}, {"height", height},
+                     {"reprojection_rms_px", loc.reprojection_rms_px}}}};
+  return {{"run", {{"id", "0193c0de-0000-7000-8000-0000000cc0de"}, {"campaign", "characterize-camera"},
+                   {"params", json::object()}, {"status", "finished_ok"}}},
+          {"measurements", json::array({row})}};
+}
+
+TEST(SceneCameraPose, FromTheLocatedChartWhereTheSimulatorsCameraIs) {
+  for (std::uint64_t seed : {3u, 11u}) {
+    sim::SceneConfig sc;
+    sc.seed = 4;
+    sc.lamps_on_at_start = {sim::Lamp::d65};
+    auto scene = std::make_shared<sim::Scene>(sc, std::make_shared<sim::SimClock>());
+    cam::CameraConfig cc;
+    cc.width = 1752;
+    cc.height = 1168;
+    cc.chart_height_fraction = 0.62;
+    cam::ChartPose pose = cam::random_chart_pose(seed);
+    pose.k1 = pose.k2 = 0;  // characterize-camera's locator is given no lens: a distortion-free bench lens
+    cc.pose = pose;
+    const cam::CameraModel camera(scene, cc);
+    cam::CameraSettings settings;
+    settings.shutter_s = 1.0 / 30;
+    const cam::RawFrame frame = camera.render(settings, 1);
+    ca::LocateOptions lo;
+    lo.reference = reference_of(*scene);
+    const ca::ChartLocation loc = ca::locate_chart(raw_view(frame), ca::ChartType::sg140, lo);
+
+    const auto l = camera.lens();  // the lab's lens calibration: the simulator's lens
+    SceneExportOptions o;
+    o.lamps = {"D65"};
+    o.lens = CameraIntrinsics{l.fx, l.fy, l.cx, l.cy, l.k1, l.k2};
+    o.lens_source = "the simulator's lens";
+    const std::vector<json> runs{testing::chart_read_run(*scene, 1), characterize_run(loc, cc.width, cc.height)};
+    const json k = export_scene(default_cabinet(), runs, o)["camera"];
+    const Truth want = truth_of(pose, cc, *scene);
+
+    ASSERT_EQ(k["pose"]["source"], "located chart");
+    EXPECT_FALSE(k["estimated"].get<bool>());
+    EXPECT_DOUBLE_EQ(k["pose"]["corner_accuracy_px"].get<double>(), loc.reprojection_rms_px);
+    const auto pos = k["position_m"].get<std::vector<double>>();
+    const auto sig = k["pose"]["position_sigma_m"].get<std::vector<double>>();
+    for (std::size_t i = 0; i < 3; ++i) {
+      EXPECT_LE(std::abs(pos[i] * 1000 - want.position_mm[static_cast<Eigen::Index>(i)]), kSigmas * sig[i] * 1000)
+          << "seed " << seed << " axis " << i << ": exported " << pos[i] * 1000 << " mm, simulator "
+          << want.position_mm[static_cast<Eigen::Index>(i)] << " mm, σ " << sig[i] * 1000 << " mm";
+    }
+    const auto z = k["axes"][2].get<std::vector<double>>();
+    const double angle = std::acos(std::clamp(Eigen::Vector3d(z[0], z[1], z[2]).dot(want.axis), -1.0, 1.0)) * 180 / std::numbers::pi;
+    const double axis_sigma = k["pose"]["axis_sigma_deg"].get<double>();
+    EXPECT_LE(angle, kSigmas * axis_sigma) << "seed " << seed;
+    std::printf("[ pose %llu ] camera at (%.1f, %.1f, %.1f) mm, simulator (%.1f, %.1f, %.1f) mm, σ (%.2f, %.2f, %.2f) mm; "
+                "axis %.3f° off (σ %.3f°); locator RMS %.3f px, corners' reprojection %.3f px\n",
+                static_cast<unsigned long long>(seed), pos[0] * 1000, pos[1] * 1000, pos[2] * 1000, want.position_mm.x(),
+                want.position_mm.y(), want.position_mm.z(), sig[0] * 1000, sig[1] * 1000, sig[2] * 1000, angle, axis_sigma,
+                loc.reprojection_rms_px, k["pose"]["reprojection_px"].get<double>());
+
+    // The bound is not so wide that a wrong lens passes: 10 % off in focal length moves the camera beyond it.
+    o.lens->fx *= 1.1, o.lens->fy *= 1.1;
+    const json wrong = export_scene(default_cabinet(), runs, o)["camera"];
+    const auto wp = wrong["position_m"].get<std::vector<double>>();
+    bool outside = false;
+    for (std::size_t i = 0; i < 3; ++i)
+      outside = outside || std::abs(wp[i] * 1000 - want.position_mm[static_cast<Eigen::Index>(i)]) > kSigmas * sig[i] * 1000;
+    EXPECT_TRUE(outside) << "seed " << seed << ": a lens 10 % off still agrees — the bound cannot tell";
+  }
+}
+
+TEST(SceneCameraPose, WithoutALensCalibrationTheIntrinsicsSayTheyAreNominal) {
+  sim::SceneConfig sc;
+  auto scene = std::make_shared<sim::Scene>(sc, std::make_shared<sim::SimClock>());
+  ca::ChartLocation loc;
+  // A chart seen square-on from above its centre, 1000 px across 262 mm.
+  const double s = 1000.0 / 262.0;
+  loc.corners = {{{876 - 131 * s, 584 - 93 * s}, {876 + 131 * s, 584 - 93 * s}, {876 + 131 * s, 584 + 93 * s}, {876 - 131 * s, 584 + 93 * s}}};
+  loc.reprojection_rms_px = 0.2;
+  SceneExportOptions o;
+  o.lamps = {"D65"};
+  const json k = export_scene(default_cabinet(), {testing::chart_read_run(*scene, 1), characterize_run(loc, 1752, 1168)}, o)["camera"];
+  EXPECT_TRUE(k["estimated"].get<bool>());
+  EXPECT_NE(k["intrinsics_source"].get<std::string>().find("nominal"), std::string::npos);
+  // Straight above the chart's centre (600, 140) mm, looking down, at f·size/size_px = (50 · 1752 / 22.5) / s mm.
+  const auto p = k["position_m"].get<std::vector<double>>();
+  EXPECT_NEAR(p[0], 0.600, 1e-3);
+  EXPECT_NEAR(p[1], 0.140, 1e-3);
+  EXPECT_NEAR(p[2], 50.0 * 1752 / 22.5 / s / 1000, 1e-3);
+  // Without a characterize-camera run: the nominal camera, said so.
+  const json n = export_scene(default_cabinet(), {testing::chart_read_run(*scene, 1)}, o)["camera"];
+  EXPECT_TRUE(n["estimated"].get<bool>());
+  EXPECT_FALSE(n.contains("pose"));
+}
+
+}  // namespace
+}  // namespace colorlab::verify
