@@ -18,12 +18,22 @@ handlers on the same main thread find and refuse them: what they measure is the 
 Reports per route and phase: count, p50, p99 and the slowest answer (ms), and the machine's load average.
 Target (issue 27): the slowest answer of every route <= 50 ms in the busy phase.
 
+Attribution (load-independent where it can be): every answer carries colorlabd's Server-Timing header (queue: waiting
+for the io thread or the HTTP pool; handler, of it cpu on a CPU and store on the store's writer; later; app: the
+daemon's whole). Each answer slower than --slow-ms is split into: queued, handler on a CPU, handler waiting for a CPU
+or blocked, on the store's writer, and outside the daemon's handling (client - app: writing the answer, the network,
+the client's own turn on a CPU). Per phase the probe also reads the io (main) thread's CPU time and its time waiting
+for a CPU (/proc/PID/task/PID/schedstat), and from the daemon's log (COLORLAB_IO_LAG_MS=5, COLORLAB_IO_SLOW_MS set to
+--stage-ms) the longest stage on the io thread and the most CPU the thread spent in one late tick's interval: its
+longest task, in CPU time, which the machine's load does not lengthen.
+
 Usage: bench/service/latency_probe.py [--build build] [--time-scale 50] [--idle-s 60] [--json out.json]
 Run it niced when the machine is shared: nice -n 10 python3 bench/service/latency_probe.py
 """
 import argparse
 import json
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -54,7 +64,7 @@ READ_ROUTES = ["/v1", "/v1/instruments", "/v1/runs", "/v1/runs/{id}", "/v1/contr
 TERMINAL = ("finished_ok", "finished_error", "aborted", "interrupted")
 
 
-def start_daemon(build, state, scale, log_path=None):
+def start_daemon(build, state, scale, log_path=None, stage_ms=20):
     os.makedirs(os.path.join(state, "s", "campaigns"), exist_ok=True)
     with open(os.path.join(state, "s", "campaigns", "probe-ask.lua"), "w") as f:
         f.write(PROBE_ASK)
@@ -63,32 +73,72 @@ def start_daemon(build, state, scale, log_path=None):
         # The probe's clients start, answer, pause and resume over loopback TCP, as a lab's own console would.
         f.write(f"[simulator]\nenabled = true\ntime_scale = {scale}\nseed = 1\n[access]\nloopback_scope = \"control\"\n")
     log = open(log_path or os.path.join(state, "colorlabd.log"), "w")
+    env = dict(os.environ)
+    # The io thread's diagnostics (io_watch.hpp): stages and late ticks beyond stage_ms, each split by CPU time.
+    env.setdefault("COLORLAB_IO_LAG_MS", "5")
+    env.setdefault("COLORLAB_IO_SLOW_MS", str(stage_ms))
     proc = subprocess.Popen([os.path.join(build, "bin", "colorlabd"), "--config", cfg, "--state",
                              os.path.join(state, "s"), "--listen", "127.0.0.1:0"],
-                            stdout=subprocess.DEVNULL, stderr=log)
+                            stdout=subprocess.DEVNULL, stderr=log, env=env)
     endpoint = os.path.join(state, "s", "colorlabd.endpoint")
     for _ in range(600):
         if os.path.exists(endpoint):
             with open(endpoint) as f:
                 e = json.load(f)
             if e.get("pid") == proc.pid:
-                return proc, e["url"]
+                return proc, e["url"], log.name
         time.sleep(0.05)
     proc.kill()
     raise SystemExit("colorlabd did not start; see " + log.name)
 
 
+TIMING_PART = re.compile(r"([a-z]+);dur=([0-9.]+)")
+
+
+def server_timing(response):
+    """colorlabd's Server-Timing header as {part: ms}; {} when absent."""
+    if response is None:
+        return {}
+    return {k: float(v) for k, v in TIMING_PART.findall(response.headers.get("Server-Timing", ""))}
+
+
+def split_answer(ms, t):
+    """Where one answer's time went (ms), from its Server-Timing and the client's own time."""
+    if "app" not in t:
+        return {"outside": ms}
+    handler, cpu, store = t.get("handler", 0.0), t.get("cpu", 0.0), t.get("store", 0.0)
+    return {"queued": t.get("queue", 0.0), "handler_cpu": min(cpu, handler), "store": store,
+            "handler_waiting": max(0.0, handler - min(cpu, handler) - store), "later": t.get("later", 0.0),
+            "outside": max(0.0, ms - t["app"])}
+
+
 class Times:
-    def __init__(self):
+    def __init__(self, slow_ms):
         self.lock = threading.Lock()
+        self.slow_ms = slow_ms
         self.by_route = {}
         self.errors = {}
+        self.worst = {}          # route -> (ms, its split)
+        self.slow = []           # (route, ms, split) of every answer beyond slow_ms
+        self.handler_cpu = {}    # route -> [sum ms, max ms, max handler ms]
+        self.missing_timing = 0
 
-    def add(self, route, ms, status):
+    def add(self, route, ms, status, timing):
+        split = split_answer(ms, timing)
         with self.lock:
             self.by_route.setdefault(route, []).append(ms)
             if status >= 500 or status == 0:
                 self.errors[route] = self.errors.get(route, 0) + 1
+            if status and "app" not in timing:
+                self.missing_timing += 1
+            if route not in self.worst or ms > self.worst[route][0]:
+                self.worst[route] = (ms, split)
+            if ms > self.slow_ms:
+                self.slow.append((route, ms, split))
+            c = self.handler_cpu.setdefault(route, [0.0, 0.0, 0.0])
+            c[0] += timing.get("cpu", 0.0)
+            c[1] = max(c[1], timing.get("cpu", 0.0))
+            c[2] = max(c[2], timing.get("handler", 0.0))
 
 
 def timed(session, times, route, method, url, **kw):
@@ -99,7 +149,7 @@ def timed(session, times, route, method, url, **kw):
         status = r.status_code
     except requests.RequestException:
         r, status = None, 0
-    times.add(route, (time.perf_counter() - t0) * 1000.0, status)
+    times.add(route, (time.perf_counter() - t0) * 1000.0, status, server_timing(r))
     return r
 
 
@@ -152,13 +202,69 @@ def answered_execution(url):
     raise SystemExit("probe-ask did not end")
 
 
-def probe(url, until, label, ended_id):
-    times = Times()
+def main_thread_schedstat(pid):
+    """The daemon's main (io) thread: (s on a CPU, s runnable waiting for one) so far."""
+    try:
+        with open(f"/proc/{pid}/task/{pid}/schedstat") as f:
+            on_cpu, waiting = f.read().split()[:2]
+        return int(on_cpu) / 1e9, int(waiting) / 1e9
+    except (OSError, ValueError):
+        return None
+
+
+# Before the CPU split (an older colorlabd) a stage's line had no ", on a CPU": its CPU is then unknown (-1).
+STAGE_LINE = re.compile(r"slow stage '([^']+)' took ([0-9.]+) ms(?:, on a CPU ([0-9.]+) ms)?")
+LAG_LINE = re.compile(r"tick fired ([0-9.]+) ms late \(of its ([0-9.]+) ms: on a CPU ([0-9.]+), waiting for a CPU "
+                      r"([0-9.]+), blocked ([0-9.]+)\)")
+
+
+def io_thread_log(log_path, start, end):
+    """The io-thread lines the daemon logged between two offsets of its log: the longest stage (wall, and the most
+    CPU in one), and the late ticks' intervals (the most CPU in one, the most blocked in one, the most waiting)."""
+    out = {"stages": 0, "longest_stage": None, "most_cpu_stage": None, "late_ticks": 0, "tick_max_cpu_ms": 0.0,
+           "tick_max_blocked_ms": 0.0, "tick_max_waiting_ms": 0.0}
+    try:
+        with open(log_path, "rb") as f:
+            f.seek(start)
+            text = f.read(max(0, end - start)).decode("utf-8", "replace")
+    except OSError:
+        return out
+    for m in STAGE_LINE.finditer(text):
+        name, took, cpu = m.group(1), float(m.group(2)), float(m.group(3) or -1)
+        out["stages"] += 1
+        if not out["longest_stage"] or took > out["longest_stage"][1]:
+            out["longest_stage"] = (name, took, cpu)
+        if not out["most_cpu_stage"] or cpu > out["most_cpu_stage"][2]:
+            out["most_cpu_stage"] = (name, took, cpu)
+    for m in LAG_LINE.finditer(text):
+        out["late_ticks"] += 1
+        out["tick_max_cpu_ms"] = max(out["tick_max_cpu_ms"], float(m.group(3)))
+        out["tick_max_waiting_ms"] = max(out["tick_max_waiting_ms"], float(m.group(4)))
+        out["tick_max_blocked_ms"] = max(out["tick_max_blocked_ms"], float(m.group(5)))
+    return out
+
+
+def attribution(times):
+    """The answers beyond slow_ms: how many, the ms in each part summed, and how many each part dominated."""
+    parts = ("queued", "handler_cpu", "handler_waiting", "store", "later", "outside")
+    total = {p: 0.0 for p in parts}
+    dominated = {p: 0 for p in parts}
+    for _, _, split in times.slow:
+        for p in parts:
+            total[p] += split.get(p, 0.0)
+        dominated[max(parts, key=lambda p: split.get(p, 0.0))] += 1
+    return {"answers": len(times.slow), "ms_by_part": total, "dominated_by": dominated}
+
+
+def probe(url, until, label, ended_id, pid=None, log_path=None, slow_ms=50.0):
+    times = Times(slow_ms)
     stop = threading.Event()
     run_id = [""]
     threads = [threading.Thread(target=reader, args=(url, times, stop, run_id)) for _ in range(2)]
     threads.append(threading.Thread(target=operator, args=(url, times, stop, ended_id)))
     load0 = os.getloadavg()
+    sched0 = main_thread_schedstat(pid) if pid else None
+    log0 = os.path.getsize(log_path) if log_path else 0
     t0 = time.monotonic()
     for t in threads:
         t.start()
@@ -168,8 +274,17 @@ def probe(url, until, label, ended_id):
         stop.set()
         for t in threads:
             t.join()
-    return {"phase": label, "wall_s": time.monotonic() - t0, "load_before": load0, "load_after": os.getloadavg(),
-            "routes": summarize(times), "errors": times.errors}
+    wall = time.monotonic() - t0
+    sched1 = main_thread_schedstat(pid) if pid else None
+    main_thread = None
+    if sched0 and sched1:
+        main_thread = {"cpu_s": sched1[0] - sched0[0], "waiting_for_cpu_s": sched1[1] - sched0[1],
+                       "cpu_share": (sched1[0] - sched0[0]) / wall}
+    io_log = io_thread_log(log_path, log0, os.path.getsize(log_path)) if log_path else None
+    return {"phase": label, "wall_s": wall, "load_before": load0, "load_after": os.getloadavg(),
+            "routes": summarize(times), "errors": times.errors, "worst": times.worst,
+            "handler_cpu": times.handler_cpu, "slow_answers": attribution(times),
+            "missing_server_timing": times.missing_timing, "main_thread": main_thread, "io_thread_log": io_log}
 
 
 def summarize(times):
@@ -196,22 +311,48 @@ def run_study(url):
         time.sleep(1)
 
 
+def print_attribution(phase):
+    fmt = lambda split: ", ".join(f"{k} {v:.1f}" for k, v in split.items() if v >= 0.05) or "-"
+    print(f"  each route's slowest answer, split (ms; Server-Timing):")
+    for route, (ms, split) in sorted(phase["worst"].items()):
+        print(f"    {route:34s} {ms:7.1f}: {fmt(split)}")
+    print("  handler CPU per answer (ms): " + "; ".join(
+        f"{route} sum {c[0]:.0f} max {c[1]:.2f} (handler max {c[2]:.2f})" for route, c in sorted(phase["handler_cpu"].items())))
+    s = phase["slow_answers"]
+    print(f"  answers beyond the limit: {s['answers']}; ms summed by part: {fmt(s['ms_by_part'])}; "
+          f"dominated by: " + ", ".join(f"{k} {v}" for k, v in s["dominated_by"].items() if v))
+    if phase["missing_server_timing"]:
+        print(f"  answers without Server-Timing: {phase['missing_server_timing']}")
+    m = phase["main_thread"]
+    if m:
+        print(f"  io (main) thread: on a CPU {m['cpu_s']:.2f} s ({100 * m['cpu_share']:.1f} % of the phase), "
+              f"waiting for a CPU {m['waiting_for_cpu_s']:.2f} s")
+    io = phase["io_thread_log"]
+    if io:
+        print(f"  io-thread log: {io['stages']} slow stages, longest {io['longest_stage']}, most CPU "
+              f"{io['most_cpu_stage']}; {io['late_ticks']} late ticks, most in one interval: on a CPU "
+              f"{io['tick_max_cpu_ms']:.1f} ms, blocked {io['tick_max_blocked_ms']:.1f} ms, waiting for a CPU "
+              f"{io['tick_max_waiting_ms']:.1f} ms")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--build", default="build")
     ap.add_argument("--time-scale", type=float, default=50)
     ap.add_argument("--idle-s", type=float, default=60)
     ap.add_argument("--json", help="write the figures here too")
-    ap.add_argument("--log", help="keep the daemon's log here (its io-thread lines attribute slow answers: "
-                                  "COLORLAB_IO_LAG_MS=5 in the environment adds the lag monitor's)")
+    ap.add_argument("--log", help="keep the daemon's log here (its io-thread lines attribute slow answers)")
+    ap.add_argument("--slow-ms", type=float, default=50.0, help="answers beyond this are attributed (default 50)")
+    ap.add_argument("--stage-ms", type=int, default=20,
+                    help="the daemon logs io-thread stages and late ticks beyond this (COLORLAB_IO_SLOW_MS; default 20)")
     a = ap.parse_args()
     with tempfile.TemporaryDirectory(prefix="latency-probe-") as state:
-        proc, url = start_daemon(a.build, state, a.time_scale, a.log)
+        proc, url, log_path = start_daemon(a.build, state, a.time_scale, a.log, a.stage_ms)
         try:
             ended = answered_execution(url)
-            idle = probe(url, lambda: time.sleep(a.idle_s), "idle", ended)
+            idle = probe(url, lambda: time.sleep(a.idle_s), "idle", ended, proc.pid, log_path, a.slow_ms)
             study = {}
-            busy = probe(url, lambda: study.update(run_study(url)), "study", ended)
+            busy = probe(url, lambda: study.update(run_study(url)), "study", ended, proc.pid, log_path, a.slow_ms)
         finally:
             proc.terminate()
             proc.wait(timeout=60)
@@ -225,6 +366,7 @@ def main():
             print(f"  {route:34s} {r['n']:6d} {r['p50']:8.1f} {r['p99']:8.1f} {r['max']:8.1f}")
         if phase["errors"]:
             print("  errors (5xx or no answer): " + json.dumps(phase["errors"]))
+        print_attribution(phase)
     worst = max(r["max"] for r in busy["routes"].values())
     print(f"\nslowest answer through the study: {worst:.1f} ms (target <= 50 ms): {'met' if worst <= 50 else 'MISSED'}")
     if a.json:

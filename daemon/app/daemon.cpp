@@ -4,6 +4,8 @@
 
 #include <unistd.h>
 
+#include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 
@@ -39,6 +41,7 @@
 #include "colorlab/daemon/worker_pool.hpp"
 #include "colorlab/drivers/discovery_monitor.hpp"
 #include "colorlab/http/server.hpp"
+#include "colorlab/store/writer_wait.hpp"
 #include "colorlab/verify/cabinet_json.hpp"
 
 namespace colorlab::daemon {
@@ -78,6 +81,50 @@ struct Daemon::Impl {
 };
 
 namespace {
+
+// Where one answer's time went, in ms, for its Server-Timing header (docs/API.md, "Which routes wait on what"):
+// queue — from the request read until its handler started (for a `main` row, the wait for the main thread);
+// handler — its run, of which cpu on a CPU and store on the store's writer; later — a heavy route's answer awaited.
+struct AnswerTiming {
+  std::chrono::steady_clock::time_point received = std::chrono::steady_clock::now();
+  std::chrono::microseconds queue{0}, handler{0}, cpu{0}, store{0}, later{0};
+
+  std::string header() const {
+    auto ms = [](std::chrono::microseconds us) {
+      char buf[32];
+      std::snprintf(buf, sizeof buf, "%.2f", static_cast<double>(us.count()) / 1000.0);
+      return std::string(buf);
+    };
+    return "queue;dur=" + ms(queue) + ", handler;dur=" + ms(handler) + ", cpu;dur=" + ms(cpu) +
+           ", store;dur=" + ms(store) + ", later;dur=" + ms(later);
+  }
+};
+
+// Times one handler's run on the thread running it: one synchronous call, so the thread's counters across it (CPU
+// time, the wait on the store's writer) are the handler's own.
+class HandlerTiming {
+ public:
+  explicit HandlerTiming(AnswerTiming& timing)
+      : timing_(timing),
+        start_(std::chrono::steady_clock::now()),
+        cpu_(thread_cpu_time()),
+        store_us_(store::writer_wait_us_this_thread()) {
+    timing_.queue = std::chrono::duration_cast<std::chrono::microseconds>(start_ - timing_.received);
+  }
+  ~HandlerTiming() {
+    timing_.handler = std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - start_);
+    timing_.cpu = thread_cpu_time() - cpu_;
+    timing_.store = std::chrono::microseconds(store::writer_wait_us_this_thread() - store_us_);
+  }
+  HandlerTiming(const HandlerTiming&) = delete;
+  HandlerTiming& operator=(const HandlerTiming&) = delete;
+
+ private:
+  AnswerTiming& timing_;
+  std::chrono::steady_clock::time_point start_;
+  std::chrono::microseconds cpu_;
+  std::int64_t store_us_;
+};
 
 asio::awaitable<void> connect_instrument(std::shared_ptr<drivers::Instrument> instrument) {
   try {
@@ -242,32 +289,45 @@ Daemon::Daemon(DaemonConfig config) : impl_(std::make_unique<Impl>()) {
   so.threads = d.config.api.threads;
   so.max_connections = d.config.api.max_connections;
   so.stream_write_timeout = std::chrono::milliseconds(static_cast<long>(d.config.api.stream_write_timeout_s * 1000));
+  // A diagnostic, opt-in like the lag monitor (a loaded machine would fill the log): with COLORLAB_IO_SLOW_MS set,
+  // an answer slower than it is logged with where its time went, its writing included.
+  if (std::getenv("COLORLAB_IO_SLOW_MS")) so.slow_answer_log = io_slow_threshold();
   // Stored data is served on the HTTP pool through read connections, so a commit's fsync never
   // stalls it; whatever touches live state (executions, instruments, the queue) runs on the main
   // thread. The route's row in the route table says which.
   auto handler = [api = d.api.get(), &io = d.io](http::HttpRequest& req) -> asio::awaitable<http::HttpResponse> {
+    AnswerTiming timing;
     const Routed routed = route_request(req);
     http::HttpResponse answer;
     if (routed.placement() == Placement::pool) {
+      HandlerTiming timed(timing);
       answer = handle_api(*api, req, routed);
     } else {
       // `req` and `routed` live in this coroutine's frame until the main thread has answered.
       answer = co_await asio::co_spawn(
           io,
-          [api, &req, &routed]() -> asio::awaitable<http::HttpResponse> {
+          [api, &req, &routed, &timing]() -> asio::awaitable<http::HttpResponse> {
             NamedIoStage stage(routed.route ? "route " + std::string(routed.route->method) + " " +
                                                   std::string(routed.route->pattern)
                                             : std::string("route (none)"));
+            HandlerTiming timed(timing);
             co_return handle_api(*api, req, routed);
           },
           asio::use_awaitable);
     }
-    if (!answer.later) co_return answer;
+    if (!answer.later) {
+      answer.headers.try_emplace("Server-Timing", timing.header());
+      co_return answer;
+    }
     // A heavy route's answer (a dry run): awaited on the main thread, which serves meanwhile while
     // the work runs on the worker pool. `later` stays alive here until it has answered.
     const auto later = answer.later;
+    const auto asked = std::chrono::steady_clock::now();
     auto answered = asio::co_spawn(io, later->answer(), asio::use_awaitable);
-    co_return co_await std::move(answered);
+    http::HttpResponse late = co_await std::move(answered);
+    timing.later = std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - asked);
+    late.headers.try_emplace("Server-Timing", timing.header());
+    co_return late;
   };
   d.server = std::make_unique<http::Server>(d.io, so, http::AsyncHandler(handler));
   d.server->start();

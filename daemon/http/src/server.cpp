@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <charconv>
+#include <cstdio>
 #include <optional>
 #include <thread>
 #include <type_traits>
@@ -308,6 +309,32 @@ asio::awaitable<HttpResponse> safe_handle(const Shared& shared, HttpRequest& req
   }
 }
 
+using Clock = std::chrono::steady_clock;
+
+std::string ms_text(std::chrono::microseconds us) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.2f", static_cast<double>(us.count()) / 1000.0);
+  return buf;
+}
+
+// The W3C Server Timing header (https://www.w3.org/TR/server-timing/): name;dur=milliseconds, comma-separated. The
+// handler may have named its own parts (colorlabd: queue, handler, cpu, store, later); the server adds `app`, its
+// own measure from the request read to the answer ready to write, which contains them.
+void add_server_timing(HttpResponse& r, std::chrono::microseconds app) {
+  const std::string part = "app;dur=" + ms_text(app);
+  auto [it, fresh] = r.headers.try_emplace("Server-Timing", part);
+  if (!fresh) it->second += ", " + part;
+}
+
+void log_slow_answer(const HttpRequest& req, const HttpResponse& r, std::chrono::microseconds total,
+                     std::chrono::microseconds app) {
+  // The path, never the target: a query could carry anything a client put there.
+  auto it = r.headers.find("Server-Timing");
+  log::warning("http", "slow answer: " + req.method + " " + req.path + " took " + ms_text(total) + " ms: " +
+                           (it == r.headers.end() ? "app;dur=" + ms_text(app) : it->second) + "; writing " +
+                           ms_text(total - app) + " ms");
+}
+
 HttpResponse read_failure(const error_code& ec) {
   if (ec == bhttp::error::body_limit) {
     return HttpResponse::problem(413, "body-too-large", "Request body too large",
@@ -359,7 +386,10 @@ asio::awaitable<void> session(Stream stream, Peer peer, std::shared_ptr<Shared> 
     unsigned version = msg.version();
     bool head = req.method == "HEAD";
 
+    const auto received = Clock::now();
     HttpResponse r = co_await safe_handle(*shared, req);
+    const auto app = std::chrono::duration_cast<std::chrono::microseconds>(Clock::now() - received);
+    if (shared->options.server_timing) add_server_timing(r, app);
     if constexpr (std::is_same_v<Stream, TlsStream>) {
       // A browser that once reached the console over HTTPS never falls back to plain HTTP for a year (RFC 6797).
       r.headers.try_emplace("Strict-Transport-Security", "max-age=31536000");
@@ -370,6 +400,10 @@ asio::awaitable<void> session(Stream stream, Peer peer, std::shared_ptr<Shared> 
       co_await write_file_response(stream, r, version, keep_alive, head, *shared, ec);
     } else {
       co_await write_response(stream, r, version, keep_alive, head, *shared, ec);
+    }
+    if (shared->options.slow_answer_log.count() > 0 && !r.stream) {
+      const auto total = std::chrono::duration_cast<std::chrono::microseconds>(Clock::now() - received);
+      if (total > shared->options.slow_answer_log) log_slow_answer(req, r, total, app);
     }
     if (ec || !keep_alive) break;
   }

@@ -2,7 +2,10 @@
 
 #include <sqlite3.h>
 
+#include <chrono>
+
 #include "colorlab/core/error.hpp"
+#include "colorlab/store/writer_wait.hpp"
 
 namespace colorlab::store {
 
@@ -120,7 +123,33 @@ std::string Statement::text(int col) const {
 }
 bool Statement::is_null(int col) const { return sqlite3_column_type(stmt_, col) == SQLITE_NULL; }
 
-Transaction::Transaction(Database& db) : db_(db) { db_.exec("BEGIN IMMEDIATE"); }
+namespace {
+
+thread_local std::int64_t writer_wait_us = 0;
+
+// Adds its lifetime to this thread's writer wait, also when the statement throws.
+class WriterWaitTimer {
+ public:
+  WriterWaitTimer() : start_(std::chrono::steady_clock::now()) {}
+  ~WriterWaitTimer() {
+    writer_wait_us +=
+        std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - start_).count();
+  }
+  WriterWaitTimer(const WriterWaitTimer&) = delete;
+  WriterWaitTimer& operator=(const WriterWaitTimer&) = delete;
+
+ private:
+  std::chrono::steady_clock::time_point start_;
+};
+
+}  // namespace
+
+std::int64_t writer_wait_us_this_thread() { return writer_wait_us; }
+
+Transaction::Transaction(Database& db) : db_(db) {
+  WriterWaitTimer timed;
+  db_.exec("BEGIN IMMEDIATE");
+}
 
 Transaction::~Transaction() {
   if (!done_) {
@@ -133,6 +162,7 @@ Transaction::~Transaction() {
 }
 
 void Transaction::commit() {
+  WriterWaitTimer timed;
   db_.exec("COMMIT");
   done_ = true;
 }

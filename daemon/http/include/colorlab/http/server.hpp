@@ -33,6 +33,13 @@ struct ServerOptions {
   // A streaming response (SSE) whose client does not take a chunk within this time is dropped.
   std::chrono::milliseconds stream_write_timeout{10000};
   unsigned max_connections = 1024;
+  // Every answer carries a Server-Timing header: the handler's own parts, if it set the header, and `app`, the
+  // time from the request read to the answer ready. Cheap, and how a client tells a wait in the daemon from one
+  // on the network or on its own machine (issue 27).
+  bool server_timing = true;
+  // An answer that took longer than this from its request read to its last byte written is logged with where
+  // its time went, writing included (0: never).
+  std::chrono::microseconds slow_answer_log{0};
 };
 
 using AsyncHandler = std::function<boost::asio::awaitable<HttpResponse>(HttpRequest&)>;
