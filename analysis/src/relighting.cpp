@@ -83,6 +83,8 @@ ChartUnderLamp chart_under_lamp(const SpectralSet& refl, const LampSpectrum& lam
   out.lamp_measured = lamp.measured;
   out.lamp_warning = lamp.warning();
   out.wavelengths = grid;
+  out.reflectances = refl;
+  out.lamp_spd = lamp.spd;
   out.radiance = (r.values.array().rowwise() * e.array()).matrix() * M;
   out.white = e * M;
 
@@ -111,6 +113,27 @@ ChartData ChartUnderLamp::predict(const Eigen::MatrixXd& curves) const {
   ChartData c = reference;
   c.rgb = (radiance * curves.transpose()).array().rowwise() / w.array();
   return c;
+}
+
+ChartUnderLamp ChartUnderLamp::under(const SpectralSet& spd) const {
+  return chart_under_lamp(reflectances, LampSpectrum{lamp, spd, lamp_measured}, wavelengths);
+}
+
+SpectralSet draw_nominal_lamp(const SpectralSet& standard, const std::vector<double>& grid, std::mt19937& rng) {
+  standard.check_shape();
+  if (standard.size() != 1 || grid.size() < 2 || !(grid.back() > grid.front()))
+    throw Error(ErrorClass::bad_parameter, "nominal lamp draw: needs one spectrum and a grid of at least two wavelengths");
+  std::normal_distribution<double> nd(0, 1);
+  std::array<double, 3> a{};
+  for (std::size_t k = 0; k < a.size(); ++k) a[k] = kNominalLampLogSdev[k] * nd(rng);
+  SpectralSet out = standard;
+  const double lo = grid.front(), hi = grid.back();
+  for (std::size_t j = 0; j < out.wavelengths.size(); ++j) {
+    const double x = std::clamp((2 * out.wavelengths[j] - lo - hi) / (hi - lo), -1.0, 1.0);
+    const double g = a[0] * x + a[1] * (3 * x * x - 1) / 2 + a[2] * (5 * x * x * x - 3 * x) / 2;
+    out.values(0, static_cast<Eigen::Index>(j)) *= std::exp(g);
+  }
+  return out;
 }
 
 Eigen::MatrixXd SensitivityEstimate::draw(std::mt19937& rng) const {
@@ -158,9 +181,16 @@ LampCharacterization characterize_across_lamps(const SensitivityEstimate& s, con
     so.smoothing = model.spline()->smoothing();
     return Characterization(fit_spline(chart, so));
   };
+  // A nominal lamp's own uncertainty is drawn with the curves (its own stream: the curves' draws stay the same with
+  // or without it). It moves the chart's camera values and its reference colours together, as a real lamp would.
+  const bool draw_lamp = o.nominal_lamp_uncertainty && !target.lamp_measured;
   std::vector<Characterization> draws;
-  std::mt19937 rng(o.seed);
-  for (int d = 0; d < o.draws; ++d) draws.push_back(refit(target.predict(s.draw(rng))));
+  std::mt19937 rng(o.seed), lamp_rng(o.seed + 0x9e3779b9u);
+  for (int d = 0; d < o.draws; ++d) {
+    const Eigen::MatrixXd curves = s.draw(rng);
+    draws.push_back(refit(draw_lamp ? target.under(draw_nominal_lamp(target.lamp_spd, target.wavelengths, lamp_rng)).predict(curves)
+                                    : target.predict(curves)));
+  }
 
   LampCharacterization out{.lamp = target.lamp,
                            .lamp_measured = target.lamp_measured,

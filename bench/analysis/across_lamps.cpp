@@ -2,7 +2,10 @@
 // sensitivities, beside today's same-lamp selection and ArgyllCMS colprof -ax / -am, in one run on the same data.
 //
 //   bench_analysis_across_lamps [--quality m] [--cameras Canon_20D,…] [--conditions A,F11] [--draws 40] [--argyll 1]
-//                               [--noise 0.005] [--keep DIR] [--ab 1] [--remedy 1 [--pareto FILE]]
+//                               [--noise 0.005] [--keep DIR] [--ab 1] [--remedy 1 [--pareto FILE]] [--band-before 1]
+//
+// --band-before 1: beside each case's band, the band without the nominal lamp's own uncertainty (the sensitivities
+// and the family's misfit only, as before it was carried): coverage and mean radius against the mean ΔE00 it covers.
 //
 // --pareto FILE (with --remedy 1): the photographs-taken against ΔE00-reached averages as JSON, the data of the
 // report's Pareto chart (client/python/colorlab/report/data/across_lamps_pareto.json).
@@ -144,7 +147,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> cameras = kCameras;
   std::vector<std::string> condition_names = {"A", "F11", "F2"};
   std::optional<fs::path> keep, pareto;
-  bool argyll = true, remedy = false, ab = false;
+  bool argyll = true, remedy = false, ab = false, band_before = false;
   int draws = 40;
   double noise = 0.005;
   for (int i = 1; i + 1 < argc; i += 2) {
@@ -158,6 +161,7 @@ int main(int argc, char** argv) {
     else if (a == "--noise") noise = std::stod(v);
     else if (a == "--remedy") remedy = v == "1";
     else if (a == "--ab") ab = v == "1";
+    else if (a == "--band-before") band_before = v == "1";
     else if (a == "--pareto") pareto = v;
     else {
       std::cerr << "unknown option " << a << "\n";
@@ -202,7 +206,10 @@ int main(int argc, char** argv) {
                "colprof -ax on D65 photo | -am on D65 photo | colprof -ax on predicted chart | -am on predicted chart | "
                "truth inside 95 % band |\n|---|---|---|---|---|---|---|---|---|---|\n";
   int rows = 0, max_ax = 0, mean_ax = 0, max_axp = 0, mean_axp = 0, max_am = 0, mean_am = 0, better_than_today = 0;
-  long inside_all = 0, patches_all = 0;
+  long inside_all = 0, patches_all = 0, inside_before_all = 0;
+  double radius_sum = 0, radius_before_sum = 0, de_sum = 0;
+  int cases_below_80 = 0, cases_below_80_before = 0;
+  std::vector<std::string> band_rows;
   double worst_case_coverage = 1;
   std::string worst_case;
   std::vector<std::string> timing_rows, remedy_rows, ab_rows;
@@ -342,6 +349,26 @@ int main(int argc, char** argv) {
       const double coverage = static_cast<double>(inside) / static_cast<double>(band.size());
       inside_all += inside;
       patches_all += band.size();
+      radius_sum += band.sum();
+      for (const double d : e.de00) de_sum += d;
+      cases_below_80 += coverage < 0.8;
+      if (band_before) {
+        ca::AcrossLampsOptions bo;
+        bo.draws = draws;
+        bo.nominal_lamp_uncertainty = false;
+        const Eigen::VectorXd before = ca::characterize_across_lamps(est, sg_assumed.at(cond.name), bo).uncertainty95(test.rgb);
+        long in_before = 0;
+        for (Eigen::Index i = 0; i < before.size(); ++i) in_before += e.de00[static_cast<std::size_t>(i)] <= before(i);
+        inside_before_all += in_before;
+        radius_before_sum += before.sum();
+        cases_below_80_before += static_cast<double>(in_before) < 0.8 * static_cast<double>(before.size());
+        const double n = static_cast<double>(band.size());
+        std::ostringstream row;
+        row << std::fixed << std::setprecision(2) << "| " << cam << " | " << cond.name << " | " << e.s00.mean << " | "
+            << std::setprecision(0) << 100.0 * static_cast<double>(in_before) / n << " % | " << std::setprecision(2) << before.sum() / n
+            << " | " << std::setprecision(0) << 100 * coverage << " % | " << std::setprecision(2) << band.sum() / n << " |";
+        band_rows.push_back(row.str());
+      }
       if (coverage < worst_case_coverage) {
         worst_case_coverage = coverage;
         worst_case = cam + " " + cond.name;
@@ -374,7 +401,18 @@ int main(int argc, char** argv) {
             << "; better than today's same-lamp model on mean and max: " << better_than_today << "/" << rows << "\n";
   std::cout << "truth inside the 95 % band: " << std::fixed << std::setprecision(1)
             << 100.0 * static_cast<double>(inside_all) / static_cast<double>(std::max(1L, patches_all)) << " % of " << patches_all
-            << " patches; worst case " << worst_case << " " << 100 * worst_case_coverage << " %\n";
+            << " patches; worst case " << worst_case << " " << 100 * worst_case_coverage << " %; cases below 80 %: " << cases_below_80
+            << "; mean radius " << std::setprecision(2) << radius_sum / static_cast<double>(std::max(1L, patches_all))
+            << " ΔE00 against a mean ΔE00 of " << de_sum / static_cast<double>(std::max(1L, patches_all)) << "\n";
+  if (band_before) {
+    std::cout << "\n| camera | test lamp | mean ΔE00 | band before: inside | mean radius | band now: inside | mean radius |\n"
+                 "|---|---|---|---|---|---|---|\n";
+    for (const auto& r : band_rows) std::cout << r << "\n";
+    std::cout << "before (sensitivities and misfit only): " << std::setprecision(1)
+              << 100.0 * static_cast<double>(inside_before_all) / static_cast<double>(std::max(1L, patches_all))
+              << " % inside, cases below 80 %: " << cases_below_80_before << ", mean radius " << std::setprecision(2)
+              << radius_before_sum / static_cast<double>(std::max(1L, patches_all)) << " ΔE00\n";
+  }
   std::cout << "\n| camera | today's selection on the D65 photo | the prior (27 cameras) | sensitivity estimation | across lamps, per lamp: fit / fit + "
             << draws << " posterior refits |\n|---|---|---|---|---|\n";
   for (const auto& r : timing_rows) std::cout << r << "\n";

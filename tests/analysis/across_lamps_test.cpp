@@ -75,7 +75,9 @@ TEST(AcrossLamps, BeatsTheSameLampModelAndItsBandHoldsTheTruth) {
   for (const auto& [standard, measured] : lamps) assumed.emplace(standard, ca::chart_under_lamp(sg, ca::nominal_lamp(standard), grid));
 
   long inside_all = 0, patches_all = 0;
-  for (const std::string cam : {"Canon_20D", "Nikon_D3X"}) {
+  // The Nokia N900 (a phone camera unlike the DSLRs of the prior) is the case whose band fell short when the nominal
+  // lamp's own uncertainty was not carried (75–79 %, docs/ACCURACY.md §6).
+  for (const std::string cam : {"Canon_20D", "Nikon_D3X", "Nokia_N900"}) {
     const auto curves = camera(cams, cam);
     ca::ChartData photo = truth_chart(sg, ca::resample(ca::load_illuminant("D65"), std::vector<double>(grid), ca::Interpolation::linear), curves);
     std::mt19937 rng(7);
@@ -112,8 +114,8 @@ TEST(AcrossLamps, BeatsTheSameLampModelAndItsBandHoldsTheTruth) {
   }
   const double pooled = static_cast<double>(inside_all) / static_cast<double>(patches_all);
   // The issue's 90–98 %: the lower end is asserted (the band is not overconfident). The upper end is not, here: over
-  // 96 patches one patch is 1 %, and a 95 % band's count has a binomial standard deviation of 2.2 %; the bench measures
-  // it over 9 cameras × 3 lamps (docs/ACCURACY.md §6).
+  // 144 patches one patch is 0.7 %, and a 95 % band's count has a binomial standard deviation of 1.8 %; the bench
+  // measures it over 9 cameras × 3 lamps (docs/ACCURACY.md §6).
   EXPECT_GE(pooled, 0.90) << "issue 26: the truth inside the 95 % band at 90–98 % over all cases";
 }
 
@@ -139,4 +141,74 @@ TEST(AcrossLamps, NominalLampsAreWarnedAboutAndBadLampsAreTypedErrors) {
   two.values.row(1) = two.values.row(0);
   two.names.push_back("x");
   EXPECT_THROW((void)ca::measured_lamp("TL84", two), colorlab::Error);
+}
+
+// A nominal lamp's drawn spectrum departs from its standard by exp of a cubic in wavelength (Legendre degrees 1–3 over
+// the grid, held constant beyond it): inside the grid the log ratio is reproduced exactly by the cubic through four of
+// its points. A measured lamp is not drawn: its band is the same with the nominal lamp's uncertainty on or off.
+TEST(AcrossLamps, NominalLampDrawsAreSmoothAndMeasuredLampsAreNotDrawn) {
+  const auto a = ca::nominal_lamp("A");
+  const std::vector<double> grid = ca::uniform_grid(400, 720, 10);
+  std::mt19937 rng(3);
+  const ca::SpectralSet drawn = ca::draw_nominal_lamp(a.spd, grid, rng);
+  ASSERT_EQ(drawn.wavelengths, a.spd.wavelengths);
+  std::vector<double> x, g;
+  double below = NAN;  // the log ratio at the grid's first wavelength: held below it
+  for (std::size_t j = 0; j < drawn.wavelengths.size(); ++j) {
+    const double w = drawn.wavelengths[j];
+    const auto c = static_cast<Eigen::Index>(j);
+    const double r = std::log(drawn.values(0, c) / a.spd.values(0, c));
+    if (w >= 400 && w <= 720) {
+      if (x.empty()) below = r;
+      x.push_back((w - 560) / 160);
+      g.push_back(r);
+    }
+  }
+  ASSERT_GE(x.size(), 8u);
+  for (std::size_t j = 0; j < drawn.wavelengths.size() && drawn.wavelengths[j] < 400; ++j)
+    EXPECT_NEAR(std::log(drawn.values(0, static_cast<Eigen::Index>(j)) / a.spd.values(0, static_cast<Eigen::Index>(j))), below, 1e-9);
+  const std::array<std::size_t, 4> k = {0, x.size() / 3, 2 * x.size() / 3, x.size() - 1};
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    double p = 0;
+    for (std::size_t m = 0; m < 4; ++m) {
+      double l = g[k[m]];
+      for (std::size_t n = 0; n < 4; ++n)
+        if (n != m) l *= (x[i] - x[k[n]]) / (x[k[m]] - x[k[n]]);
+      p += l;
+    }
+    EXPECT_NEAR(g[i], p, 1e-9) << "at x = " << x[i];
+  }
+  bool changed = false;
+  for (double v : g) changed |= std::abs(v) > 1e-6;
+  EXPECT_TRUE(changed) << "a nominal lamp's draw must depart from its standard";
+
+  // A small chart of smooth reflectances and three smooth curves with an uncertain posterior.
+  ca::SpectralSet refl;
+  refl.wavelengths = ca::uniform_grid(380, 730, 10);
+  refl.values.resize(30, static_cast<Eigen::Index>(refl.wavelengths.size()));
+  for (int i = 0; i < 30; ++i) {
+    refl.names.push_back("p" + std::to_string(i));
+    for (std::size_t j = 0; j < refl.wavelengths.size(); ++j)
+      refl.values(i, static_cast<Eigen::Index>(j)) =
+          0.5 + 0.4 * std::sin(0.3 * i + (refl.wavelengths[j] - 380) / (40.0 + 3 * i)) * std::cos(0.7 * i);
+  }
+  ca::SensitivityEstimate est;
+  est.wavelengths = grid;
+  est.curves.resize(3, static_cast<Eigen::Index>(grid.size()));
+  for (int c = 0; c < 3; ++c) {
+    for (std::size_t j = 0; j < grid.size(); ++j)
+      est.curves(c, static_cast<Eigen::Index>(j)) = std::exp(-0.5 * std::pow((grid[j] - (600.0 - 70 * c)) / 35.0, 2));
+    est.covariance[static_cast<std::size_t>(c)] = 1e-4 * Eigen::MatrixXd::Identity(est.curves.cols(), est.curves.cols());
+  }
+  const auto measured = ca::chart_under_lamp(refl, ca::measured_lamp("A", a.spd), grid);
+  ca::AcrossLampsOptions on, off;
+  on.methods = off.methods = {"ccm"};
+  on.targets = off.targets = {ca::FitTarget::xyz_then_lab};
+  on.draws = off.draws = 8;
+  off.nominal_lamp_uncertainty = false;
+  const auto rgb = measured.predict(est.curves).rgb;
+  const Eigen::VectorXd band_on = ca::characterize_across_lamps(est, measured, on).uncertainty95(rgb);
+  const Eigen::VectorXd band_off = ca::characterize_across_lamps(est, measured, off).uncertainty95(rgb);
+  EXPECT_EQ(band_on, band_off) << "a measured lamp carries no nominal lamp's uncertainty";
+  EXPECT_GT(band_on.minCoeff(), 0.0);
 }

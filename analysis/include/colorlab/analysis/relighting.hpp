@@ -10,8 +10,9 @@
 //   2. the chart predicted under B: RAW_B = (reflectance × B) · s, white-balanced by the perfect white under B, with
 //      reference colours under B (Bradford-adapted to the ICC D50 white, as every other characterization here);
 //   3. every model family fitted and selected (LOO) on that predicted chart, as under A;
-//   4. the same chosen model refitted on charts predicted from curves drawn from the sensitivities' posterior: their
-//      spread at a patch is what the sensitivities' credible bands mean for that patch's colour.
+//   4. the same chosen model refitted on charts predicted from curves drawn from the sensitivities' posterior (and,
+//      when B is only named, under B's spectrum drawn about its standard): their spread at a patch is what the
+//      sensitivities' credible bands and the lamp's uncertainty mean for that patch's colour.
 //
 // Inputs under B must be white-balanced the same way: camera RAW ÷ the RAW of a perfect (or known neutral) white
 // under B.
@@ -53,12 +54,29 @@ struct ChartUnderLamp {
   Eigen::MatrixXd radiance;
   Eigen::RowVectorXd white;  // the perfect white's row of `radiance`
   ChartData reference;       // ids, XYZ (CIE 1931 2° under the lamp, Bradford to ICC D50) and L*a*b*; rgb empty
+  SpectralSet reflectances;  // what the chart was built from: kept so that it can be rebuilt under a drawn lamp
+  SpectralSet lamp_spd;
 
   // rgb = RAW ÷ RAW of the perfect white under this lamp, per channel; curves: 3 × bands.
   ChartData predict(const Eigen::MatrixXd& curves) const;
+  // The same chart under another spectrum for the same lamp (a draw of what a nominal lamp may really emit).
+  ChartUnderLamp under(const SpectralSet& spd) const;
 };
 // grid: the sensitivities' wavelengths (inside the reflectances' and the lamp's range).
 ChartUnderLamp chart_under_lamp(const SpectralSet& reflectances, const LampSpectrum& lamp, const std::vector<double>& grid);
+
+// What a lamp known only by its standard's name may really emit: the standard × exp(Σ a_k P_k(x)), P_k the Legendre
+// polynomials of degree 1–3 over the sensitivities' grid (x ∈ [−1, 1], held at the ends outside it), a_k drawn
+// N(0, kNominalLampLogSdev[k]). A real lamp departs from its standard smoothly (colour temperature, filter, phosphor
+// blend: the tilt and bow of the ratio) and in its lines; the smooth part is what moves a chart's colours.
+// The spreads are the coefficients fitted to ln(measured ÷ standard) over 400–720 nm for the one measured lamp in
+// ../shared/data that is a real lamp of its standard's kind and that no test uses: the ISO 7589 studio tungsten
+// against CIE A (−0.175, −0.002, 0.038; residual 0.012). (The Gretag booth's daylight against CIE D65, −0.139, −0.569,
+// −0.119, is a simulator of a phase of daylight, not a lamp its standard describes; spreads from the RMS of both,
+// 0.158 / 0.402 / 0.088, put the truth inside the band at 99.5 % pooled, wider than a 95 % band may be —
+// docs/ACCURACY.md §6. The booth's A and CWF, the test lamps there, are not used to set them.)
+inline constexpr std::array<double, 3> kNominalLampLogSdev = {0.175, 0.002, 0.038};
+SpectralSet draw_nominal_lamp(const SpectralSet& standard, const std::vector<double>& grid, std::mt19937& rng);
 
 // Spectral sensitivities with their posterior (the prior-based black box, blackbox.hpp).
 struct SensitivityEstimate {
@@ -80,6 +98,9 @@ struct AcrossLampsOptions {
   CvSpec cv = CvSpec::loo();
   int draws = 40;      // posterior draws propagated to the per-patch uncertainty
   unsigned seed = 1;   // of the draws: a characterization is reproducible
+  // A nominal lamp (not measured) is itself uncertain: each draw also draws the lamp (draw_nominal_lamp). Off: the
+  // band carries the sensitivities and the family's misfit only (the bench's before/after; docs/ACCURACY.md §6).
+  bool nominal_lamp_uncertainty = true;
   SmoothingSearch spline_search = SmoothingSearch::eigen;  // direct: the reference path (bench A/B)
 };
 
@@ -100,7 +121,8 @@ struct LampCharacterization {
 
   Eigen::MatrixXd apply(const Eigen::MatrixXd& rgb) const { return model.apply(rgb); }
   // Per row of rgb, the radius (ΔE00 about apply(rgb)) of its 95 % band, two independent parts in quadrature:
-  // - the sensitivities' uncertainty: the 95th percentile over the draws of the distance to the point prediction;
+  // - the sensitivities' uncertainty and, for a nominal lamp, the lamp's: the 95th percentile over the draws of the
+  //   distance to the point prediction;
   // - the family's misfit (which the draws do not contain): misfit95.
   // (A local misfit — the RMS CV error of the 8 nearest training patches — was tried: narrower bands, 84 % pooled
   // coverage against 94 % on four cameras; docs/ACCURACY.md §6.)
