@@ -4,8 +4,10 @@
 A bench's backlog of RUNS ended runs x MEASUREMENTS measurements (bench_fleet_backlog, colorlabd's own Store)
 goes to a throwaway PostgreSQL 15 with fsync on (its defaults: fsync, synchronous_commit, full_page_writes), in
 rounds of A then B:
-  A  `colorlab-ship once` into a fresh database made by `colorlab-ship central-init` (every run: COPY into staging,
-     insert-or-ignore, the per-run digest compared, the position moved, one transaction a run);
+  A  `colorlab-ship once` into a fresh database made by `colorlab-ship central-init`, with [ship]'s default
+     transaction limits (transaction_runs = 100, transaction_measurements = 200,000: five transactions for the
+     default backlog; each: COPY, insert-or-ignore of what central already holds, every run's digest compared,
+     the position moved, one COMMIT). Its JSON report's "seconds" say where the agent's time went;
   B  psql `\\copy measurements FROM file` of the same rows (dumped from A's database beforehand) into a fresh
      database with the same central schema: the same table definition with its primary key and indexes, one COPY.
 Both are timed from the client's start to its exit; rows/s counts measurements. No blobs are in the backlog.
@@ -84,7 +86,7 @@ def main():
             rounds.append({"ship_s": round(t_ship, 2), "ship_rows_per_s": round(shipped / t_ship),
                            "copy_s": round(t_copy, 2), "copy_rows_per_s": round(copied / t_copy),
                            "ratio": round((shipped / t_ship) / (copied / t_copy), 3),
-                           "rows": [shipped, copied], "ship_report": out.strip()[-400:],
+                           "rows": [shipped, copied], "ship_report": {k: v for k, v in json.loads(out).items() if k not in ("divergences", "superseded")},
                            "loadavg_before": load_before, "loadavg_after": os.getloadavg()})
             psql(port, "postgres", f"DROP DATABASE ship{i}")
             psql(port, "postgres", f"DROP DATABASE raw{i}")

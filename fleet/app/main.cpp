@@ -32,7 +32,10 @@ nlohmann::json to_json(const colorlab::fleet::CycleReport& r) {
   return {{"position_before", r.position_before}, {"position_after", r.position_after},
           {"runs_shipped", r.runs_shipped},       {"measurements", r.measurements},
           {"events", r.events},                   {"blobs_uploaded", r.blobs_uploaded},
-          {"divergences", d},                     {"superseded", s}};
+          {"divergences", d},                     {"superseded", s},
+          {"transactions", r.transactions},
+          {"seconds", {{"read", r.seconds.read}, {"read_wait", r.seconds.read_wait}, {"blobs", r.seconds.blobs}, {"copy", r.seconds.copy},
+                       {"merge", r.seconds.merge}, {"digest", r.seconds.digest}, {"commit", r.seconds.commit}}}};
 }
 
 // One cycle, its outcome noted in <state_dir>/ship/status.json for the bench to show (GET /v1/shipping).

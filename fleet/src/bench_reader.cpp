@@ -34,6 +34,13 @@ std::optional<std::string> exact(std::optional<double> v) {
   return exact(*v);
 }
 
+// From run_blobs alone (not joined to blobs as read() ships them): a reference without its blob row still counts.
+void add_blob_refs(store::Database& db, const std::string& run_id, RunDigest& d) {
+  auto st = db.prepare("SELECT name, sha256, kind, step FROM run_blobs WHERE run_id = ?1 ORDER BY name");
+  st.bind(1, std::string_view(run_id));
+  while (st.step()) d.blob_ref(st.text(0), st.text(1), st.text(2), st.text(3));
+}
+
 const std::string kEnded = "SELECT seq, json_extract(payload, '$.run_id'), json_extract(payload, '$.status') FROM "
                           "event_log WHERE seq > ?1 AND " + store::kEndEventSql + " ORDER BY seq LIMIT ?2";
 
@@ -78,6 +85,9 @@ RunBatch BenchReader::read(const std::string& bench_id, const EndedRun& run, std
   RunBatch b;
   b.run = run;
   std::string line;
+  // The digest is fed from the rows being encoded (the same snapshot, the same order as digest_locked's
+  // queries): the measurements, most of a run, are read once, not twice.
+  RunDigest digest;
   {
     auto st = db_.prepare(
         "SELECT seq, id, campaign, params, status, simulated, instruments, created_at, started_at, finished_at, "
@@ -98,6 +108,7 @@ RunBatch BenchReader::read(const std::string& bench_id, const EndedRun& run, std
     for (int c : {8, 9, 10, 11, 12}) copy_field(line, opt_text(st, c));
     copy_field(line, std::to_string(run.ended_event), true);
     b.runs = line;
+    digest.run(st.text(1), st.text(4), opt_text(st, 9), opt_text(st, 10), opt_text(st, 11), st.text(3));
   }
   {
     auto st = db_.prepare(
@@ -121,18 +132,21 @@ RunBatch BenchReader::read(const std::string& bench_id, const EndedRun& run, std
         "WHERE run_id = ?1 ORDER BY seq, step");
     st.bind(1, std::string_view(run.run_id));
     while (st.step()) {
-      line.clear();
-      copy_field(line, st.text(0));
-      copy_field(line, st.text(1));
-      copy_field(line, std::to_string(st.int64(2)));
-      copy_field(line, st.text(3));
-      copy_field(line, std::to_string(st.int64(4)));
-      copy_field(line, st.text(5));
-      copy_field(line, exact(opt_real(st, 6)));
-      copy_field(line, opt_text(st, 7));
-      copy_field(line, opt_text(st, 8));
-      copy_field(line, st.text(9), true);
-      b.measurements += line;
+      const std::string step = st.text(1), instrument = st.text(3), quantity = st.text(5), at = st.text(9);
+      const auto value = opt_real(st, 6);
+      const auto unit = opt_text(st, 7), data = opt_text(st, 8);
+      const std::int64_t seq = st.int64(2), simulated = st.int64(4);
+      copy_field(b.measurements, st.text(0));
+      copy_field(b.measurements, step);
+      copy_field(b.measurements, std::to_string(seq));
+      copy_field(b.measurements, instrument);
+      copy_field(b.measurements, std::to_string(simulated));
+      copy_field(b.measurements, quantity);
+      copy_field(b.measurements, exact(value));
+      copy_field(b.measurements, unit);
+      copy_field(b.measurements, data);
+      copy_field(b.measurements, at, true);
+      digest.measurement(seq, step, instrument, simulated, quantity, unit, data, at, value);
       ++b.measurement_count;
     }
   }
@@ -175,7 +189,8 @@ RunBatch BenchReader::read(const std::string& bench_id, const EndedRun& run, std
       ++b.event_count;
     }
   }
-  b.digest = digest_locked(run.run_id);
+  add_blob_refs(db_, run.run_id, digest);
+  b.digest = digest.hex();
   return b;
 }
 
@@ -202,11 +217,7 @@ std::string BenchReader::digest_locked(const std::string& run_id) {
                     st.text(7), opt_real(st, 8));
     }
   }
-  {
-    auto st = db_.prepare("SELECT name, sha256, kind, step FROM run_blobs WHERE run_id = ?1 ORDER BY name");
-    st.bind(1, std::string_view(run_id));
-    while (st.step()) d.blob_ref(st.text(0), st.text(1), st.text(2), st.text(3));
-  }
+  add_blob_refs(db_, run_id, d);
   return d.hex();
 }
 

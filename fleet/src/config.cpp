@@ -70,6 +70,16 @@ ShipConfig load_ship_config(const fs::path& file) {
       auto v = node.value<std::int64_t>();
       if (!v || *v < 1 || *v > 100000) bad(file, node.source(), "ship.batch_runs must be an integer from 1 to 100000");
       c.batch_runs = static_cast<int>(*v);
+    } else if (k == "transaction_runs") {
+      auto v = node.value<std::int64_t>();
+      if (!v || *v < 1 || *v > 10000) bad(file, node.source(), "ship.transaction_runs must be an integer from 1 to 10000");
+      c.transaction_runs = static_cast<int>(*v);
+    } else if (k == "transaction_measurements") {
+      auto v = node.value<std::int64_t>();
+      if (!v || *v < 1 || *v > 10000000) {
+        bad(file, node.source(), "ship.transaction_measurements must be an integer from 1 to 10000000");
+      }
+      c.transaction_measurements = *v;
     } else if (k == "backup_keep_daily" || k == "backup_keep_weekly") {
       auto v = node.value<std::int64_t>();
       if (!v || *v < 0 || *v > 3660) bad(file, node.source(), "ship." + k + " must be an integer from 0 to 3660");

@@ -4,11 +4,14 @@
 
 #include <bit>
 #include <cstring>
+#include <string>
 
 namespace colorlab::fleet {
 
-const char* const kCentralDigestSql = R"sql(
-SELECT encode(sha256(
+namespace {
+// One expression over the run row `r`, shared by the one-run and the many-runs statements.
+const std::string kDigestOfRun = R"sql(
+encode(sha256(
   convert_to(concat_ws(E'\x1f', r.id, r.status, coalesce(r.finished_at, '\N'), coalesce(r.summary, '\N'),
                        coalesce(r.error, '\N'), r.params) || E'\n', 'UTF8')
   || coalesce((SELECT string_agg(int8send(m.seq)
@@ -20,8 +23,13 @@ SELECT encode(sha256(
   || coalesce((SELECT string_agg(convert_to(concat_ws(E'\x1f', b.name, b.sha256, b.kind, b.step) || E'\n', 'UTF8'),
                   ''::bytea ORDER BY b.name COLLATE "C")
                FROM run_blobs b WHERE b.run_id = r.id), ''::bytea)), 'hex')
-FROM runs r WHERE r.id = $1
 )sql";
+const std::string kOne = "SELECT " + kDigestOfRun + " FROM runs r WHERE r.id = $1";
+const std::string kMany = "SELECT r.id, " + kDigestOfRun + " FROM runs r WHERE r.id = ANY($1::text[])";
+}  // namespace
+
+const char* const kCentralDigestSql = kOne.c_str();
+const char* const kCentralDigestsSql = kMany.c_str();
 
 namespace {
 

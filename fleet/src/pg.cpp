@@ -66,14 +66,18 @@ PgResult Pg::query(const std::string& sql, const std::vector<std::optional<std::
   return PgResult(r);
 }
 
-void Pg::copy_in(const std::string& table, const std::string& data) {
+void Pg::copy_in(const std::string& table, const std::string& data) { copy_in(table, {&data}); }
+
+void Pg::copy_in(const std::string& table, const std::vector<const std::string*>& pieces) {
   pg_result* r = PQexec(c_, ("COPY " + table + " FROM STDIN").c_str());
   if (PQresultStatus(r) != PGRES_COPY_IN) fail("COPY " + table, r);
   PQclear(r);
   constexpr std::size_t kChunk = 1 << 20;
-  for (std::size_t off = 0; off < data.size(); off += kChunk) {
-    const std::size_t n = std::min(kChunk, data.size() - off);
-    if (PQputCopyData(c_, data.data() + off, static_cast<int>(n)) != 1) fail("COPY " + table + " data");
+  for (const std::string* data : pieces) {
+    for (std::size_t off = 0; off < data->size(); off += kChunk) {
+      const std::size_t n = std::min(kChunk, data->size() - off);
+      if (PQputCopyData(c_, data->data() + off, static_cast<int>(n)) != 1) fail("COPY " + table + " data");
+    }
   }
   if (PQputCopyEnd(c_, nullptr) != 1) fail("COPY " + table + " end");
   r = PQgetResult(c_);

@@ -2,6 +2,7 @@
 // colorlab-ship's settings: the [ship] section of colorlabd's own TOML, plus its state_dir, so one file
 // describes the bench (docs/fleet.md). Credentials are named by file and read when needed, never kept in
 // anything that is printed or logged.
+#include <cstdint>
 #include <filesystem>
 #include <string>
 
@@ -17,7 +18,11 @@ struct ShipConfig {
   std::string region = "us-east-1";
   std::filesystem::path access_key_file;
   std::filesystem::path secret_key_file;
-  int batch_runs = 50;       // runs shipped per cycle, each in its own PostgreSQL transaction
+  int batch_runs = 50;       // runs shipped per cycle
+  // One PostgreSQL transaction (one fsync'd commit) takes consecutive runs until it holds transaction_runs runs
+  // or at least transaction_measurements measurements; a run is never split (docs/fleet.md, "Sizing").
+  int transaction_runs = 100;
+  std::int64_t transaction_measurements = 200000;
   double interval_s = 30;    // between cycles when running as a service
   int stall_timeout_s = 30;  // an S3 request under 1 KiB/s for this long ends the cycle (retried next cycle)
   // `colorlab backup` rotation (docs/fleet.md, "Backups"): after a successful upload the bucket keeps the

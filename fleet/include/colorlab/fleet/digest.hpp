@@ -12,6 +12,9 @@ namespace colorlab::fleet {
 
 // $1 = run id; one row, one column: the hex digest (no row when central lacks the run).
 extern const char* const kCentralDigestSql;
+// $1 = a text[] of run ids ('{id,id}'); a row (id, hex digest) for each run central holds. One statement for a
+// transaction of several runs: one round trip instead of one a run.
+extern const char* const kCentralDigestsSql;
 
 class RunDigest {
  public:

@@ -40,6 +40,8 @@ class Pg {
   PgResult query(const std::string& sql, const std::vector<std::optional<std::string>>& params = {});
   // COPY <table> FROM STDIN in text format; `data` holds whole lines (copy_field() escapes a value).
   void copy_in(const std::string& table, const std::string& data);
+  // The same, the lines given in pieces (several runs' rows in one COPY, without joining them first).
+  void copy_in(const std::string& table, const std::vector<const std::string*>& pieces);
 
  private:
   [[noreturn]] void fail(const std::string& what, pg_result* r = nullptr);
