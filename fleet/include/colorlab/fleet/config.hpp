@@ -17,6 +17,9 @@ struct ShipConfig {
   std::string region = "us-east-1";
   std::filesystem::path access_key_file;
   std::filesystem::path secret_key_file;
+  // An https:// s3_endpoint's CA (PEM) when the store's certificate is not signed by a CA the system trusts
+  // (docs/fleet.md, "HTTPS object store"); empty: the system's CA certificates.
+  std::filesystem::path s3_ca_file;
   int batch_runs = 50;       // runs shipped per cycle, each in its own PostgreSQL transaction
   double interval_s = 30;    // between cycles when running as a service
   int stall_timeout_s = 30;  // an S3 request under 1 KiB/s for this long ends the cycle (retried next cycle)
