@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "colorlab/api/access.hpp"
+#include "colorlab/api/console_files.hpp"
 #include "colorlab/core/error.hpp"
 #include "colorlab/core/ids.hpp"
 #include "colorlab/core/log.hpp"
@@ -59,6 +60,7 @@ int serve(const fleet::CentralConfig& c) {
   fleet::S3Client s3(c.s3_endpoint, c.bucket, c.region,
                      {fleet::read_secret_file(c.access_key_file, "S3 access key"),
                       fleet::read_secret_file(c.secret_key_file, "S3 secret key")});
+  s3.set_ca_file(c.s3_ca_file);
 
   asio::io_context io{1};
   // The keys' table is colorlabd's own (same hashes, same checks, same wrong-key limit); its one writer
@@ -66,6 +68,7 @@ int serve(const fleet::CentralConfig& c) {
   colorlab::store::Store keys(c.keys_database());
   colorlab::daemon::Access access(keys, io.get_executor());
   fleet::CentralContext ctx{pool, s3, &access, colorlab::now_iso8601()};
+  ctx.console_dir = colorlab::daemon::shipped_console_dir();
 
   colorlab::http::ServerOptions o;
   o.tcp_host = c.listen;

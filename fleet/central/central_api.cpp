@@ -3,6 +3,7 @@
 #include "colorlab/fleet/central_api.hpp"
 
 #include "colorlab/api/access.hpp"
+#include "colorlab/api/console_files.hpp"
 #include "colorlab/api/problem.hpp"
 #include "colorlab/api/router.hpp"
 #include "colorlab/core/error.hpp"
@@ -57,6 +58,9 @@ constexpr Served kServed[] = {
 HttpResponse dispatch(CentralContext& ctx, const HttpRequest& req) {
   const std::string prefix(protocol::kPrefix);
   if (req.path != prefix && req.path.rfind(prefix + "/", 0) != 0) {
+    if (!ctx.console_dir.empty()) {
+      if (auto r = daemon::serve_console(req, ctx.console_dir)) return *r;
+    }
     return daemon::problem_response(404, "not_found", "Not found", "colorlab-central serves the v1 API only",
                                     "GET /v1 lists what it serves; see docs/fleet.md", {{"instance", req.path}});
   }

@@ -62,6 +62,7 @@ CentralConfig load_central_config(const fs::path& file) {
     else if (k == "region") c.region = need_string(file, node, k);
     else if (k == "access_key_file") c.access_key_file = resolve(need_string(file, node, k));
     else if (k == "secret_key_file") c.secret_key_file = resolve(need_string(file, node, k));
+    else if (k == "s3_ca_file") c.s3_ca_file = resolve(need_string(file, node, k));
     else if (k == "tls_certificate") c.tls_certificate = resolve(need_string(file, node, k));
     else if (k == "tls_private_key") c.tls_private_key = resolve(need_string(file, node, k));
     else if (k == "allow_plaintext") {
@@ -75,6 +76,9 @@ CentralConfig load_central_config(const fs::path& file) {
   const auto& where = central->source();
   if (c.postgres.empty()) bad(file, where, "[central] needs postgres (a libpq connection string)");
   if (c.s3_endpoint.empty() || c.bucket.empty()) bad(file, where, "[central] needs s3_endpoint and bucket");
+  if (!c.s3_ca_file.empty() && c.s3_endpoint.rfind("https://", 0) != 0) {
+    bad(file, where, "central.s3_ca_file is for an https:// s3_endpoint; '" + c.s3_endpoint + "' is not one");
+  }
   if (c.access_key_file.empty() || c.secret_key_file.empty()) {
     bad(file, where, "[central] needs access_key_file and secret_key_file (the keys themselves never go in this file)");
   }

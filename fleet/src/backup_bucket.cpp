@@ -24,6 +24,7 @@ S3Client bucket_for(const ShipConfig& c) {
                   read_secret_file(c.secret_key_file, "S3 secret key")};
   S3Client s3(c.s3_endpoint, c.bucket, c.region, std::move(k));
   s3.set_stall_timeout(c.stall_timeout_s);
+  s3.set_ca_file(c.s3_ca_file);
   return s3;
 }
 

@@ -66,6 +66,7 @@ ShipConfig load_ship_config(const fs::path& file) {
     else if (k == "region") c.region = need_string(file, node, k);
     else if (k == "access_key_file") c.access_key_file = resolve(need_string(file, node, k));
     else if (k == "secret_key_file") c.secret_key_file = resolve(need_string(file, node, k));
+    else if (k == "s3_ca_file") c.s3_ca_file = resolve(need_string(file, node, k));
     else if (k == "batch_runs") {
       auto v = node.value<std::int64_t>();
       if (!v || *v < 1 || *v > 100000) bad(file, node.source(), "ship.batch_runs must be an integer from 1 to 100000");
@@ -106,6 +107,9 @@ ShipConfig load_ship_config(const fs::path& file) {
   if (c.bench_name.empty()) c.bench_name = c.bench_id;
   if (c.postgres.empty()) bad(file, where, "[ship] needs postgres (a libpq connection string)");
   if (c.s3_endpoint.empty() || c.bucket.empty()) bad(file, where, "[ship] needs s3_endpoint and bucket");
+  if (!c.s3_ca_file.empty() && c.s3_endpoint.rfind("https://", 0) != 0) {
+    bad(file, where, "ship.s3_ca_file is for an https:// s3_endpoint; '" + c.s3_endpoint + "' is not one");
+  }
   if (c.access_key_file.empty() || c.secret_key_file.empty()) {
     bad(file, where, "[ship] needs access_key_file and secret_key_file (the keys themselves never go in this file)");
   }

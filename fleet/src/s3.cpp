@@ -50,6 +50,29 @@ S3Client::S3Client(std::string endpoint, std::string bucket, std::string region,
   curl_global_init(CURL_GLOBAL_DEFAULT);
 }
 
+void S3Client::set_tls(void* curl, char* error_buffer) const {
+  CURL* c = static_cast<CURL*>(curl);
+  // libcurl's defaults, stated: a store's certificate and name are checked whatever the configuration says.
+  curl_easy_setopt(c, CURLOPT_SSL_VERIFYPEER, 1L);
+  curl_easy_setopt(c, CURLOPT_SSL_VERIFYHOST, 2L);
+  if (!ca_file_.empty()) curl_easy_setopt(c, CURLOPT_CAINFO, ca_file_.c_str());
+  error_buffer[0] = '\0';
+  curl_easy_setopt(c, CURLOPT_ERRORBUFFER, error_buffer);
+}
+
+std::optional<std::string> S3Client::tls_failure(int curl_code, const char* error_buffer) const {
+  const auto rc = static_cast<CURLcode>(curl_code);
+  const std::string detail = error_buffer && *error_buffer ? error_buffer : curl_easy_strerror(rc);
+  if (rc == CURLE_PEER_FAILED_VERIFICATION) {
+    return "the store's TLS certificate was not verified against " +
+           (ca_file_.empty() ? std::string("the system's CA certificates") : "s3_ca_file " + ca_file_.string()) +
+           " (" + detail + ")";
+  }
+  if (rc == CURLE_SSL_CACERT_BADFILE) return "cannot use s3_ca_file " + ca_file_.string() + " (" + detail + ")";
+  if (rc == CURLE_SSL_CONNECT_ERROR) return "the TLS handshake failed (" + detail + ")";
+  return std::nullopt;
+}
+
 S3Client::Reply S3Client::request(const std::string& method, const std::string& key,
                                   const std::filesystem::path* upload, const std::string& payload_sha256,
                                   const std::string& extra_header) {
@@ -72,6 +95,8 @@ S3Client::Reply S3Client::request(const std::string& method, const std::string& 
   curl_easy_setopt(c, CURLOPT_LOW_SPEED_TIME, stall_timeout_s_);
   curl_easy_setopt(c, CURLOPT_WRITEFUNCTION, collect);
   curl_easy_setopt(c, CURLOPT_WRITEDATA, &reply.body);
+  char error_buffer[CURL_ERROR_SIZE];
+  set_tls(c, error_buffer);
   curl_slist* headers = nullptr;
   const std::string hash_header = "x-amz-content-sha256: " + payload_sha256;
   headers = curl_slist_append(headers, hash_header.c_str());
@@ -105,6 +130,12 @@ S3Client::Reply S3Client::request(const std::string& method, const std::string& 
                 "S3 store " + endpoint_ + ": " + method + " " + key + " stalled (under 1 KiB/s for " +
                     std::to_string(stall_timeout_s_) + " s)",
                 "the store or the link to it is stalling; the next cycle retries ([ship] stall_timeout_s)");
+  }
+  if (auto tls = tls_failure(rc, error_buffer)) {
+    throw Error(ErrorClass::no_comms, "S3 store " + endpoint_ + ": " + method + " " + key + ": " + *tls,
+                "s3_ca_file must name the CA certificate (PEM) that signed the store's certificate (unset: the "
+                "system's CAs), and the certificate must name the host of s3_endpoint (docs/fleet.md, \"HTTPS "
+                "object store\")");
   }
   if (rc != CURLE_OK) {
     throw Error(ErrorClass::no_comms, "S3 store " + endpoint_ + ": " + method + " " + key + ": " + curl_easy_strerror(rc),

@@ -33,6 +33,7 @@ struct S3Download::Impl {
   EVP_MD_CTX* hash = EVP_MD_CTX_new();
   std::uint64_t delivered = 0;
   std::string what;  // "GET sha256/<hex>", for messages
+  char error_buffer[CURL_ERROR_SIZE] = {};
 
   ~Impl() {
     if (multi && easy) curl_multi_remove_handle(multi, easy);
@@ -103,6 +104,7 @@ S3Download::S3Download(S3Client& client, const std::string& key,
   curl_easy_setopt(c, CURLOPT_WRITEDATA, &d.buffer);
   curl_easy_setopt(c, CURLOPT_HEADERFUNCTION, &Impl::on_header);
   curl_easy_setopt(c, CURLOPT_HEADERDATA, &d);
+  client.set_tls(c, d.error_buffer);
   d.headers = curl_slist_append(d.headers, (std::string("x-amz-content-sha256: ") + kEmptySha256).c_str());
   if (range) {
     d.headers = curl_slist_append(
@@ -112,6 +114,12 @@ S3Download::S3Download(S3Client& client, const std::string& key,
   curl_multi_add_handle(d.multi, c);
 
   d.pump([&d] { return d.headers_done && !d.buffer.empty(); });
+  if (d.done) {
+    if (auto tls = client.tls_failure(d.result, d.error_buffer)) {
+      throw Error(ErrorClass::no_comms, "S3 store " + client.endpoint_ + ": " + d.what + ": " + *tls,
+                  "[central] s3_ca_file must name the CA certificate that signed the store's certificate (docs/fleet.md)");
+    }
+  }
   d.throw_if_broken(client.endpoint_);
   long status = 0;
   curl_easy_getinfo(c, CURLINFO_RESPONSE_CODE, &status);

@@ -1,14 +1,16 @@
 // What may this browser do? GET /v1/control says whose the control lock is and — where the daemon reports
 // it — the asker's own scope. Without that field the console asks the way a control request would be judged: a dry run without a campaign needs the control scope, stores
 // nothing and moves nothing. 400 (the body is incomplete) means the access check passed; 401/403/409 are the
-// access answers themselves, with the daemon's explanation.
+// access answers themselves, with the daemon's explanation. A server whose GET /v1 says read_only (colorlab-central)
+// controls nothing for anyone: no lock or control request is asked about. The answer carries GET /v1 (`server`).
 import { get, post, ApiError } from "./api.js";
 import { getKey } from "./key.js";
 
 export async function probeAccess() {
   const key = getKey();
+  let server;
   try {
-    await get("/v1");
+    server = await get("/v1");
   } catch (e) {
     if (e instanceof ApiError && e.status === 401) {
       return { control: false, read: false, why: key ? `the key was refused: ${e.message}` :
@@ -16,6 +18,14 @@ export async function probeAccess() {
     }
     return { control: false, read: false, why: `the daemon cannot be reached: ${e.message}` };
   }
+  if (server && server.read_only) {
+    return { control: false, read: true, server, why: `read-only: ${server.server || "this server"} serves the runs ` +
+      "the benches shipped and changes nothing; control a bench at its own URL" };
+  }
+  return { ...(await probeControl(key)), server };
+}
+
+async function probeControl(key) {
   let lock = null;
   try { lock = await get("/v1/control"); } catch { /* an older daemon without the lock: probe below */ }
   if (lock && lock.held && !lock.yours) {

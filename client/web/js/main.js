@@ -1,5 +1,7 @@
 // Wires the pieces: the key form, the access probe, the event stream into the store, and hash routing
-// between the four pages (#lab, #queue, #now, #runs[/RUN_ID]) — one page, so the stream stays open.
+// between the four pages (#lab, #queue, #now, #runs[/RUN_ID]) — one page, so the stream stays open. What the
+// server serves comes from GET /v1 (its features, read_only): on colorlab-central only the Runs page is there,
+// across benches, with no stream and no control (docs/fleet.md, "Console on central").
 import { EventStream } from "./events.js";
 import { Store } from "./store.js";
 import { probeAccess } from "./access.js";
@@ -19,7 +21,16 @@ const ctx = {
   // A control request refused for access reasons means what we knew about the key is stale: ask again.
   accessChanged(e) { if (e && [401, 403, 409].includes(e.status)) checkAccess(); },
   refreshQueue: null,
+  // GET /v1 as last read (null until then: a bench is assumed, as the console always did).
+  server: null,
+  has(feature) {
+    const f = ctx.server && ctx.server.features;
+    return !Array.isArray(f) || f.includes(feature);
+  },
 };
+// The feature of GET /v1 each page needs: the pages a server cannot fill are not offered.
+const PAGE_NEEDS = { lab: "instruments", queue: "queue", now: "executions", runs: "runs" };
+const served = name => ctx.has(PAGE_NEEDS[name]);
 
 const pages = {
   lab: lab.mount(document.getElementById("page-lab"), ctx),
@@ -30,17 +41,19 @@ const pages = {
 let currentPage = null;
 
 function route() {
-  const [name, arg] = (location.hash.replace(/^#/, "") || "now").split("/");
-  const page = pages[name] ? name : "now";
+  const home = served("now") ? "now" : "runs";
+  const [name, arg] = (location.hash.replace(/^#/, "") || home).split("/");
+  const page = pages[name] && served(name) ? name : home;
   if (currentPage && currentPage !== page) pages[currentPage].hide();
   for (const [n] of Object.entries(pages)) {
     document.getElementById(`page-${n}`).hidden = n !== page;
     const link = document.querySelector(`nav a[href="#${n}"]`);
+    link.hidden = !served(n);
     if (n === page) link.setAttribute("aria-current", "page"); else link.removeAttribute("aria-current");
   }
   currentPage = page;
   pages[page].show(arg ? decodeURIComponent(arg) : undefined);
-  document.title = `colorlab · ${page}`;
+  document.title = `colorlab${ctx.has("benches") && ctx.server ? " central" : ""} · ${page}`;
 }
 window.addEventListener("hashchange", route);
 
@@ -54,6 +67,13 @@ function toast(text, bad = false) {
 
 async function checkAccess() {
   ctx.access = await probeAccess();
+  // An unreachable or refusing server leaves what was known of it.
+  if (ctx.access.server) {
+    const changed = JSON.stringify(ctx.access.server.features) !== JSON.stringify(ctx.server && ctx.server.features);
+    ctx.server = ctx.access.server;
+    applyServer();
+    if (changed && currentPage) route();
+  }
   const note = document.getElementById("access-note");
   document.body.classList.toggle("read-only", !ctx.access.control);
   note.textContent = ctx.access.control ? "control: this console may start, pause, abort and answer" : ctx.access.why;
@@ -81,11 +101,30 @@ const stream = new EventStream({
   onSnapshot: s => store.applySnapshot(s),
   onEvent: ev => store.applyEvent(ev),
   onStatus: (state, why) => {
+    if (!ctx.has("event-stream")) return;  // a late word from a stream stopped because the server has none
     conn.textContent = state === "live" ? "LIVE" : state.toUpperCase();
     conn.className = `conn conn-${state}`;
     conn.title = why || "";
   },
 });
+
+// A server without the live stream (colorlab-central: runs the benches shipped, nothing happening here) is
+// not asked for it; one with it gets it opened once, reopened later only by a new key.
+let streamOpened = false;
+function applyServer() {
+  document.body.classList.toggle("central", !!ctx.server && ctx.has("benches"));
+  if (ctx.has("event-stream")) {
+    if (!streamOpened) { streamOpened = true; stream.start(); }
+    return;
+  }
+  streamOpened = false;
+  stream.stop();
+  const central = ctx.has("benches");
+  conn.textContent = central ? "CENTRAL" : "NOT LIVE";
+  conn.className = "conn conn-central";
+  conn.title = central ? `${ctx.server.server || "central"}: the runs the benches shipped; nothing live to follow here`
+    : "this server has no live event stream";
+}
 store.subscribe(what => {
   const topic = what.event && what.event.topic;
   if (topic === "queue") queueChanged();
@@ -105,15 +144,18 @@ keyRemember.checked = remembered();
 document.getElementById("key-form").addEventListener("submit", ev => {
   ev.preventDefault();
   setKey(keyInput.value, keyRemember.checked);
-  checkAccess();
-  stream.restart();
+  keyChanged();
 });
 document.getElementById("key-clear").addEventListener("click", () => {
   keyInput.value = "";
   setKey("", false);
-  checkAccess();
-  stream.restart();
+  keyChanged();
 });
+// After the probe: a key may be what let GET /v1 say which server this is (and whether it has a stream).
+async function keyChanged() {
+  await checkAccess();
+  if (ctx.has("event-stream")) stream.restart();
+}
 
 // For the tests and for curious operators: the live figures, read-only.
 window.colorlabConsole = {
@@ -129,11 +171,12 @@ let hiddenTimer = null;
 document.addEventListener("visibilitychange", () => {
   clearTimeout(hiddenTimer);
   if (document.hidden) hiddenTimer = setTimeout(() => stream.stop(), 60000);
-  else stream.start();
+  else if (ctx.has("event-stream")) stream.start();
 });
 window.addEventListener("pagehide", () => stream.stop());
-window.addEventListener("pageshow", ev => { if (ev.persisted) stream.start(); });
+window.addEventListener("pageshow", ev => { if (ev.persisted && ctx.has("event-stream")) stream.start(); });
 
+// GET /v1 first (it is in the access probe): which pages there are, and whether there is a stream to open.
+await checkAccess();
 route();
-checkAccess();
-stream.start();
+applyServer();

@@ -18,6 +18,7 @@ struct CentralConfig {
   std::string region = "us-east-1";
   std::filesystem::path access_key_file;  // a key that may GET objects; first line, never logged
   std::filesystem::path secret_key_file;
+  std::filesystem::path s3_ca_file;       // an https:// store's CA (PEM); empty: the system's CAs
   std::filesystem::path tls_certificate;  // both set: the listener speaks TLS
   std::filesystem::path tls_private_key;
   bool allow_plaintext = false;           // beyond loopback without TLS (keys would cross in the clear)

@@ -18,6 +18,9 @@ struct ShipConfig {
   std::string region = "us-east-1";
   std::filesystem::path access_key_file;
   std::filesystem::path secret_key_file;
+  // An https:// s3_endpoint's CA (PEM) when the store's certificate is not signed by a CA the system trusts
+  // (docs/fleet.md, "HTTPS object store"); empty: the system's CA certificates.
+  std::filesystem::path s3_ca_file;
   int batch_runs = 50;       // runs shipped per cycle
   // One PostgreSQL transaction (one fsync'd commit) takes consecutive runs until it holds transaction_runs runs
   // or at least transaction_measurements measurements; a run is never split (docs/fleet.md, "Sizing").

@@ -35,6 +35,10 @@ class S3Client {
   void set_stall_timeout(long seconds) { stall_timeout_s_ = seconds; }
   // Deletes an object (backup rotation); a missing one is no error (S3 answers 204 either way).
   void remove(const std::string& key);
+  // The CA certificates (PEM) an https:// store's certificate must chain to, instead of the system's ([ship] and
+  // [central] s3_ca_file). The certificate and its host name are verified either way; one that fails ends the
+  // request as Error{no_comms} saying so.
+  void set_ca_file(std::filesystem::path file) { ca_file_ = std::move(file); }
 
  private:
   friend class S3Download;
@@ -45,7 +49,12 @@ class S3Client {
   Reply request(const std::string& method, const std::string& key, const std::filesystem::path* upload,
                 const std::string& payload_sha256, const std::string& extra_header = {});
   [[noreturn]] void refuse(const std::string& what, const Reply& r) const;
+  // TLS settings of every request (S3Download's too); `curl` is a CURL*.
+  void set_tls(void* curl, char* error_buffer) const;
+  // The error for a transfer that failed in TLS (the certificate, the CA file), or nothing for another failure.
+  std::optional<std::string> tls_failure(int curl_code, const char* error_buffer) const;
   std::string endpoint_, bucket_, region_;
+  std::filesystem::path ca_file_;
   S3Credentials credentials_;
   long stall_timeout_s_ = 30;
 };
