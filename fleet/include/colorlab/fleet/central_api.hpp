@@ -5,6 +5,7 @@
 // table and wrong-key limit, the problem+json builder, the byte-range and entity-tag rules, the export
 // conversions and the record types' JSON. What central adds: GET /v1/benches, bench filters on the run list, a
 // `bench` member on run documents, and a 405 `central-read-only` for anything that would change something.
+#include "colorlab/fleet/central_cache.hpp"
 #include "colorlab/fleet/central_catalog.hpp"
 #include "colorlab/fleet/s3.hpp"
 #include "colorlab/http/message.hpp"
@@ -20,6 +21,7 @@ struct CentralContext {
   S3Client& s3;
   daemon::Access* access = nullptr;  // every /v1 request is checked for the read scope
   std::string started_at;
+  AnswerCache answers;  // run listings and measurement pages already built (central_cache.hpp)
 };
 
 // Any thread; every error leaves as problem+json.
