@@ -4,13 +4,18 @@
 A throwaway PostgreSQL 15 (fsync on) gets the central schema from `colorlab-ship central-init`, then a catalog of
 BENCHES benches x RUNS runs x MEASUREMENTS measurements (10.2 M by default) written by SQL; bench-1's share is
 written, row for row the same, into a colorlabd state directory (the daemon's own schema, created by starting it
-once). Then wrk -t2 -c32 --latency, alternating bench and central, on
-  - the run listing, 50 runs a page (GET /v1/runs?limit=50), and
-  - one run's measurement page, 500 a page (GET /v1/runs/{id}/measurements?limit=500, a run in the middle).
+once). Then wrk -t2 -c32 --latency, alternating bench and central (and --baseline, another colorlab-central binary on
+the same catalog), on
+  - the run listing, 50 runs a page (GET /v1/runs?limit=50),
+  - one run's measurement page, 500 a page (GET /v1/runs/{id}/measurements?limit=500, a run in the middle): asked
+    again and again, central answers it from memory (fleet/include/colorlab/fleet/central_cache.hpp), and
+  - the first page of a different run each request (bench-1's 2,000 runs in turn), which central builds afresh.
+Each figure comes with the CPU milliseconds per request of the server process (and of all of PostgreSQL for
+central), read from /proc before and after: on a shared machine GETs/s follow the load, CPU per request hardly.
 Blobs are not part of this bench (the bucket is not started).
 
 Usage: python3 bench/fleet/central_load.py --build build [--runs 2000] [--measurements 1700] [--benches 3]
-       [--seconds 10] [--rounds 2] [--threads 4]
+       [--seconds 10] [--rounds 2] [--threads 4] [--baseline path/to/colorlab-central]
 Run as root (PostgreSQL's initdb runs as the `postgres` user) with wrk installed. Prints one JSON document;
 docs/PERFORMANCE.md records the figures and this command.
 """
@@ -137,8 +142,8 @@ def start_daemon(build, root):
     raise SystemExit("colorlabd did not start")
 
 
-def start_central(build, root, port, threads):
-    c = os.path.join(root, "central")
+def start_central(build, root, port, threads, binary=None, name="central"):
+    c = os.path.join(root, name)
     os.makedirs(c)
     for name in ("ak", "sk"):
         with open(os.path.join(c, name), "w") as f:
@@ -147,19 +152,71 @@ def start_central(build, root, port, threads):
         f.write(f"state_dir = \"{c}/state\"\n[central]\nport = 0\nthreads = {threads}\n"
                 f"postgres = \"host=127.0.0.1 port={port} dbname=central user=postgres\"\n"
                 f"s3_endpoint = \"http://127.0.0.1:9\"\nbucket = \"none\"\naccess_key_file = \"ak\"\nsecret_key_file = \"sk\"\n")
-    proc = subprocess.Popen([os.path.join(build, "bin", "colorlab-central"), "--config", os.path.join(c, "central.toml"),
+    proc = subprocess.Popen([binary or os.path.join(build, "bin", "colorlab-central"), "--config", os.path.join(c, "central.toml"),
                              "serve"], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
     return proc, json.loads(proc.stdout.readline())["url"]
 
 
-def wrk(url, seconds, connections=32, threads=2):
-    out = subprocess.run(["wrk", f"-t{threads}", f"-c{connections}", f"-d{seconds}s", "--latency", url],
-                         capture_output=True, text=True, check=True).stdout
+def cpu_seconds(pid, children=False):
+    """User + system CPU of a process (with its reaped children's when asked), from /proc/<pid>/stat."""
+    with open(f"/proc/{pid}/stat") as f:
+        fields = f.read().rsplit(")", 1)[1].split()
+    ticks = int(fields[11]) + int(fields[12]) + (int(fields[13]) + int(fields[14]) if children else 0)
+    return ticks / os.sysconf("SC_CLK_TCK")
+
+
+def postgres_cpu_seconds(data):
+    """The whole PostgreSQL server's CPU: the postmaster with the backends it reaped, plus its live children."""
+    with open(os.path.join(data, "postmaster.pid")) as f:
+        postmaster = int(f.readline())
+    total = cpu_seconds(postmaster, children=True)
+    for entry in os.listdir("/proc"):
+        if not entry.isdigit():
+            continue
+        try:
+            with open(f"/proc/{entry}/stat") as f:
+                fields = f.read().rsplit(")", 1)[1].split()
+            if int(fields[1]) == postmaster:
+                total += cpu_seconds(int(entry))
+        except (OSError, ValueError, IndexError):
+            pass  # a backend that ended meanwhile is in the postmaster's reaped children
+    return total
+
+
+# Each request a different run's first page, each wrk thread starting half the list away from the other: the runs
+# cycle through more pages than central's answer cache holds (64 MiB, ~870 pages of ~75 KB), so every request is
+# built from PostgreSQL: the figure for pages nobody asked for lately.
+DISTINCT_RUNS_LUA = """
+local n = 0
+function setup(thread)
+  thread:set("offset", n * math.floor(#ids / 2))
+  n = n + 1
+end
+function init(args)
+  i = offset or 0
+end
+function request()
+  i = i + 1
+  return wrk.format("GET", "/v1/runs/" .. ids[(i % #ids) + 1] .. "/measurements?limit=500")
+end
+"""
+
+
+def wrk(url, seconds, connections=32, threads=2, script=None, cpu=None):
+    """wrk's figures, plus the CPU milliseconds per request of each process in `cpu` ({name: () -> seconds})."""
+    before = {name: f() for name, f in (cpu or {}).items()}
+    cmd = ["wrk", f"-t{threads}", f"-c{connections}", f"-d{seconds}s", "--latency"] + (["-s", script] if script else [])
+    out = subprocess.run(cmd + [url], capture_output=True, text=True, check=True).stdout
     rps = float(re.search(r"Requests/sec:\s+([\d.]+)", out).group(1))
+    total = int(re.search(r"(\d+) requests in", out).group(1))
     p99 = re.search(r"99%\s+([\d.]+)(us|ms|s)", out)
     errors = re.search(r"Non-2xx or 3xx responses:\s+(\d+)", out)
-    return {"requests_per_s": rps, "p99_ms": round(float(p99.group(1)) * {"us": 1e-3, "ms": 1.0, "s": 1e3}[p99.group(2)], 2),
-            "non_2xx": int(errors.group(1)) if errors else 0}
+    r = {"requests_per_s": rps, "p99_ms": round(float(p99.group(1)) * {"us": 1e-3, "ms": 1.0, "s": 1e3}[p99.group(2)], 2),
+         "non_2xx": int(errors.group(1)) if errors else 0}
+    for name, f in (cpu or {}).items():
+        # CPU time per request hardly depends on how many other processes share the cores, unlike GETs/s.
+        r[f"cpu_ms_per_request_{name}"] = round((f() - before[name]) * 1e3 / max(total, 1), 3)
+    return r
 
 
 def main():
@@ -171,6 +228,8 @@ def main():
     ap.add_argument("--seconds", type=int, default=10)
     ap.add_argument("--rounds", type=int, default=2)
     ap.add_argument("--threads", type=int, default=4, help="colorlab-central's HTTP threads")
+    ap.add_argument("--baseline", help="another colorlab-central binary (e.g. the previous commit's) measured beside "
+                                       "this one on the same catalog, in the same run")
     a = ap.parse_args()
     build = os.path.abspath(a.build)
     root = tempfile.mkdtemp(prefix="colorlab-central-bench-")
@@ -198,6 +257,15 @@ def main():
         procs.append(daemon)
         central, central_url = start_central(build, root, port, a.threads)
         procs.append(central)
+        sides = [("bench", bench_url), ("central", central_url)]
+        cpu = {"bench": {"server": lambda: cpu_seconds(daemon.pid)},
+               "central": {"server": lambda: cpu_seconds(central.pid), "postgres": lambda: postgres_cpu_seconds(data)}}
+        if a.baseline:
+            baseline, baseline_url = start_central(build, root, port, a.threads, os.path.abspath(a.baseline), "baseline")
+            procs.append(baseline)
+            sides.append(("central baseline", baseline_url))
+            cpu["central baseline"] = {"server": lambda: cpu_seconds(baseline.pid),
+                                       "postgres": lambda: postgres_cpu_seconds(data)}
         rows = int(psql(port, "central", "SELECT count(*) FROM measurements"))
         # Bytes per row for docs/fleet.md "Sizing": heap (with TOAST), each index, and the total.
         sizes = {}
@@ -219,14 +287,19 @@ def main():
                                           "ORDER BY r.id DESC LIMIT 51")):
             plans[name] = psql(port, "central", "EXPLAIN (ANALYZE, BUFFERS, TIMING OFF) " + sql).strip().splitlines()
         middle = run_id(1, a.runs // 2)
-        routes = {"run listing, 50 a page": "/v1/runs?limit=50",
-                  "measurement page, 500 a page": f"/v1/runs/{middle}/measurements?limit=500"}
-        results = {name: {"bench": [], "central": []} for name in routes}
+        script = os.path.join(root, "distinct_runs.lua")
+        with open(script, "w") as f:
+            # bench-1's runs: the bench holds these too, so both sides build the same pages.
+            f.write("ids = {" + ",".join(f'"{run_id(1, i)}"' for i in range(1, a.runs + 1)) + "}\n" + DISTINCT_RUNS_LUA)
+        routes = {"run listing, 50 a page": ("/v1/runs?limit=50", None),
+                  "measurement page, 500 a page": (f"/v1/runs/{middle}/measurements?limit=500", None),
+                  "measurement pages, a different run each request": ("/", script)}
+        results = {name: {side: [] for side, _ in sides} for name in routes}
         load_before = os.getloadavg()
         for _ in range(a.rounds):
-            for name, path in routes.items():
-                for side, url in (("bench", bench_url), ("central", central_url)):
-                    r = wrk(url + path, a.seconds)
+            for name, (path, lua) in routes.items():
+                for side, url in sides:
+                    r = wrk(url + path, a.seconds, script=lua, cpu=cpu[side])
                     r["loadavg_1min"] = round(os.getloadavg()[0], 1)  # the machine is shared: say its load
                     results[name][side].append(r)
         print(json.dumps({"central_measurements": rows, "benches": a.benches, "runs_per_bench": a.runs,

@@ -118,6 +118,20 @@ std::optional<CentralRun> central_run(Pg& pg, const std::string& id) {
   return read_run(r, 0);
 }
 
+std::optional<std::string> central_run_validator(Pg& pg, const std::string& id) {
+  auto r = pg.query("SELECT xmin::text FROM runs WHERE id = $1", {id});
+  if (r.rows() == 0) return std::nullopt;
+  return r.text(0, 0);
+}
+
+std::string central_catalog_validator(Pg& pg) {
+  // Every transaction that adds runs also moves its bench's shipped_position, and a renamed bench is an update of
+  // its row, so the set of (bench, row version) changes whenever the listing could. A bench row is small and
+  // there are tens of them, not millions.
+  return pg.query("SELECT coalesce(string_agg(id || ' ' || xmin::text, ',' ORDER BY id COLLATE \"C\"), '') FROM benches")
+      .text(0, 0);
+}
+
 CentralRunPage central_runs(Pg& pg, unsigned limit, const std::optional<std::string>& cursor,
                             const CentralRunFilter& f) {
   if (cursor && !is_run_id(*cursor)) {

@@ -4,8 +4,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include "colorlab/api/conditional.hpp"
 #include "colorlab/core/error.hpp"
 #include "colorlab/protocol/api.hpp"
+#include "central_json.hpp"
 #include "query.hpp"
 
 #ifndef COLORLAB_VERSION
@@ -26,15 +28,44 @@ std::string query_or_empty(const HttpRequest& req, const char* name) {
 
 json bench_of(const CentralRun& c) { return {{"id", c.bench_id}, {"name", c.bench_name}}; }
 
+[[noreturn]] void no_such_run(const std::string& id) {
+  throw Error(ErrorClass::not_found, "central holds no run with id '" + id + "'",
+              "a run arrives when its bench's colorlab-ship ships it after it ended; GET /v1/benches shows each "
+              "bench's lag");
+}
+
+// An answer's key in the AnswerCache: the path and every query parameter (each can show in the answer's links),
+// length-prefixed so no two requests share one.
+std::string answer_key(const HttpRequest& req) {
+  std::string key = req.path;
+  for (const auto& [k, v] : req.query) key += "\n" + std::to_string(k.size()) + ":" + k + std::to_string(v.size()) + ":" + v;
+  return key;
+}
+
+// A kept answer, or 304 when the client already holds these bytes (If-None-Match).
+HttpResponse kept_answer(const HttpRequest& req, const AnswerCache::Answer& a) {
+  HttpResponse r;
+  r.headers["ETag"] = a.etag;
+  if (auto inm = req.header("if-none-match"); inm && daemon::none_match_hits(*inm, a.etag)) {
+    r.status = 304;
+    return r;
+  }
+  r.status = 200;
+  r.content_type = std::string(protocol::kContentJson);
+  r.body = *a.body;
+  return r;
+}
+
+HttpResponse keep_answer(CentralContext& ctx, const HttpRequest& req, const std::string& key,
+                         const std::string& validator, const json& body) {
+  return kept_answer(req, ctx.answers.keep(key, validator, body.dump(-1, ' ', false, json::error_handler_t::replace)));
+}
+
 }  // namespace
 
 CentralRun require_run(Pg& pg, const std::string& id) {
   auto r = central_run(pg, id);
-  if (!r) {
-    throw Error(ErrorClass::not_found, "central holds no run with id '" + id + "'",
-                "a run arrives when its bench's colorlab-ship ships it after it ended; GET /v1/benches shows each "
-                "bench's lag");
-  }
+  if (!r) no_such_run(id);
   return *r;
 }
 
@@ -63,6 +94,9 @@ HttpResponse get_runs(CentralContext& ctx, const HttpRequest& req, const PathPar
   CentralRunFilter filter{query_or_empty(req, "campaign"), query_or_empty(req, "status"), query_or_empty(req, "bench"),
                           query_or_empty(req, "since"), query_or_empty(req, "until")};
   auto pg = ctx.pool.lease();
+  const std::string key = answer_key(req);
+  const std::string validator = central_catalog_validator(*pg);  // before the page: never newer rows than it
+  if (auto kept = ctx.answers.find(key, validator)) return kept_answer(req, *kept);
   auto page = central_runs(*pg, limit, cursor, filter);
   json items = json::array();
   for (const auto& c : page.runs) {
@@ -80,8 +114,9 @@ HttpResponse get_runs(CentralContext& ctx, const HttpRequest& req, const PathPar
     }
     next = link;
   }
-  return HttpResponse::json(200, {{"items", items}, {"links", {{"next", next}}},
-                                  {"next_cursor", page.next_cursor ? json(*page.next_cursor) : json(nullptr)}});
+  return keep_answer(ctx, req, key, validator,
+                     {{"items", items}, {"links", {{"next", next}}},
+                      {"next_cursor", page.next_cursor ? json(*page.next_cursor) : json(nullptr)}});
 }
 
 // The bench's run document plus `bench`; no report link: reports are made on a bench.
@@ -103,24 +138,33 @@ HttpResponse get_run_measurements(CentralContext& ctx, const HttpRequest& req, c
   const std::int64_t after = dr::non_negative_query(req, "cursor", "cursor must be the next_cursor of the previous page");
   store::MeasurementFilter filter{query_or_empty(req, "step_prefix"), query_or_empty(req, "quantity"),
                                   query_or_empty(req, "instrument")};
+  // A shipped run's pages never change while its row is the same (AnswerCache); the row is asked for at most
+  // once per AnswerCache::kRunRecheck, so a page asked for again costs no PostgreSQL round trip at all.
+  const std::string key = answer_key(req);
+  const auto now = AnswerCache::Clock::now();
+  std::optional<std::string> validator = ctx.answers.recent_run(id, now);
+  if (validator) {
+    if (auto kept = ctx.answers.find(key, *validator)) return kept_answer(req, *kept);
+  }
   auto pg = ctx.pool.lease();
+  if (!validator) {
+    validator = central_run_validator(*pg, id);
+    if (!validator) no_such_run(id);  // an unknown run is a 404, not an empty page
+    ctx.answers.run_checked(id, *validator, now);
+    if (auto kept = ctx.answers.find(key, *validator)) return kept_answer(req, *kept);
+  }
   auto page = central_measurements_page(*pg, id, filter, after, limit);
-  // An unknown run is a 404, not an empty page; a page with rows names a run central holds (measurements reference
-  // runs), so only an empty one costs the second query.
-  if (page.items.empty()) require_run(*pg, id);
-  json items = json::array();
-  for (const auto& m : page.items) items.push_back(m.to_json());
-  json next = nullptr, next_link = nullptr;
+  std::optional<std::string> next, next_link;
   if (page.next_after) {
     next = std::to_string(*page.next_after);
     std::string link = std::string(protocol::kPrefix) + "/runs/" + id + "/measurements?limit=" + std::to_string(limit) +
-                       "&cursor=" + next.get<std::string>();
+                       "&cursor=" + *next;
     for (const auto& [k, v] : req.query) {
       if (k != "limit" && k != "cursor") link += "&" + k + "=" + http::percent_encode(v);
     }
     next_link = link;
   }
-  return HttpResponse::json(200, {{"items", items}, {"next_cursor", next}, {"links", {{"next", next_link}}}});
+  return kept_answer(req, ctx.answers.keep(key, *validator, measurement_page_json(page, next, next_link)));
 }
 
 HttpResponse get_run_blobs(CentralContext& ctx, const HttpRequest&, const PathParams& params) {

@@ -389,13 +389,55 @@ TEST_F(Central, BenchesShowTheirLag) {
   EXPECT_EQ(unshipped.status, 404) << "not shipped yet";
   EXPECT_NE(unshipped.body.find("/v1/benches"), std::string::npos) << unshipped.body;
 
+  // A listing central has answered (and keeps, central_cache.hpp) still shows what ships after it.
+  auto listed = [&] {
+    std::set<std::string> ids;
+    const auto r = central("/v1/runs?limit=50");
+    EXPECT_EQ(r.status, 200) << r.body;
+    const json doc = r.doc();  // held: a range-for over a temporary's member would dangle
+    for (const auto& item : doc.at("items")) ids.insert(item.at("id").get<std::string>());
+    return ids;
+  };
+  EXPECT_EQ(listed().count(w().c_runs[4]), 0u);
+  EXPECT_EQ(listed().count(w().c_runs[4]), 0u) << "asked again: the kept answer";
+
   // Two more cycles ship the rest: no lag left.
   for (int i = 0; i < 2; ++i) ASSERT_EQ(ship(w().bench_c_config).exit_code, 0);
+  EXPECT_EQ(listed().count(w().c_runs[4]), 1u) << "a run shipped after the listing was kept is listed";
   auto after = benches();
   EXPECT_EQ(after["bench-c"]["lag"]["unshipped_runs"], 0);
   EXPECT_EQ(after["bench-c"]["runs"], 5);
   EXPECT_EQ(after["bench-c"]["lag"]["age_s"], 0.0);
   EXPECT_EQ(central("/v1/runs/" + w().c_runs[4]).status, 200);
+}
+
+// Pages and listings asked for again are the same bytes (kept in memory, central_cache.hpp) with an entity tag of
+// those bytes; a client that holds them gets 304 (RFC 9110 §13.1.2), and an unknown run is still a 404.
+TEST_F(Central, AnswersAskedAgainAreTheSameBytesWithAnEntityTag) {
+  const std::string path = "/v1/runs/" + w().chart_run + "/measurements?limit=5";
+  auto first = central(path), again = central(path);
+  ASSERT_EQ(first.status, 200) << first.body;
+  ASSERT_EQ(again.status, 200) << again.body;
+  EXPECT_EQ(again.body, first.body);
+  EXPECT_EQ(first.doc(), bench(path).doc());
+  ASSERT_EQ(first.headers.count("etag"), 1u);
+  EXPECT_EQ(again.headers["etag"], first.headers["etag"]);
+  auto held = central(path, {"-H", "If-None-Match: " + first.headers["etag"]});
+  EXPECT_EQ(held.status, 304);
+  EXPECT_TRUE(held.body.empty());
+  EXPECT_EQ(central(path, {"-H", "If-None-Match: \"0000000000000000\""}).status, 200);
+  ASSERT_TRUE(first.doc()["next_cursor"].is_string());
+  auto next = central(path + "&cursor=" + first.doc()["next_cursor"].get<std::string>());
+  ASSERT_EQ(next.status, 200);
+  EXPECT_NE(next.headers["etag"], first.headers["etag"]);
+
+  auto listing = central("/v1/runs?limit=4");
+  ASSERT_EQ(listing.status, 200);
+  EXPECT_EQ(central("/v1/runs?limit=4", {"-H", "If-None-Match: " + listing.headers["etag"]}).status, 304);
+
+  const std::string unknown = "/v1/runs/0190ffff-ffff-7fff-8fff-ffffffffffff/measurements";
+  EXPECT_EQ(central(unknown).status, 404);
+  EXPECT_EQ(central(unknown).status, 404) << "a 404 is not kept";
 }
 
 TEST_F(Central, BlobsComeFromTheBucketWithRangeAndETag) {

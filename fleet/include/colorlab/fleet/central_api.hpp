@@ -7,6 +7,7 @@
 // `bench` member on run documents, and a 405 `central-read-only` for anything that would change something.
 #include <filesystem>
 
+#include "colorlab/fleet/central_cache.hpp"
 #include "colorlab/fleet/central_catalog.hpp"
 #include "colorlab/fleet/s3.hpp"
 #include "colorlab/http/message.hpp"
@@ -25,6 +26,7 @@ struct CentralContext {
   // The web console's files, served at / as a bench serves them (same files, same Content-Security-Policy); GET /v1
   // tells the console it is on central (read_only, its features), so it shows the Runs page across benches only.
   std::filesystem::path console_dir;
+  AnswerCache answers;  // run listings and measurement pages already built (central_cache.hpp)
 };
 
 // Any thread; every error leaves as problem+json.

@@ -77,6 +77,10 @@ struct CentralBlobRef {
 };
 
 std::optional<CentralRun> central_run(Pg& pg, const std::string& id);
+// What says a run's rows are still the ones an answer was built from (its `runs` row version), or nothing when
+// central holds no such run; and the same for the whole run listing (every bench's row version). AnswerCache.
+std::optional<std::string> central_run_validator(Pg& pg, const std::string& id);
+std::string central_catalog_validator(Pg& pg);
 // Error{bad_parameter} for a cursor that is no run id, or a since/until PostgreSQL cannot read as a time.
 CentralRunPage central_runs(Pg& pg, unsigned limit, const std::optional<std::string>& cursor,
                             const CentralRunFilter& filter);
