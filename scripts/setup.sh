@@ -30,6 +30,8 @@ packages=(
   python3-matplotlib chromium chromium-driver python3-selenium
   # clang only recommends its fuzzer and sanitizer runtimes, and this script installs without recommends
   libclang-rt-14-dev
+  # the system's CA bundle, which an https:// object store without s3_ca_file is verified against (tests/fleet/ship_https_test.cpp)
+  ca-certificates
   # the Debian package (docs/packaging.md): cpack's dpkg-shlibdeps, lintian, and mmdebstrap's throwaway chroot
   dpkg-dev binutils lintian mmdebstrap debian-archive-keyring
   # the TLS listener checked by a tool colorlab did not write (tests/security/testssl_test.py)

@@ -114,6 +114,17 @@ class TlsFront {
   std::string endpoint() const { return "https://127.0.0.1:" + std::to_string(good_); }
   std::string rogue_endpoint() const { return "https://127.0.0.1:" + std::to_string(rogue_); }
   std::string store_log() const { return read_all(dir_ / "logs" / "store.log"); }
+  // nginx writes a request's access-log line after the answer's last byte left, so the client can be done
+  // first: wait (bounded) for the line rather than read the log at once.
+  std::string store_log_with(const std::string& needle) const {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(15);
+    std::string log = store_log();
+    while (log.find(needle) == std::string::npos && std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      log = store_log();
+    }
+    return log;
+  }
 
  private:
   fs::path dir_;
@@ -192,7 +203,7 @@ TEST(ShipHttps, ShipsAndReadsBackThroughATlsFrontWithTheLabsCa) {
   EXPECT_GT(fleet::read_shipped_position(position), 0);
   const std::string blobs = s.pg->psql(name, "SELECT count(*) FROM run_blobs");
   EXPECT_EQ(blobs, "6") << "three frames a run";
-  const std::string log = front.store_log();
+  const std::string log = front.store_log_with("\"PUT /" + name + "/sha256/");
   EXPECT_NE(log.find("\"PUT /" + name + "/sha256/"), std::string::npos) << log;
   const auto t2 = std::chrono::steady_clock::now();
 
@@ -222,7 +233,9 @@ TEST(ShipHttps, ShipsAndReadsBackThroughATlsFrontWithTheLabsCa) {
                                   url + "/v1/blobs/" + sha}, std::chrono::seconds(60));
   EXPECT_EQ(trimmed(fetched.out), "200") << read_all(got).substr(0, 400);
   EXPECT_EQ(fleet::sha256_hex(read_all(got)), sha);
-  EXPECT_NE(front.store_log().find("\"GET /" + name + "/sha256/" + sha), std::string::npos) << "read through the front";
+  EXPECT_NE(front.store_log_with("\"GET /" + name + "/sha256/" + sha).find("\"GET /" + name + "/sha256/" + sha),
+            std::string::npos)
+      << "read through the front";
 
   // Central aimed at the rogue certificate answers with the reason, not with bytes.
   auto [rogue_central, rogue_url] = start_central("central-rogue", front.rogue_endpoint());

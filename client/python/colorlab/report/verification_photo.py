@@ -172,8 +172,12 @@ def load(client, run, items_by_kind) -> dict:
     against = [str(a) for a in (run.doc.get("params") or {}).get("against") or []]
     for rid in against:
         try:
-            kind = dict(client.run(rid)).get("campaign")
-            if kind == "characterize-camera" and "chart" not in out and (
+            doc = dict(client.run(rid))
+            kind = doc.get("campaign")
+            # The overlay's patch grid is the SG's (verification_overlay.SG_COLUMNS × SG_ROWS): a ColorChecker 24
+            # run gets no map over its photograph rather than squares in the wrong places.
+            chart = str((doc.get("params") or {}).get("chart", "sg"))
+            if kind == "characterize-camera" and chart == "sg" and "chart" not in out and (
                     "colour_7_3" in items_by_kind or "colour_7_4" in items_by_kind):
                 photo = chart_photo(client, rid)
                 if photo is not None:
