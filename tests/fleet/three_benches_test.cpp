@@ -95,7 +95,7 @@ json instrument(const Bench& b, const std::string& id) {
   for (const auto& i : b.api->get("/v1/instruments")["items"]) {
     if (i.value("id", "") == id) return i;
   }
-  return {};
+  return json::object();
 }
 
 std::string status_of(const Bench& b, const std::string& execution) {
@@ -185,8 +185,11 @@ TEST(ThreeBenches, CampaignsAtOnceShipIntoOneCatalog) {
   }
   // Each daemon has its own camera, not one absent for want of an address.
   for (auto& b : benches) {
-    auto cam = instrument(b, "genicam");
-    ASSERT_FALSE(cam.is_null()) << b.id << " lists no genicam instrument";
+    json cam;
+    // The daemon connects its instruments after it starts serving: wait for the camera to be ready or absent.
+    wait_until([&] { cam = instrument(b, "genicam"); return cam.value("state", "") == "ready" || cam.value("state", "") == "absent"; },
+               kCampaignBound);
+    ASSERT_FALSE(cam.empty()) << b.id << " lists no genicam instrument: " << b.api->get("/v1/instruments").dump();
     ASSERT_NE(cam.value("state", ""), "absent") << b.id << "'s GigE camera on " << b.address << ": " << cam.dump();
     EXPECT_EQ(cam.value("serial", ""), b.serial) << b.id << " talks to another bench's camera: " << cam.dump();
   }
