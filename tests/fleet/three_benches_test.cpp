@@ -93,13 +93,13 @@ void start_bench(Bench& b, int seed, const ShipTarget& t) {
 
 json instrument(const Bench& b, const std::string& id) {
   for (const auto& i : b.api->get("/v1/instruments")["items"]) {
-    if (i.value("id", "") == id) return i;
+    if (i.value("id", std::string()) == id) return i;
   }
   return json::object();
 }
 
 std::string status_of(const Bench& b, const std::string& execution) {
-  return b.api->get("/v1/executions/" + execution).value("status", "");
+  return b.api->get("/v1/executions/" + execution).value("status", std::string());
 }
 
 bool terminal(const std::string& status) {
@@ -187,11 +187,11 @@ TEST(ThreeBenches, CampaignsAtOnceShipIntoOneCatalog) {
   for (auto& b : benches) {
     json cam;
     // The daemon connects its instruments after it starts serving: wait for the camera to be ready or absent.
-    wait_until([&] { cam = instrument(b, "genicam"); return cam.value("state", "") == "ready" || cam.value("state", "") == "absent"; },
+    wait_until([&] { cam = instrument(b, "genicam"); return cam.value("state", std::string()) == "ready" || cam.value("state", std::string()) == "absent"; },
                kCampaignBound);
     ASSERT_FALSE(cam.empty()) << b.id << " lists no genicam instrument: " << b.api->get("/v1/instruments").dump();
-    ASSERT_NE(cam.value("state", ""), "absent") << b.id << "'s GigE camera on " << b.address << ": " << cam.dump();
-    EXPECT_EQ(cam.value("serial", ""), b.serial) << b.id << " talks to another bench's camera: " << cam.dump();
+    ASSERT_NE(cam.value("state", std::string()), "absent") << b.id << "'s GigE camera on " << b.address << ": " << cam.dump();
+    EXPECT_EQ(cam.value("serial", std::string()), b.serial) << b.id << " talks to another bench's camera: " << cam.dump();
   }
 
   for (auto& b : benches) {
