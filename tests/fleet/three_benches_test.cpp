@@ -92,7 +92,8 @@ void start_bench(Bench& b, int seed, const ShipTarget& t) {
 }
 
 json instrument(const Bench& b, const std::string& id) {
-  for (const auto& i : b.api->get("/v1/instruments")["items"]) {
+  const json all = b.api->get("/v1/instruments");  // held: a range over a temporary's member would dangle
+  for (const auto& i : all["items"]) {
     if (i.value("id", std::string()) == id) return i;
   }
   return json::object();
