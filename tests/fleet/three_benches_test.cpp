@@ -130,14 +130,15 @@ std::int64_t central_count(const std::string& conninfo, const std::string& sql, 
 }
 
 // The bucket's keys under sha256/, listed by curl (an independent S3 client, SigV4-signed). The access key holds a
-// colon, which curl's --user would split at, so the keys go in a netrc file.
+// colon, which curl's --user would split at, so the keys go in a netrc file. curl 7.88 signs the query string as
+// written, so it is written in SigV4's canonical form (parameters sorted, '/' encoded) or Swift answers 403.
 std::vector<std::string> list_blob_keys(const std::string& endpoint, const std::string& bucket, const fs::path& dir) {
   const fs::path netrc = dir / "netrc";
   std::ofstream(netrc) << "machine 127.0.0.1 login " << SwiftServer::kAccessKey << " password "
                        << SwiftServer::kSecretKey << "\n";
   auto r = ct::run_command({"/usr/bin/curl", "-sS", "-f", "--netrc-file", netrc.string(), "--aws-sigv4",
                             "aws:amz:us-east-1:s3", "-H", "x-amz-content-sha256: " + fleet::sha256_hex(""),
-                            endpoint + "/" + bucket + "?prefix=sha256/&max-keys=1000"},
+                            endpoint + "/" + bucket + "?max-keys=1000&prefix=sha256%2F"},
                            std::chrono::seconds(60));
   EXPECT_EQ(r.exit_code, 0) << "listing the bucket with curl: " << r.err << r.out;
   EXPECT_EQ(r.out.find("<IsTruncated>true</IsTruncated>"), std::string::npos)
