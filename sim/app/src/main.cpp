@@ -32,11 +32,15 @@ int main(int argc, char** argv) {
   long long seed = -1;
   std::string control;
   std::string scratch;
+  std::string genicam_address;
   app.add_option("--config", config_file, "lab configuration (TOML); default: every instrument")->check(CLI::ExistingFile);
   app.add_option("--time-scale", time_scale, "simulated seconds per real second (overrides the config)");
   app.add_option("--seed", seed, "random seed (overrides the config)");
   app.add_option("--control", control, "control socket path");
   app.add_option("--scratch-dir", scratch, "where the DSLR's card folder goes when [dslr] capture_dir is not set (default: the temporary directory)");
+  app.add_option("--genicam-address", genicam_address,
+                 "the GigE Vision camera's IPv4 address (overrides [genicam] address; default 127.0.0.1): one fake "
+                 "per address, so each lab on one machine needs its own, held by an interface (docs/simulator.md)");
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -45,6 +49,7 @@ int main(int argc, char** argv) {
     if (seed >= 0) config.seed = static_cast<std::uint64_t>(seed);
     if (!control.empty()) config.control_socket = control;
     if (!scratch.empty()) config.scratch_dir = scratch;
+    if (!genicam_address.empty()) config.genicam.address = genicam_address;
 
     // A simulator killed with SIGKILL leaves its default sockets behind; the next one removes them.
     colorlab::sim::reclaim_dead_sockets(default_control_path().parent_path());

@@ -1,7 +1,10 @@
 #include "colorlab/sim/aravis/gv_fake_camera.hpp"
 
+#include <arpa/inet.h>
 #include <arv.h>
 #include <fcntl.h>
+#include <ifaddrs.h>
+#include <netinet/in.h>
 #include <sys/file.h>
 #include <unistd.h>
 
@@ -30,6 +33,24 @@ std::string_view format_name(std::uint32_t pf) {
     case kMono16: return "Mono16";
     default: return {};
   }
+}
+
+// Aravis binds the fake to an interface found by its address (or name), so an address that is merely routed to
+// loopback (127.0.0.2 on a stock Linux) does not serve; say so before Aravis fails with a bare "could not start".
+// A name such as "lo" is left to Aravis.
+bool is_ipv4_without_interface(const std::string& address) {
+  in_addr wanted{};
+  if (::inet_pton(AF_INET, address.c_str(), &wanted) != 1) return false;
+  ifaddrs* list = nullptr;
+  if (::getifaddrs(&list) != 0) return false;
+  bool found = false;
+  for (auto* i = list; i && !found; i = i->ifa_next) {
+    if (i->ifa_addr && i->ifa_addr->sa_family == AF_INET) {
+      found = reinterpret_cast<const sockaddr_in*>(i->ifa_addr)->sin_addr.s_addr == wanted.s_addr;
+    }
+  }
+  ::freeifaddrs(list);
+  return !found;
 }
 
 }  // namespace
@@ -111,6 +132,12 @@ GvFakeCamera::GvFakeCamera(GvFakeOptions options) : impl_(std::make_unique<Impl>
   if (o.serial.empty() || o.serial.size() > 15) {
     throw Error(ErrorClass::bad_parameter, "GigE Vision serial '" + o.serial + "' must have 1..15 characters",
                 "shorten the serial in the simulator config");
+  }
+  if (is_ipv4_without_interface(o.address)) {
+    throw Error(ErrorClass::bad_parameter,
+                "no network interface has the address " + o.address + " for the GigE Vision fake camera",
+                "give loopback the address first (as root: ip addr add " + o.address +
+                    "/8 dev lo), run the lab in its own network namespace, or use an address this machine has");
   }
   // The fake's sockets use SO_REUSEADDR, so a second fake on the same address would start
   // "successfully" and clients would talk to either. A lock file per address, held for the
