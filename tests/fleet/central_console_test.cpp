@@ -15,6 +15,7 @@
 #include "content_security.hpp"
 #include "fleet_servers.hpp"
 #include "sim_bench.hpp"
+#include "web_tls_servers.hpp"
 
 namespace fs = std::filesystem;
 using namespace colorlab;
@@ -25,15 +26,8 @@ using protocol::ExecutionStatus;
 
 namespace {
 
-SharedServers& servers() {
-  // The same scratch as the other file of this program: the servers start once for both.
-  return shared_servers(fs::path(COLORLAB_BIN_DIR).parent_path() / "tests" / "fleet-web-tls-scratch", "colorlab-web-tls-pg");
-}
+SharedServers& servers() { return web_tls_servers(); }
 
-std::string read_all(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), {}};
-}
 
 // The response headers of one GET with curl (lower-case names), and its status.
 std::map<std::string, std::string> head_of(const std::string& url, int& status) {

@@ -33,10 +33,6 @@ using protocol::ExecutionStatus;
 
 namespace {
 
-std::string read_all(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), {}};
-}
 
 struct Reply {
   int status = 0;

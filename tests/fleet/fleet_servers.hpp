@@ -57,6 +57,12 @@ class SwiftServer {
 // A free TCP port on 127.0.0.1 with `count` consecutive free ports from it.
 int free_port_run(int count);
 
+// Whether a server accepts TCP connections on 127.0.0.1:`port` yet.
+bool accepts(int port);
+
+// A file's bytes ("" when it cannot be read: a log not written yet).
+std::string read_all(const std::filesystem::path& p);
+
 // The PostgreSQL and Swift one fleet test program shares: started on first use (again after a start that failed)
 // with their scratch under `scratch`/<pid> — under the build tree, on disk, since Swift keeps metadata in extended
 // attributes, which tmpfs lacks — and removed at exit with everything the tests put there.

@@ -53,16 +53,6 @@ int port_of(const std::string& text, const std::string& prefix) {
   return std::stoi(text.substr(at + prefix.size()));
 }
 
-bool accepts(int port) {
-  int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_port = htons(static_cast<std::uint16_t>(port));
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  bool ok = ::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
-  ::close(fd);
-  return ok;
-}
 
 // socat relaying 127.0.0.1:listen to 127.0.0.1:upstream, a child per connection. Started through setsid, so
 // cut() kills the whole process group: the listener and every connection it relays, as a cable pulled would.

@@ -20,6 +20,7 @@
 #include "colorlab/testing/process.hpp"
 #include "fleet_servers.hpp"
 #include "sim_bench.hpp"
+#include "web_tls_servers.hpp"
 
 namespace fs = std::filesystem;
 using namespace colorlab;
@@ -30,31 +31,14 @@ using protocol::ExecutionStatus;
 
 namespace {
 
-SharedServers& servers() {
-  // The same scratch as the other file of this program: the servers start once for both.
-  return shared_servers(fs::path(COLORLAB_BIN_DIR).parent_path() / "tests" / "fleet-web-tls-scratch", "colorlab-web-tls-pg");
-}
+SharedServers& servers() { return web_tls_servers(); }
 
-std::string read_all(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), {}};
-}
 
 void sh(const std::string& cmd) {
   auto r = ct::run_command({"/bin/sh", "-c", cmd}, std::chrono::seconds(60));
   if (r.exit_code != 0) throw std::runtime_error(cmd + ": " + r.out + r.err);
 }
 
-bool accepts(int port) {
-  int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_port = htons(static_cast<std::uint16_t>(port));
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  bool ok = ::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
-  ::close(fd);
-  return ok;
-}
 
 // The lab's CA and a server certificate for 127.0.0.1 it signed; an unrelated CA and a certificate for the same
 // address that one signed (what a wrong or intercepted store would present).

@@ -55,10 +55,6 @@ SharedServers& servers() {
   return shared_servers(fs::path(COLORLAB_BIN_DIR).parent_path() / "tests" / "fleet-three-scratch", "colorlab-3b-pg");
 }
 
-std::string read_all(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), {}};
-}
 
 struct Bench {
   std::string id, address, serial;
