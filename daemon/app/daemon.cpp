@@ -5,7 +5,6 @@
 #include <unistd.h>
 
 #include <chrono>
-#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 
@@ -90,13 +89,9 @@ struct AnswerTiming {
   std::chrono::microseconds queue{0}, handler{0}, cpu{0}, store{0}, later{0};
 
   std::string header() const {
-    auto ms = [](std::chrono::microseconds us) {
-      char buf[32];
-      std::snprintf(buf, sizeof buf, "%.2f", static_cast<double>(us.count()) / 1000.0);
-      return std::string(buf);
-    };
-    return "queue;dur=" + ms(queue) + ", handler;dur=" + ms(handler) + ", cpu;dur=" + ms(cpu) +
-           ", store;dur=" + ms(store) + ", later;dur=" + ms(later);
+    return http::server_timing_metric("queue", queue) + ", " + http::server_timing_metric("handler", handler) + ", " +
+           http::server_timing_metric("cpu", cpu) + ", " + http::server_timing_metric("store", store) + ", " +
+           http::server_timing_metric("later", later);
   }
 };
 

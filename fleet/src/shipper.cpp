@@ -1,6 +1,7 @@
 #include "colorlab/fleet/shipper.hpp"
 
 #include <chrono>
+#include <exception>
 #include <optional>
 
 #include <nlohmann/json.hpp>
@@ -390,6 +391,12 @@ CycleReport ship_cycle(const ShipConfig& c) {
     }
     return Next::go_on;
   };
+  // A failure while a transaction's runs are gathered (reading the bench, uploading blobs): the runs gathered
+  // before it still commit, as when each run was its own transaction, then the failure ends the cycle. Returns
+  // only when settling them stopped shipping itself (a divergence, already reported), which ends the cycle instead.
+  auto settle_before_failure = [&](const std::vector<RunBatch>& group, std::exception_ptr failure) {
+    if (group.empty() || settle(group) != Next::stop) std::rethrow_exception(failure);
+  };
 
   Next next = Next::go_on;
   while (budget > 0 && next != Next::stop) {
@@ -413,15 +420,10 @@ CycleReport ship_cycle(const ShipConfig& c) {
           try {
             b = ahead.next();
           } catch (...) {
-            // A run the bench cannot read (e.g. an end event whose run is gone): the runs read before it
-            // still commit, as when each run was its own transaction, so the position stops right at it.
-            if (group.empty()) throw;
-            const auto read_error = std::current_exception();
-            if (settle(group) == Next::stop) {
-              next = Next::stop;
-              break;
-            }
-            std::rethrow_exception(read_error);
+            // A run the bench cannot read (e.g. an end event whose run is gone): the position stops right at it.
+            settle_before_failure(group, std::current_exception());
+            next = Next::stop;
+            break;
           }
         }
         if (!b) break;
@@ -435,15 +437,10 @@ CycleReport ship_cycle(const ShipConfig& c) {
         try {
           report.blobs_uploaded += upload_blobs(s3, files, c, *b);
         } catch (...) {
-          // The store failing mid-transaction: the runs whose blobs are all there still commit, so a store
-          // that fails now and then does not hold back what was ready; then the cycle stops with the store's error.
-          if (group.empty()) throw;
-          const auto store_error = std::current_exception();
-          if (settle(group) == Next::stop) {
-            next = Next::stop;
-            break;
-          }
-          std::rethrow_exception(store_error);
+          // The store failing mid-transaction: a store that fails now and then does not hold back what was ready.
+          settle_before_failure(group, std::current_exception());
+          next = Next::stop;
+          break;
         }
         report.seconds.blobs += since(t);
         measurements += b->measurement_count;

@@ -321,7 +321,7 @@ std::string ms_text(std::chrono::microseconds us) {
 // handler may have named its own parts (colorlabd: queue, handler, cpu, store, later); the server adds `app`, its
 // own measure from the request read to the answer ready to write, which contains them.
 void add_server_timing(HttpResponse& r, std::chrono::microseconds app) {
-  const std::string part = "app;dur=" + ms_text(app);
+  const std::string part = server_timing_metric("app", app);
   auto [it, fresh] = r.headers.try_emplace("Server-Timing", part);
   if (!fresh) it->second += ", " + part;
 }
@@ -331,7 +331,7 @@ void log_slow_answer(const HttpRequest& req, const HttpResponse& r, std::chrono:
   // The path, never the target: a query could carry anything a client put there.
   auto it = r.headers.find("Server-Timing");
   log::warning("http", "slow answer: " + req.method + " " + req.path + " took " + ms_text(total) + " ms: " +
-                           (it == r.headers.end() ? "app;dur=" + ms_text(app) : it->second) + "; writing " +
+                           (it == r.headers.end() ? server_timing_metric("app", app) : it->second) + "; writing " +
                            ms_text(total - app) + " ms");
 }
 
@@ -537,6 +537,10 @@ std::shared_ptr<ssl::context> make_tls_context(const ServerOptions& o) {
 }
 
 }  // namespace
+
+std::string server_timing_metric(const std::string& name, std::chrono::microseconds duration) {
+  return name + ";dur=" + ms_text(duration);
+}
 
 struct Server::Impl {
   explicit Impl(asio::io_context& context) : io(context) {}

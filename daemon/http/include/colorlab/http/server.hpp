@@ -44,6 +44,10 @@ struct ServerOptions {
 
 using AsyncHandler = std::function<boost::asio::awaitable<HttpResponse>(HttpRequest&)>;
 
+// One Server-Timing metric, `name;dur=` in milliseconds with two decimals (https://www.w3.org/TR/server-timing/):
+// how a handler writes its own parts, so they read like the server's `app`.
+std::string server_timing_metric(const std::string& name, std::chrono::microseconds duration);
+
 struct ServerStats {
   unsigned open_connections = 0;
   unsigned long long accepted = 0;
