@@ -161,7 +161,7 @@ TermSet root_polynomial_set(int degree) {
   }
   if (degree >= 4) {
     for (auto e : {std::array<double, 3>{3, 1, 0}, {3, 0, 1}, {1, 3, 0}, {0, 3, 1}, {1, 0, 3}, {0, 1, 3}, {2, 1, 1},
-                   {1, 2, 1}, {1, 1, 2}})
+                   {1, 2, 1}, {1, 1, 2},})
       s.terms.push_back(root(e[0], e[1], e[2]));
   }
   return s;

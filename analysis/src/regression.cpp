@@ -39,7 +39,8 @@ Solution solve(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y, double ridge,
   Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(A);
   qr.setThreshold(1e-12);
   if (qr.rank() < m)
-    throw Error(ErrorClass::bad_data, what + ": design of " + std::to_string(n) + " patches x " + std::to_string(m) +
+    throw Error(ErrorClass::bad_data,
+                what + ": design of " + std::to_string(n) + " patches x " + std::to_string(m) +
                                           " terms has rank " + std::to_string(qr.rank()) + " (rank-deficient)",
                 "use fewer terms, more (distinct) patches, or ridge");
   Solution s;

@@ -176,7 +176,8 @@ FitWithHat SplineFitter::fit(const ChartData& train, const SplineOptions& o) {
   Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(P);
   qr.setThreshold(1e-10);
   if (P.cols() >= n || qr.rank() < P.cols())
-    throw Error(ErrorClass::bad_data, model.method_ + ": " + std::to_string(n) + " patches cannot determine the base's " +
+    throw Error(ErrorClass::bad_data,
+                model.method_ + ": " + std::to_string(n) + " patches cannot determine the base's " +
                                           std::to_string(P.cols()) + " terms (rank " + std::to_string(qr.rank()) + ")",
                 "use a smaller base (rbf:ccm) or more distinct patches");
   const Eigen::VectorXd w = target_weights(train, o.target);

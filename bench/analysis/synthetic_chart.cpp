@@ -19,7 +19,8 @@ ca::ChartData render_chart(const ca::SpectralSet& refl, const ca::SpectralSet& l
   const auto grid = ca::uniform_grid(curves.wavelengths.front(), curves.wavelengths.back(), 1.0);
   // Reflectances are smooth (Sprague, CIE 167); lamps may have lines and camera curves steep edges: linear for both,
   // so neither invents overshoot. Fluorescent lamps come at 5 nm from colord, so their lines survive.
-  const ca::SpectralSet r = ca::resample(refl, grid, ca::sprague_applicable(refl.wavelengths) ? ca::Interpolation::sprague
+  const ca::SpectralSet r = ca::resample(refl, grid,
+                                         ca::sprague_applicable(refl.wavelengths) ? ca::Interpolation::sprague
                                                                                              : ca::Interpolation::cubic_spline);
   const ca::SpectralSet l = ca::resample(lamp, grid, ca::Interpolation::linear);
   const ca::SpectralSet s = ca::resample(curves, grid, ca::Interpolation::linear);

@@ -128,7 +128,7 @@ void BM_Ls110Step_Direct(benchmark::State& state) {
         json result{{"luminance", r.luminance}, {"unit", r.unit}, {"instrument", b.meter->id()}, {"raw", r.raw_reply}};
         pending.journal.push_back({i, "meter.measure", json::array(), result});
         pending.measurements.push_back({"reading/" + std::to_string(i), b.meter->id(), true, "luminance", r.luminance, r.unit,
-                                        {{"raw", r.raw_reply}}});
+                                        {{"raw", r.raw_reply}},});
         pending.progress = static_cast<double>(i) / kReadings;
         pending.label = "reading/" + std::to_string(i);
       }

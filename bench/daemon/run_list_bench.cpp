@@ -102,7 +102,7 @@ void before(benchmark::State& state, const std::string& campaign) {
     json items = json::array();
     while (sqlite3_step(st) == SQLITE_ROW) {
       items.push_back({{"id", text(1)}, {"campaign", text(2)}, {"params", json::parse(text(3))}, {"status", text(4)},
-                       {"instruments", json::parse(text(6))}, {"summary", json::parse(text(10))}});
+                       {"instruments", json::parse(text(6))}, {"summary", json::parse(text(10))},});
     }
     sqlite3_reset(st);
     bytes = json{{"items", items}}.dump().size();

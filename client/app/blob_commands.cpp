@@ -84,7 +84,7 @@ void add_blob_commands(CLI::App& app, GlobalOptions& global) {
     write_bytes(path, r.body);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     json done{{"path", fs::absolute(path).string()}, {"bytes", r.body.size()}, {"sha256", *sha}, {"preview", *preview},
-              {"seconds", seconds}};
+              {"seconds", seconds},};
     print(global, done, [](const json& j) {
       return "wrote " + j["path"].get<std::string>() + " (" + std::to_string(j["bytes"].get<std::size_t>()) + " bytes)\n";
     });

@@ -153,7 +153,8 @@ std::string format_run(const json& r) {
   o << "run " << str(r, "id") << "\n"
     << "  campaign   " << str(r, "campaign") << "  params " << r["params"].dump() << "\n"
     << "  status     " << str(r, "status") << "\n"
-    << "  data       " << (r.value("simulated", false) ? "SIMULATED instruments (not a measurement of the real lab)"
+    << "  data       "
+    << (r.value("simulated", false) ? "SIMULATED instruments (not a measurement of the real lab)"
                                                          : "real instruments")
     << "\n"
     << "  created    " << str(r, "created_at") << "\n"

@@ -35,7 +35,7 @@ nlohmann::json to_json(const colorlab::fleet::CycleReport& r) {
           {"divergences", d},                     {"superseded", s},
           {"transactions", r.transactions},
           {"seconds", {{"read", r.seconds.read}, {"read_wait", r.seconds.read_wait}, {"blobs", r.seconds.blobs}, {"copy", r.seconds.copy},
-                       {"merge", r.seconds.merge}, {"digest", r.seconds.digest}, {"commit", r.seconds.commit}}}};
+                       {"merge", r.seconds.merge}, {"digest", r.seconds.digest}, {"commit", r.seconds.commit},}},};
 }
 
 // One cycle, its outcome noted in <state_dir>/ship/status.json for the bench to show (GET /v1/shipping).
@@ -89,7 +89,7 @@ int main(int argc, char** argv) {
       std::cout << nlohmann::json{{"name", r.name}, {"database_key", r.database_key},
                                   {"database_bytes", r.database_bytes}, {"last_event", r.last_event},
                                   {"runs", r.runs}, {"blobs", r.blobs}, {"blobs_uploaded", r.blobs_uploaded},
-                                  {"blobs_missing", r.blobs_missing}, {"rotated_out", r.rotated_out}}
+                                  {"blobs_missing", r.blobs_missing}, {"rotated_out", r.rotated_out},}
                        .dump()
                 << std::endl;
       return 0;
@@ -98,7 +98,7 @@ int main(int argc, char** argv) {
       auto r = colorlab::fleet::restore(config, snapshot, into.empty() ? config.state_dir : std::filesystem::path(into));
       std::cout << nlohmann::json{{"name", r.name}, {"state_dir", r.state_dir.string()}, {"epoch", r.epoch},
                                   {"next_event", r.next_event}, {"last_event", r.last_event}, {"runs", r.runs},
-                                  {"blobs_restored", r.blobs_restored}, {"blobs_missing", r.blobs_missing}}
+                                  {"blobs_restored", r.blobs_restored}, {"blobs_missing", r.blobs_missing},}
                        .dump()
                 << std::endl;
       return 0;

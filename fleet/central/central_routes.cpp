@@ -79,7 +79,7 @@ HttpResponse get_root(CentralContext& ctx, const HttpRequest&, const PathParams&
                                   {"read_only", true},
                                   {"features", features},
                                   {"limits", {{"max_request_body", protocol::kMaxRequestBody},
-                                              {"max_page_limit", protocol::kMaxPageLimit}}}});
+                                              {"max_page_limit", protocol::kMaxPageLimit},}}});
 }
 
 HttpResponse get_benches(CentralContext& ctx, const HttpRequest&, const PathParams&) {
@@ -116,7 +116,7 @@ HttpResponse get_runs(CentralContext& ctx, const HttpRequest& req, const PathPar
   }
   return keep_answer(ctx, req, key, validator,
                      {{"items", items}, {"links", {{"next", next}}},
-                      {"next_cursor", page.next_cursor ? json(*page.next_cursor) : json(nullptr)}});
+                      {"next_cursor", page.next_cursor ? json(*page.next_cursor) : json(nullptr)},});
 }
 
 // The bench's run document plus `bench`; no report link: reports are made on a bench.

@@ -134,7 +134,7 @@ bool commit_superseded(Pg& pg, const ShipConfig& c, const RunBatch& b, std::int6
               " FROM stage_events ON CONFLICT (" + kStaged[5].key + ") DO NOTHING");
     }
     nlohmann::json detail{{"bench_digest", d.bench_digest}, {"central_digest", d.central_digest},
-                          {"bench_ended_event", b.run.ended_event}};
+                          {"bench_ended_event", b.run.ended_event},};
     pg.query("INSERT INTO ship_problems (bench_id, run_id, kind, detail) VALUES ($1, $2, 'superseded_by_restore', $3)",
              {c.bench_id, d.run_id, detail.dump()});
     pg.query("UPDATE benches SET shipped_position = $2, last_seen = now() WHERE id = $1",
@@ -302,7 +302,8 @@ int upload_blobs(S3Client& s3, store::BlobStore& files, const ShipConfig& c, con
     if (s3.exists(key)) continue;
     const auto path = files.path_of(blob.sha256);
     if (!std::filesystem::exists(path)) {
-      throw Error(ErrorClass::io_error, "run " + b.run.run_id + " references blob " + blob.sha256 +
+      throw Error(ErrorClass::io_error,
+                  "run " + b.run.run_id + " references blob " + blob.sha256 +
                                             ", whose file is missing from " + c.blob_root().string(),
                   "colorlab blobs check; shipping cannot pass this run until the file is restored");
     }

@@ -40,7 +40,8 @@ ReportService::State wait_until_not_generating(ReportService& reports, const std
 TEST(ReportService, MadeOnceThenServedFromTheFile) {
   TempDir dir;
   // Counts its runs, writes the HTML where -o says.
-  const auto python = stand_in(dir, "python", "echo run >> \"" + (dir / "count").string() +
+  const auto python = stand_in(dir, "python",
+                               "echo run >> \"" + (dir / "count").string() +
                                                    "\"\nwhile [ \"$1\" != -o ]; do shift; done\necho '<html>' $2 > \"$2\"");
   ReportService reports({dir / "reports", dir / "sock", python, "v1"});
   EXPECT_EQ(reports.request("run-a").kind, Kind::generating);

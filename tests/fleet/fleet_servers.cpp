@@ -148,7 +148,7 @@ void PostgresServer::start() {
 void PostgresServer::stop_immediate() {
   auto r = testing::run_command(
       {"/bin/sh", "-c", as_owner(std::string(kPgBin) + "/pg_ctl -D " + quote(dir_ / "data") + " -m immediate -w stop") +
-                            " 2>&1"},
+                            " 2>&1",},
       std::chrono::seconds(60));
   if (r.exit_code != 0) throw std::runtime_error("pg_ctl stop failed: " + r.out + r.err);
 }

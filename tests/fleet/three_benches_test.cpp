@@ -253,7 +253,8 @@ TEST(ThreeBenches, CampaignsAtOnceShipIntoOneCatalog) {
     for (const auto& r : reader.ended_after(0, 1000000)) last_end[b.id] = std::max(last_end[b.id], r.ended_event);
     ASSERT_TRUE(wait_until(
         [&] {
-          return central_count(target.postgres, "SELECT count(*) FROM benches WHERE id = $1 AND shipped_position >= " +
+          return central_count(target.postgres,
+                               "SELECT count(*) FROM benches WHERE id = $1 AND shipped_position >= " +
                                                     std::to_string(last_end[b.id]),
                                b.id) == 1;
         },
@@ -327,7 +328,7 @@ TEST(ThreeBenches, CampaignsAtOnceShipIntoOneCatalog) {
   const std::vector<std::pair<std::string, std::string>> keys = {
       {"runs", "id"},         {"executions", "id"},           {"measurements", "(run_id, step)"},
       {"blobs", "sha256"},    {"run_blobs", "(run_id, name)"}, {"events", "(bench_id, seq)"},
-      {"benches", "id"}};
+      {"benches", "id"},};
   for (const auto& [table, key] : keys) {
     auto c = pg.query("SELECT count(*), count(DISTINCT " + key + ") FROM " + table);
     EXPECT_EQ(c.int64(0, 0), c.int64(0, 1)) << table << ": rows differ from distinct " << key;

@@ -271,7 +271,7 @@ TEST(CrashLoopGuard, SuspendsBacksOffRetriesByItselfAndTheRunCompletes) {
     const auto& p = ev["payload"];
     if (p.value("status", "") == "suspended" && p.contains("suspension") && p["suspension"]["category"] == "crash-loop") {
       steps.push_back({{"suspended", p["suspension"]["retry"]}, {"backoff_s", p["suspension"]["backoff_s"]},
-                       {"retry_at", p["suspension"]["retry_at"]}, {"reason", p["reason"]}});
+                       {"retry_at", p["suspension"]["retry_at"]}, {"reason", p["reason"]},});
     } else if (p.contains("resumed_by")) {
       steps.push_back({{"retried_by", p["resumed_by"]["by"]}, {"retry", p["resumed_by"]["retry"]}});
     } else if (p.value("status", "") == "finished_error" || p.value("status", "") == "aborted") {

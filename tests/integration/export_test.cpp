@@ -44,7 +44,7 @@ struct Lab {
     chart_read = run_to_end(*api, "chart-read", json::object());
     characterization = run_to_end(*api, "characterize-camera",
                                   {{"reference_run", chart_read["id"]}, {"frames", 1}, {"formats", {"raw"}},
-                                   {"prior_exclude", {"Canon_20D"}}},
+                                   {"prior_exclude", {"Canon_20D"}},},
                                   std::chrono::seconds(300));
     spot = run_to_end(*api, "luminance-spot", {{"readings", 3}});
   }

@@ -296,7 +296,7 @@ TEST_F(LocateChartApi, TheCliPrintsWhatAnalyzeLocateChartPrintsForTheSameMosaic)
 TEST_F(LocateChartApi, CharacterizeCameraRefusesADarkPhotographWithTheBlobAndCommandThenTakesTheCorners) {
   auto a = api();
   const json params{{"reference_run", *reference_}, {"frames", 2}, {"formats", {"raw"}}, {"lamp", ""}, {"keep", json::array()},
-                    {"prior_exclude", {"Canon_20D"}}};
+                    {"prior_exclude", {"Canon_20D"}},};
   // In the dark: refused. The run fails as needing a person, its hint naming the kept photograph and the commands.
   control({{"cmd", "lamp"}, {"lamp", "D65"}, {"on", false}});
   auto started = a.post("/v1/executions", {{"campaign", "characterize-camera"}, {"params", params}});

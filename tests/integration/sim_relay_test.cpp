@@ -94,7 +94,7 @@ TEST(SimRelay, AStuckRelayAndAnUnpluggedBoardAreTypedErrors) {
 
   // Unplugged, found again on the second open: the driver's reconnect gets there by itself.
   rig.sim.control({{"cmd", "fault"}, {"instrument", "relay"},
-                   {"faults", {{"stuck_mask", 0}, {"unplugged", true}, {"replug_after_opens", 2}}}});
+                   {"faults", {{"stuck_mask", 0}, {"unplugged", true}, {"replug_after_opens", 2}}},});
   run(rig.io, rig.relay->set_lamps({"A"}));
   EXPECT_EQ(scene_lamps(rig.sim), std::vector<std::string>{"A"});
 

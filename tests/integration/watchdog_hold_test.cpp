@@ -90,7 +90,7 @@ TEST(WatchdogWhileHeld, PingsGoOnWhileACommitIsHeldInItsSyncAndWhileAFitIsHeldOn
   std::unique_ptr<DaemonProcess> daemon;
   {
     ScopedEnv env{{"NOTIFY_SOCKET", systemd.path().string()}, {"WATCHDOG_USEC", "400000"},
-                  {"COLORLAB_TEST_WORKER_LATCH", latch.string()}};
+                  {"COLORLAB_TEST_WORKER_LATCH", latch.string()},};
     daemon = faults.start(write_daemon_config(dir.path(), 100, 3));
   }
   auto api = api_for(*daemon);

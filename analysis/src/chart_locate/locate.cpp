@@ -215,7 +215,8 @@ ChartLocation locate_chart(const PhotoView& photo, ChartType type, const LocateO
     const int min_cells = std::max(6, L.size() / 4);
     auto lat = build_lattice(quads, centres, min_cells);
     if (!lat)
-      throw Error(ErrorClass::not_found, "no " + grid_name(L) + " found in the photo: " + std::to_string(quads.size()) +
+      throw Error(ErrorClass::not_found,
+                  "no " + grid_name(L) + " found in the photo: " + std::to_string(quads.size()) +
                                              " patch-like squares, no grid of " + std::to_string(min_cells) + " or more",
                   kCornersHint);
     auto choices = placements(L, *lat);
@@ -251,7 +252,8 @@ ChartLocation locate_chart(const PhotoView& photo, ChartType type, const LocateO
   lower(conf, clamp01((coverage - 0.3) / 0.3), "only " + std::to_string(loc.patches_detected) + " of " + std::to_string(L.size()) + " patches were seen");
   if (pitch_px > 0) {
     const double rel = loc.reprojection_rms_px / pitch_px;
-    lower(conf, clamp01(1 - (rel - 0.04) / 0.08), "the patches do not sit on a flat grid (rms " + std::to_string(loc.reprojection_rms_px) +
+    lower(conf, clamp01(1 - (rel - 0.04) / 0.08),
+          "the patches do not sit on a flat grid (rms " + std::to_string(loc.reprojection_rms_px) +
                                                      " px); is the lens distortion uncorrected?");
   }
   for (const auto& block : undetected_blocks(L, detected)) {
@@ -263,7 +265,8 @@ ChartLocation locate_chart(const PhotoView& photo, ChartType type, const LocateO
                           "): too close to the surround's luminance for an edge, not covered");
       continue;
     }
-    lower(conf, 0.1, "patches " + names + " show no edges of their own: is the chart partly covered?" +
+    lower(conf, 0.1,
+          "patches " + names + " show no edges of their own: is the chart partly covered?" +
                          (why.empty() ? std::string() : " (" + why + ")"));
     break;
   }
@@ -286,7 +289,8 @@ ChartLocation locate_chart(const PhotoView& photo, ChartType type, const LocateO
   else if (!L.neutral_ramp.empty()) loc.check = check_neutral_ramp(L, loc.patches, photo.black_level);
   else loc.check.method = "none";
   if (!loc.check.passed)
-    lower(conf, 0.2, "the chart's own neutrals disagree (" + loc.check.method + ", worst at " + loc.check.worst_patch + ": " +
+    lower(conf, 0.2,
+          "the chart's own neutrals disagree (" + loc.check.method + ", worst at " + loc.check.worst_patch + ": " +
                          std::to_string(loc.check.worst_disagreement * 100) + " %): the grid is misplaced or the chart is covered");
   loc.confidence = conf.value;
   if (conf.value < 1) loc.notes.push_back("confidence limited by: " + conf.why);

@@ -106,7 +106,7 @@ json to_json(const Run& r) {
   json j{{"client", r.client},       {"done", r.done},         {"why", r.why},
          {"load_before", r.load_before}, {"load_after", r.load_after}, {"init_s", r.init},
          {"locate_s", r.locate},     {"read_s", r.read},       {"total_s", r.total()},
-         {"baud", r.baud},           {"sim_lines_answered", r.sim_lines}, {"sim_measurements", r.sim_measurements}};
+         {"baud", r.baud},           {"sim_lines_answered", r.sim_lines}, {"sim_measurements", r.sim_measurements},};
   if (r.client == "colorlab") {
     j["calibrations"] = r.calibrations;
     j["device_per_patch_s"] = r.device_per_patch;

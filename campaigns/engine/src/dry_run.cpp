@@ -139,7 +139,8 @@ class DryRun final : public LabCallSink {
     sandbox_->reset_budget();
     if (kind_of(call) == CallKind::control) return 0;
     if (++calls_ > static_cast<std::int64_t>(setup_.max_calls)) {
-      return stop_at(call, "script", "the dry run stopped after " + std::to_string(setup_.max_calls) +
+      return stop_at(call, "script",
+                     "the dry run stopped after " + std::to_string(setup_.max_calls) +
                                          " lab calls: the script may wait for a reading the dry run cannot predict");
     }
     const std::string role = DryLab::role_of(call);
@@ -213,7 +214,7 @@ class DryRun final : public LabCallSink {
     if (a.is_null()) {
       action_order_.push_back(r.action);
       a = json{{"action", r.action}, {"prompt", r.prompt}, {"count", 0}, {"options", r.options},
-               {"default", r.default_option}, {"timeout_s", r.timeout_s}, {"by", person ? "operator" : "simulated lab"}};
+               {"default", r.default_option}, {"timeout_s", r.timeout_s}, {"by", person ? "operator" : "simulated lab"},};
     }
     a["count"] = a["count"].get<int>() + 1;
   }
@@ -315,7 +316,8 @@ class DryRun final : public LabCallSink {
   LuaSandbox* sandbox_ = nullptr;  // while run_script runs
   lua_State* thread_ = nullptr;
   std::optional<std::pair<std::string, json>> requested_;  // the lab call the script yielded with
-  HandedComputation handed_;  // a computation the script handed over, for setup_.compute to run
+  // a computation the script handed over, for setup_.compute to run
+  HandedComputation handed_;
 
   TimingKeys keys_;
   std::vector<DryProblem> problems_;

@@ -75,7 +75,7 @@ LuaSandbox::LuaSandbox(std::string script_name, ScriptLimits limits, std::uint64
   *static_cast<LuaSandbox**>(lua_getextraspace(L_)) = this;
   const luaL_Reg libs[] = {{LUA_GNAME, luaopen_base},        {LUA_TABLIBNAME, luaopen_table},
                            {LUA_STRLIBNAME, luaopen_string}, {LUA_MATHLIBNAME, luaopen_math},
-                           {LUA_UTF8LIBNAME, luaopen_utf8},  {LUA_COLIBNAME, luaopen_coroutine}};
+                           {LUA_UTF8LIBNAME, luaopen_utf8},  {LUA_COLIBNAME, luaopen_coroutine},};
   for (const auto& lib : libs) {
     luaL_requiref(L_, lib.name, lib.func, 1);
     lua_pop(L_, 1);

@@ -45,7 +45,7 @@ json CampaignSequence::to_json() const {
   for (const auto& s : steps) steps_json.push_back(s.to_json());
   return {{"name", name},       {"kind", "sequence"},  {"description", description}, {"origin", origin},
           {"sha256", sha256},   {"path", path.string()}, {"steps", steps_json},       {"small", small},
-          {"needs", json::array()}, {"parameters", json::object()}};
+          {"needs", json::array()}, {"parameters", json::object()},};
 }
 
 std::vector<SequenceStep> CampaignSequence::expand(bool use_small, const json& overrides) const {

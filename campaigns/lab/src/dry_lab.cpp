@@ -104,12 +104,12 @@ json DryLab::answer(const std::string& call, const json& args, double lab_now_s,
 
 json DryLab::call_meter_measure(const json&, DryContext&) {
   return json{{"luminance", state_.dimmer_percent.value_or(100.0)}, {"unit", "cd/m2"}, {"instrument", id_for("luminance_meter")},
-              {"raw", "dry run"}};
+              {"raw", "dry run"},};
 }
 
 json DryLab::call_wait_stable(const json&, DryContext&) {
   return json{{"luminance", state_.dimmer_percent.value_or(100.0)}, {"unit", "cd/m2"}, {"instrument", id_for("luminance_meter")},
-              {"drift_pct", 0.0}, {"readings", 0}, {"waited_s", 0.0}};
+              {"drift_pct", 0.0}, {"readings", 0}, {"waited_s", 0.0},};
 }
 
 json DryLab::lamps_lit(std::vector<std::string> on, DryContext& context) const {
@@ -191,7 +191,7 @@ json DryLab::call_camera_capture(const json& args, DryContext&) {
     for (const char* c : {"R", "G", "B"}) rows.push_back({{"frames", n}, {"channel", c}, {"stdev", 8.0 / std::sqrt(n)}});
   }
   return json{{"frames", frames}, {"region", {0, 0, 32, 32}}, {"rows", rows}, {"instrument", id_for("camera")},
-              {"unit", "DN above black"}};
+              {"unit", "DN above black"},};
 }
 
 json DryLab::call_camera_photograph_chart(const json& args, DryContext&) {
@@ -210,7 +210,7 @@ json DryLab::call_camera_photograph_chart(const json& args, DryContext&) {
     }
   }
   json out = json{{"instrument", id_for("camera")}, {"chart", o.value("chart", std::string("sg"))}, {"frames", frames},
-                  {"formats", json::object()}};
+                  {"formats", json::object()},};
   for (const auto& f : formats) {
     const std::string format = f.get<std::string>();
     json values = json::array();
@@ -224,7 +224,7 @@ json DryLab::call_camera_photograph_chart(const json& args, DryContext&) {
                                   {"check", json::object()}, {"frames", frames}, {"files", json::array()},
                                   {"width", 0}, {"height", 0}, {"notes", {"dry run: values from the reference"}},
                                   {"ids", ids}, {"values", values},
-                                  {"detected", std::vector<bool>(ids.size(), true)}};
+                                  {"detected", std::vector<bool>(ids.size(), true)},};
   }
   return out;
 }

@@ -96,7 +96,7 @@ double quantile(std::vector<double> v, double q) {
 
 json stats_json(const ca::ErrorStats& e) {
   return json{{"mean", e.s00.mean}, {"median", e.s00.median}, {"p95", quantile(e.de00, 0.95)},
-              {"max", e.s00.max},   {"mean_de76", e.s76.mean}, {"max_de76", e.s76.max}};
+              {"max", e.s00.max},   {"mean_de76", e.s76.mean}, {"max_de76", e.s76.max},};
 }
 
 Eigen::MatrixXd lab_rows(const std::vector<ca::Lab>& lab) {
@@ -116,7 +116,7 @@ json camera_colour_space(const ca::ChartData& d, double full_scale, ca::RgbSpace
   auto e = ca::evaluate(lab_rows(ca::rgb_to_lab_d50(space, rgb)), d.lab);
   json s = stats_json(e);
   return json{{"training", s}, {"cv", s}, {"fitted", false},
-              {"colour_space", space == ca::RgbSpace::srgb ? "srgb" : "adobe_rgb"}};
+              {"colour_space", space == ca::RgbSpace::srgb ? "srgb" : "adobe_rgb"},};
 }
 
 // Which patches each fold holds out: every patch alone (LOO) or every k-th (k-fold, interleaved so
@@ -148,7 +148,7 @@ json icc_profile(const ca::ChartData& d, double gamma, const ca::CvSpec& cv) {
   }
   auto cross = ca::evaluate(predicted, d.lab);
   return json{{"training", stats_json(training)}, {"cv", stats_json(cross)}, {"fitted", true}, {"gamma", gamma},
-              {"kind", "matrix/shaper"}};
+              {"kind", "matrix/shaper"},};
 }
 
 json matrix_json(const Eigen::MatrixXd& m) {
@@ -170,7 +170,7 @@ json adapted_mapping(const ca::ChartData& d, const ca::CvSpec& cv, double tolera
   for (const auto& c : s.candidates) {
     if (c.rank_deficient) continue;
     candidates.push_back({{"method", c.method}, {"target", ca::to_string(c.target)}, {"parameters", c.parameters},
-                          {"training_mean", c.training.s00.mean}, {"cv_mean", c.cv.s00.mean}});
+                          {"training_mean", c.training.s00.mean}, {"cv_mean", c.cv.s00.mean},});
   }
   ca::FitOptions fo;
   fo.target = chosen.target;
@@ -339,7 +339,7 @@ json residual_table(const Eigen::MatrixXd& residuals, double full_scale) {
     const ca::Summary sum = ca::summarize(a);
     out[std::string(1, "RGB"[c])] = {{"min", sum.min}, {"mean", sum.mean}, {"median", sum.median}, {"max", sum.max},
                                      {"stdev", sum.stdev}, {"min_pct", 100 * sum.min / full_scale},
-                                     {"mean_pct", 100 * sum.mean / full_scale}, {"max_pct", 100 * sum.max / full_scale}};
+                                     {"mean_pct", 100 * sum.mean / full_scale}, {"max_pct", 100 * sum.max / full_scale},};
   }
   return out;
 }
@@ -421,7 +421,7 @@ json black_box(const ca::ChartData& d, const BlackBoxSetup& s, const std::string
   }
   json regularisation = model.with_prior
                             ? json{{"kind", "prior from other cameras' measured curves"}, {"source", s.prior_source},
-                                   {"cameras", s.prior->cameras}, {"excluded", s.prior_excluded}, {"lambda", model.lambda}}
+                                   {"cameras", s.prior->cameras}, {"excluded", s.prior_excluded}, {"lambda", model.lambda},}
                             : json{{"kind", "second-difference smoothness, weight by GCV"}, {"lambda", model.lambda}};
   return json{{"training", stats_json(training)},
               {"cv", stats_json(cross)},
@@ -436,7 +436,7 @@ json black_box(const ca::ChartData& d, const BlackBoxSetup& s, const std::string
               {"residuals", {{"unit", "counts"}, {"training", residual_table(predicted - d.rgb, full_scale)},
                              {"cv", residual_table(held_counts - d.rgb, full_scale)},
                              {"patches", {{"training", residual_patches(d.ids, predicted - d.rgb)},
-                                          {"cv", residual_patches(d.ids, held_counts - d.rgb)}}}}},
+                                          {"cv", residual_patches(d.ids, held_counts - d.rgb)},}},}},
               {"regularisation", regularisation},
               {"sensitivities", curves}};
 }
@@ -498,7 +498,7 @@ json characterize(const json& camera, const json& reference, const json& options
   }
   return json{{"format", format},     {"patches", d.size()},   {"cv", cv.name()},
               {"approaches", approaches}, {"best_approach", best}, {"selected", selected},
-              {"not_fitted", not_fitted}, {"unit", "ΔE00"}, {"across_lamps", across_lamps}};
+              {"not_fitted", not_fitted}, {"unit", "ΔE00"}, {"across_lamps", across_lamps},};
 }
 
 json characterize_black_box(const json& camera, const json& reference, const json& options) {

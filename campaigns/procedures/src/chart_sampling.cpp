@@ -23,7 +23,8 @@ class Summer {
       first_ = {p.width, p.height, p.channels, p.type, {}};
       sum_.assign(static_cast<std::size_t>(p.width) * p.height * p.channels, 0);
     } else if (p.width != first_.width || p.height != first_.height || p.channels != first_.channels || p.type != first_.type) {
-      throw Error(ErrorClass::bad_data, path.filename().string() + " is not the same kind of image as " +
+      throw Error(ErrorClass::bad_data,
+                  path.filename().string() + " is not the same kind of image as " +
                                             std::filesystem::path(out_.files.front()).filename().string() +
                                             " (size, channels or bit depth differ within one series)",
                   "the camera's settings changed during the series: photograph the chart again");
@@ -85,7 +86,7 @@ namespace {
 // What every answer about one format's photograph starts with, located or refused.
 json photograph_fields(const AveragedPhoto& a) {
   return json{{"format", a.format}, {"frames", a.frames}, {"files", a.files},
-              {"width", a.photo.width}, {"height", a.photo.height}, {"bits", a.bits}};
+              {"width", a.photo.width}, {"height", a.photo.height}, {"bits", a.bits},};
 }
 
 }  // namespace
@@ -147,7 +148,7 @@ json locate_and_sample(const AveragedPhoto& a, const SamplingOptions& options) {
                                  {"worst_disagreement", loc.check.worst_disagreement},
                                  {"worst_patch", loc.check.worst_patch},
                                  {"gradient_x", loc.check.gradient_x},
-                                 {"gradient_y", loc.check.gradient_y}}},
+                                 {"gradient_y", loc.check.gradient_y},}},
                       {"ids", ids},
                       {"values", values},
                       {"detected", detected},

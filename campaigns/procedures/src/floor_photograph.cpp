@@ -152,7 +152,7 @@ void plan_spots(FloorSeries& s, const FloorOptions& p, const cam::RawImage& imag
 
 json spot_json(const Spot& spot, const std::array<double, 2>& px, std::size_t pixels) {
   return {{"row", spot.row}, {"col", spot.col}, {"x_mm", spot.x_mm}, {"y_mm", spot.y_mm}, {"px", {px[0], px[1]}},
-          {"pixels", pixels}, {"signal", json::array()}, {"stdev", json::array()}};
+          {"pixels", pixels}, {"signal", json::array()}, {"stdev", json::array()},};
 }
 
 }  // namespace
@@ -214,7 +214,7 @@ boost::asio::awaitable<json> photograph_floor(cam::CameraInstrument& instrument,
   for (const auto& c : s.corners) corners.push_back({c[0], c[1]});
   co_return json{{"instrument", instrument.id()}, {"frames", p.frames}, {"width", s.width}, {"height", s.height},
                  {"corners_px", corners}, {"spot_mm", p.spot_mm}, {"subsets", p.subsets},
-                 {"unit", "DN above black (green)"}, {"spots", spots}, {"blobs", blobs}};
+                 {"unit", "DN above black (green)"}, {"spots", spots}, {"blobs", blobs},};
 }
 
 json dry_floor_photograph(const json& options, const std::string& instrument) {
@@ -235,7 +235,7 @@ json dry_floor_photograph(const json& options, const std::string& instrument) {
   for (const auto& q : c) corners.push_back({q[0], q[1]});
   return json{{"instrument", instrument}, {"frames", p.frames}, {"width", kWidth}, {"height", kHeight},
               {"corners_px", corners}, {"spot_mm", p.spot_mm}, {"subsets", p.subsets},
-              {"unit", "DN above black (green)"}, {"spots", spots}, {"blobs", json::array()}};
+              {"unit", "DN above black (green)"}, {"spots", spots}, {"blobs", json::array()},};
 }
 
 }  // namespace colorlab::campaigns

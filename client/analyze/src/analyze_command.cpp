@@ -182,7 +182,7 @@ void run_fit(const FitCliOptions& o) {
   fo.target = parse_target(o.target);
   const ca::CvSpec cv = ca::CvSpec::parse(o.cv);
   Table fits{"fits", {"method", "terms", "target", "train_dE76_mean", "train_dE00_mean", "train_dE00_max", "cv_dE76_mean",
-                      "cv_dE00_mean", "cv_dE00_max", "cv", "parameters"}, {}};
+                      "cv_dE00_mean", "cv_dE00_max", "cv", "parameters",}, {}};
   // Splines (rbf:<term set>) are candidates of `auto` beside every polynomial; selection compares effective parameters.
   std::string chosen = o.method;
   if (o.method == "auto") {
@@ -197,7 +197,7 @@ void run_fit(const FitCliOptions& o) {
   const auto model = ca::fit_method(chosen, train, fo);
   const double terms = model.spline() ? double(model.spline()->base_terms()) : double(ca::term_set_by_name(chosen).size());
   Table model_t{"model", {"method", "terms", "target", "input_scale", "description"},
-                {{chosen, terms, ca::to_string(fo.target), model.input_scale(), model.describe()}}};
+                {{chosen, terms, ca::to_string(fo.target), model.input_scale(), model.describe()}},};
   std::vector<Table> out{fits, model_t};
   if (!o.test.empty()) {
     ca::ChartData test = ca::read_chart(o.test);
@@ -245,7 +245,7 @@ void run_uniformity(const UniformityCliOptions& o) {
     windows.rows.push_back(std::move(r));
   }
   Table best{"placement", {"min", "max", "range", "best_row", "best_col", "best_stdev"},
-             {{res.min, res.max, res.max - res.min, double(res.best.row), double(res.best.col), res.best.stdev}}};
+             {{res.min, res.max, res.max - res.min, double(res.best.row), double(res.best.col), res.best.stdev}},};
   std::vector<Table> out{windows, best};
   if (!o.full.empty()) {
     if (!(o.setting > 0)) throw Error(ErrorClass::bad_parameter, "--full needs --setting (e.g. 0.5 for 50 %)");

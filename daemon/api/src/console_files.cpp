@@ -30,7 +30,7 @@ std::string content_type_of(const fs::path& file) {
       {".css", "text/css; charset=utf-8"},    {".svg", "image/svg+xml"},
       {".png", "image/png"},                  {".ico", "image/x-icon"},
       {".json", "application/json"},          {".webmanifest", "application/manifest+json"},
-      {".txt", "text/plain; charset=utf-8"}};
+      {".txt", "text/plain; charset=utf-8"},};
   auto it = types.find(file.extension().string());
   return it == types.end() ? "application/octet-stream" : it->second;
 }

@@ -270,10 +270,13 @@ void Executions::crash_loop(const store::ExecutionRecord& record, int attempts) 
                            "' without committing it";
   const std::string look = "look at the daemon's log (journalctl -u colorlabd) for what killed it";
   if (verdict.kind == CrashLoopVerdict::Kind::give_up) {
+    // Laid out by hand: clang-format 14 joins a break inside a ?: operand into one 216-column line.
+    // clang-format off
     std::string why = what + (policy.retries == 0 ? std::string(" (crash_loop_retries = 0)")
                                                   : ", also after " + std::to_string(policy.retries) + " retr" +
                                                         (policy.retries == 1 ? "y" : "ies") + " after a back-off") +
                       "; not resuming again";
+    // clang-format on
     json problem = crash_loop_problem(why, look + "; start a new run when fixed");
     problem["step"] = record.step;
     json summary{{"measurements", store_.measurement_summary(record.run_id)}};
@@ -342,7 +345,7 @@ void Executions::notify(const std::string& event, const store::ExecutionRecord& 
                         const json& problem, const json& suspension) {
   if (!options_.notifier) return;
   json details{{"execution_id", record.id}, {"run_id", record.run_id}, {"campaign", record.campaign},
-               {"step", record.step},       {"reason", reason},        {"problem", problem}};
+               {"step", record.step},       {"reason", reason},        {"problem", problem},};
   if (event == "failed") details["status"] = protocol::to_string(ExecutionStatus::finished_error);
   else details["status"] = protocol::to_string(ExecutionStatus::suspended);
   if (problem.is_object() && problem.contains("code")) details["category"] = problem["code"];
@@ -493,7 +496,8 @@ store::ExecutionRecord Executions::pause(const std::string& id) {
   auto it = active_.find(id);
   if (it == active_.end()) {
     if (record.status == ExecutionStatus::paused) return record;
-    throw Error(ErrorClass::conflict, "execution " + id + " is " + std::string(protocol::to_string(record.status)) +
+    throw Error(ErrorClass::conflict,
+                "execution " + id + " is " + std::string(protocol::to_string(record.status)) +
                                           ", not running", "only a running execution can be paused");
   }
   it->second->control.request = Request::pause;
@@ -514,7 +518,8 @@ store::ExecutionRecord Executions::resume(const std::string& id) {
     return record;
   }
   if (record.status != ExecutionStatus::paused && record.status != ExecutionStatus::suspended) {
-    throw Error(ErrorClass::conflict, "execution " + id + " is " + std::string(protocol::to_string(record.status)) +
+    throw Error(ErrorClass::conflict,
+                "execution " + id + " is " + std::string(protocol::to_string(record.status)) +
                                           ", not paused", "only a paused or suspended execution can be resumed");
   }
   if (shutting_down_) throw Error(ErrorClass::conflict, "colorlabd is shutting down");

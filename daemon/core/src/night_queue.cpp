@@ -261,7 +261,7 @@ store::QueueStore::EnqueuedGroup NightQueue::enqueue_sequence(const std::string&
     items.push_back(std::move(n));
   }
   json options{{"small", small}, {"overrides", overrides.is_null() ? json::object() : overrides},
-               {"on_failure", store::to_string(on_failure)}};
+               {"on_failure", store::to_string(on_failure)},};
   auto enqueued = queue_.enqueue_group(new_uuid_v7(), name, options, items);
   if (enqueued.created) poke();
   return enqueued;
@@ -290,7 +290,7 @@ json NightQueue::describe_group(const store::QueueGroup& group) {
   std::string state = all_done ? "done" : any_bad ? "failed" : any_running ? "running" : "queued";
   json described{{"id", group.id},       {"sequence", group.sequence}, {"options", group.options},
                  {"created_at", group.created_at}, {"state", state},  {"items", items},
-                 {"runs", runs},         {"run_ids", run_ids}};
+                 {"runs", runs},         {"run_ids", run_ids},};
   // The study's report, of the runs it finished, once nothing of it is left to run.
   if (group_ended(group) && !run_ids.empty())
     described["links"] = {{"report", std::string(protocol::kPrefix) + "/queue/groups/" + group.id + "/report"}};

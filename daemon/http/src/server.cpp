@@ -589,7 +589,8 @@ void Server::start() {
     if (!ec) acc->bind(ep, ec);
     if (!ec) acc->listen(asio::socket_base::max_listen_connections, ec);
     if (ec) {
-      throw Error(ErrorClass::io_error, "cannot listen on " + o.tcp_host + ":" + std::to_string(o.tcp_port) + ": " +
+      throw Error(ErrorClass::io_error,
+                  "cannot listen on " + o.tcp_host + ":" + std::to_string(o.tcp_port) + ": " +
                                             ec.message(),
                   "another colorlabd may be running; pick another port with --listen");
     }

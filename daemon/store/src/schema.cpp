@@ -207,7 +207,8 @@ void migrate(Database& db) {
   int version = schema_version(db);
   int app_id = read_pragma_int(db, "application_id");
   if (app_id != 0 && app_id != kApplicationId) {
-    throw Error(ErrorClass::io_error, "the database file belongs to another application (application_id " +
+    throw Error(ErrorClass::io_error,
+                "the database file belongs to another application (application_id " +
                                           std::to_string(app_id) + ")",
                 "point --state at colorlab's own state directory");
   }

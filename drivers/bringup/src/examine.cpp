@@ -67,7 +67,7 @@ asio::awaitable<void> identify_ls110(asio::any_io_executor ex, Examination& x, c
                 {"detail", "the meter has no identification command; it answered MDS,04 in remote mode"}};
   x.calibration = {{"applies", true}, {"state", "factory"},
                    {"detail", "the LS-110 reports no calibration over RS-232: its accuracy is Konica Minolta's "
-                              "calibration (see the certificate's date); the calibration factor shown on its display applies"}};
+                              "calibration (see the certificate's date); the calibration factor shown on its display applies"},};
   if (!o.measure) co_return;
   drivers::Ls110Options d;
   d.port = x.port;
@@ -127,7 +127,7 @@ asio::awaitable<void> identify_spectrolino_readonly(asio::any_io_executor ex, Ex
       auto dev = sl::DeviceDataAnswer::decode(co_await protocol.transact(sl::req::device_data_request(), t.command, "device data"));
       auto tid = sl::TargetIdAnswer::decode(co_await protocol.transact(sl::req::target_id_request(), t.command, "target id"));
       x.identity = {{"model", trim(tid.name)}, {"serial", std::to_string(dev.serial)}, {"firmware", trim(dev.software)},
-                    {"baud", heard.baud}};
+                    {"baud", heard.baud},};
       x.decoded["serial"] = std::to_string(dev.serial);
       x.decoded["topology"] = "standalone";
     }
@@ -142,7 +142,7 @@ asio::awaitable<void> identify_spectrolino(asio::any_io_executor ex, Examination
   co_await identify_spectrolino_readonly(ex, x, heard, o, rec);
   x.calibration = {{"applies", true}, {"state", "unknown"},
                    {"detail", "the Spectrolino keeps no white calibration colorlab can read back: the daemon calibrates on "
-                              "the white tile before its readings, and doctor --measure does it once"}};
+                              "the white tile before its readings, and doctor --measure does it once"},};
   if (!o.measure) co_return;
   drivers::SpectrolinoOptions d;
   d.port = x.port;
@@ -170,7 +170,7 @@ asio::awaitable<void> identify_spectrolino(asio::any_io_executor ex, Examination
     auto cal = spectro.calibration();
     if (!cal.empty()) {
       x.calibration = {{"applies", true}, {"state", cal.front().valid ? "valid" : "expired"}, {"type", cal.front().type},
-                       {"detail", "white calibration made by doctor on the tile just now"}};
+                       {"detail", "white calibration made by doctor on the tile just now"},};
       if (cal.front().readings_left) x.calibration["readings_left"] = *cal.front().readings_left;
     }
   } catch (...) {
@@ -284,7 +284,7 @@ json to_json(const Examination& e) {
   for (const auto& c : e.confirmations) confirm.push_back({{"key", c.key}, {"question", c.question}, {"unit", c.unit}});
   json j{{"port", e.port}, {"verdict", e.verdict}, {"message", e.message}, {"tried", e.tried},
          {"identity", e.identity}, {"calibration", e.calibration}, {"decoded", e.decoded},
-         {"measured", e.measured}, {"confirm", confirm}, {"seconds", e.seconds}};
+         {"measured", e.measured}, {"confirm", confirm}, {"seconds", e.seconds},};
   j["kind"] = e.kind.empty() ? json(nullptr) : json(e.kind);
   j["expected_kind"] = e.expected_kind.empty() ? json(nullptr) : json(e.expected_kind);
   if (!e.hint.empty()) j["hint"] = e.hint;

@@ -22,7 +22,7 @@ json discover_gige_cameras() {
     std::string protocol = str(arv_get_device_protocol(i));
     out.push_back({{"id", str(arv_get_device_id(i))}, {"vendor", str(arv_get_device_vendor(i))},
                    {"model", str(arv_get_device_model(i))}, {"serial", str(arv_get_device_serial_nbr(i))},
-                   {"address", str(arv_get_device_address(i))}, {"protocol", protocol}});
+                   {"address", str(arv_get_device_address(i))}, {"protocol", protocol},});
   }
   return out;
 }
@@ -69,7 +69,7 @@ json identify_gige_camera(const std::string& address) {
     j["pixel_formats"] = f;
     j["calibration"] = {{"applies", true}, {"state", "in the daemon"},
                         {"detail", "a camera's characterization is a campaign's result (characterize-camera), kept by colorlabd, "
-                                   "not in the camera"}};
+                                   "not in the camera"},};
     g_object_unref(cam);
   }
   j["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -193,7 +193,7 @@ json usb_devices(const HostPaths& paths) {
     int vid = std::stoi(vid_s, nullptr, 16), pid = std::stoi(pid_s, nullptr, 16);
     json j{{"sysfs", d.filename().string()}, {"usb_vid", vid}, {"usb_pid", pid},
            {"manufacturer", read_attr(d, "manufacturer")}, {"product", read_attr(d, "product")},
-           {"serial", read_attr(d, "serial")}};
+           {"serial", read_attr(d, "serial")},};
     auto known = known_usb_device(vid, pid, j["product"].get<std::string>());
     if (!known.empty()) j["known_as"] = known;
     auto bus = read_attr(d, "busnum"), dev = read_attr(d, "devnum");
@@ -221,7 +221,7 @@ json relay_boards() {
   json out = json::array();
   for (const auto& b : drivers::enumerate_relay_boards()) {
     out.push_back({{"path", b.path}, {"usb_vid", b.vendor_id}, {"usb_pid", b.product_id}, {"manufacturer", b.manufacturer},
-                   {"product", b.product}, {"serial", b.serial}, {"node", access_json(check_access(b.path))}});
+                   {"product", b.product}, {"serial", b.serial}, {"node", access_json(check_access(b.path))},});
   }
   return out;
 }

@@ -74,7 +74,7 @@ void UnixLineClient::send_line(std::string_view line, Clock::time_point deadline
       pollfd p{fd_, POLLOUT, 0};
       if (::poll(&p, 1, millis_until(deadline)) == 0) {
         throw Error(ErrorInfo{.cls = ErrorClass::timeout, .message = what_ + ": request not accepted in time",
-                              .hint = "the peer stopped reading; reconnect", .retryable = true});
+                              .hint = "the peer stopped reading; reconnect", .retryable = true,});
       }
       continue;
     }
@@ -82,7 +82,7 @@ void UnixLineClient::send_line(std::string_view line, Clock::time_point deadline
     close();
     throw Error(ErrorInfo{.cls = ErrorClass::no_comms, .message = what_ + ": connection lost while sending: " + std::strerror(err),
                           .hint = "the device went away (simulated unplug or colorlab-sim stopped); reconnect",
-                          .transport_code = err == EPIPE ? "EPIPE" : "errno " + std::to_string(err), .retryable = true});
+                          .transport_code = err == EPIPE ? "EPIPE" : "errno " + std::to_string(err), .retryable = true,});
   }
 }
 
@@ -103,7 +103,7 @@ std::string UnixLineClient::read_line(Clock::time_point deadline) {
     const int ready = ::poll(&p, 1, millis_until(deadline));
     if (ready == 0) {
       throw Error(ErrorInfo{.cls = ErrorClass::timeout, .message = what_ + ": no answer before the deadline",
-                            .hint = "the device is not answering; it may be hung or busy", .retryable = true});
+                            .hint = "the device is not answering; it may be hung or busy", .retryable = true,});
     }
     if (ready < 0 && errno == EINTR) continue;
     char chunk[16 * 1024];
@@ -117,7 +117,7 @@ std::string UnixLineClient::read_line(Clock::time_point deadline) {
     close();
     throw Error(ErrorInfo{.cls = ErrorClass::no_comms, .message = what_ + ": connection lost: " + why,
                           .hint = "the device went away (simulated unplug or colorlab-sim stopped); reconnect",
-                          .transport_code = n == 0 ? "EOF" : "errno " + std::to_string(errno), .retryable = true});
+                          .transport_code = n == 0 ? "EOF" : "errno " + std::to_string(errno), .retryable = true,});
   }
 }
 

@@ -321,7 +321,7 @@ asio::awaitable<void> Spectrolino::calibrate_now() {
         if (code == sl::exec_err::RemOverflow && topology_ == SpectrolinoTopology::standalone) {
           throw Error(ErrorInfo{ErrorClass::needs_operator, std::string(what) + ": too much light or wrong white reference",
                                 "place the Spectrolino on its white calibration tile and calibrate again",
-                                "spectrolino:" + hex_byte(code), {}, false, {}});
+                                "spectrolino:" + hex_byte(code), {}, false, {},});
         }
         sl::throw_on_exec_error(code, what, {ok});
       } catch (const Error& e) {
@@ -383,7 +383,8 @@ SpectralReading Spectrolino::make_reading(const sl::Spectrum& spectrum) {
       set.names = {"sample"};
       set.values = Eigen::Map<const Eigen::RowVectorXd>(r.values.data(), static_cast<Eigen::Index>(r.values.size()));
       // mW/(nm·m²) → W: irradiance-based XYZ with Y in lux.
-      auto xyz = analysis::emission_to_xyz(set, options_.observer == sl::Observer::Deg10 ? analysis::Observer::cie1964_10deg
+      auto xyz = analysis::emission_to_xyz(set,
+                                           options_.observer == sl::Observer::Deg10 ? analysis::Observer::cie1964_10deg
                                                                                          : analysis::Observer::cie1931_2deg,
                                            0.683);
       r.xyz = std::array<double, 3>{xyz[0].X, xyz[0].Y, xyz[0].Z};

@@ -181,7 +181,7 @@ struct Lab::Impl {
         const auto px = m->floor_point_px(x, y);
         spots.push_back({{"row", r}, {"col", c}, {"x_mm", x}, {"y_mm", y}, {"luminance", l},
                          {"ls110_sigma", scene->luminance_noise_sigma(l)}, {"px", {px[0], px[1]}},
-                         {"relative_illumination", m->relative_illumination(px[0], px[1], f_number, camera::CameraModel::View::floor)}});
+                         {"relative_illumination", m->relative_illumination(px[0], px[1], f_number, camera::CameraModel::View::floor)},});
       }
     const auto& cc = m->config();
     json lamps = json::array();
@@ -193,8 +193,8 @@ struct Lab::Impl {
             {"noise", {{"gain_dn_per_e_iso100", cc.gain_dn_per_e_iso100}, {"read_noise_e", cc.read_noise_e},
                        {"adc_noise_dn", cc.adc_noise_dn}, {"dark_current_e_per_s", cc.dark_current_e_per_s},
                        {"prnu_sigma", cc.prnu_sigma}, {"dsnu_sigma_dn", cc.dsnu_sigma_dn},
-                       {"column_offset_sigma_dn", cc.column_offset_sigma_dn}, {"black_level", 256}}},
-            {"spots", spots}};
+                       {"column_offset_sigma_dn", cc.column_offset_sigma_dn}, {"black_level", 256},}},
+            {"spots", spots},};
   }
 
   Ls110Truth ls110_truth() const {
@@ -441,12 +441,12 @@ json Lab::control(const json& command) {
       if (d.dslr) t["dslr"] = d.dslr->truth();
       if (d.relay) {
         t["relay"] = {{"board_id", d.relay_board->board_id()}, {"mask", d.relay_board->mask()},
-                      {"requests", d.relay->requests()}, {"socket", d.relay->socket_path().string()}};
+                      {"requests", d.relay->requests()}, {"socket", d.relay->socket_path().string()},};
       }
       if (d.ls110) {
         auto lt = d.ls110_truth();
         t["ls110"] = {{"luminance", lt.luminance}, {"noise_sigma", lt.noise_sigma},
-                      {"aim", {d.aim_row, d.aim_col}}, {"readings_served", d.ls110->readings_served()}};
+                      {"aim", {d.aim_row, d.aim_col}}, {"readings_served", d.ls110->readings_served()},};
       }
       if (d.spectrolino) {
         t["spectrolino"] = d.spectrolino_truth();
@@ -457,7 +457,7 @@ json Lab::control(const json& command) {
         // what a GigE Vision client should find and how many frames the camera has filled for it
         t["genicam"] = {{"address", d.genicam->address()}, {"serial", d.genicam->serial()},
                         {"plugged_in", d.genicam->plugged_in()}, {"frames_filled", d.genicam->frames_filled()},
-                        {"sensor", {d.camera_model->width(), d.camera_model->height()}}};
+                        {"sensor", {d.camera_model->width(), d.camera_model->height()}},};
       }
       if (d.dmx) {
         const auto& u = d.dmx->universe();
@@ -471,7 +471,7 @@ json Lab::control(const json& command) {
                     // as the last label 4 set them, so a client's parameter writes are checked at the widget
                     {"parameters", {{"break_time", d.dmx->parameters().break_time},
                                     {"mab_time", d.dmx->parameters().mab_time},
-                                    {"output_rate", d.dmx->parameters().output_rate}}}};
+                                    {"output_rate", d.dmx->parameters().output_rate},}}};
       }
       return t;
     }

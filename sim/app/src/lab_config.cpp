@@ -132,7 +132,8 @@ void load_relay(const std::filesystem::path& file, const toml::table& t, RelayLa
   }
   for (const auto& [lamp, relay] : rc.lamps) {
     if (relay > rc.relays) {
-      throw Error(ErrorClass::bad_parameter, file.string() + ": relay.lamps." + lamp + " is relay " + std::to_string(relay) +
+      throw Error(ErrorClass::bad_parameter,
+                  file.string() + ": relay.lamps." + lamp + " is relay " + std::to_string(relay) +
                                                  " but the board has " + std::to_string(rc.relays), "see docs/simulator.md");
     }
   }

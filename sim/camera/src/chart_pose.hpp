@@ -13,7 +13,8 @@ class PoseGeometry {
   PoseGeometry(const ChartPose& pose, int width, int height, double chart_height_fraction);
   std::pair<double, double> image_of(double chart_x_mm, double chart_y_mm) const;  // distorted
   std::pair<double, double> chart_of(double image_x, double image_y) const;        // from a distorted position
-  LensIntrinsics intrinsics() const;  // OpenCV convention (pixel centres at integers)
+  // OpenCV convention (pixel centres at integers)
+  LensIntrinsics intrinsics() const;
 
  private:
   Eigen::Matrix3d h_, inv_;

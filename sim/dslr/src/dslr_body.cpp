@@ -42,7 +42,8 @@ DslrBody::DslrBody(std::shared_ptr<const camera::CameraModel> model, DslrBodyCon
   std::error_code ec;
   std::filesystem::create_directories(config_.capture_dir, ec);
   if (ec) {
-    throw Error(ErrorClass::io_error, "simulated DSLR: cannot create capture directory " + config_.capture_dir.string() +
+    throw Error(ErrorClass::io_error,
+                "simulated DSLR: cannot create capture directory " + config_.capture_dir.string() +
                                           ": " + ec.message(), "check [dslr] capture_dir and its permissions");
   }
   // XYZ -> camera under D65 does not depend on which lamps are lit: computed once.

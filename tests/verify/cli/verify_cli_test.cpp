@@ -24,7 +24,8 @@ using nlohmann::json;
 
 namespace {
 
-constexpr int kRows = 4, kCols = 5;  // 20 spots: both campaigns in a few seconds at time scale 200
+// 20 spots: both campaigns in a few seconds at time scale 200
+constexpr int kRows = 4, kCols = 5;
 constexpr double kPitchX = 60, kPitchY = 54, kFloorW = 1200, kFloorD = 600;  // the §6.2 grid (docs/simulator.md)
 
 json control(const DaemonProcess& daemon, const json& command) {

@@ -132,7 +132,7 @@ TEST(VerifyColourLoo, RunsThatLackWhatColourNeedsAreRefusedWithTheirCause) {
   // A raw result whose black box was not fitted says why.
   const json no_bb = run("k1", "characterize-camera", {{"reference_run", "c1"}},
                          {{"script", {{"formats", {{"raw", {{"approaches", json::object()},
-                                                             {"not_fitted", {{"black_box", "the reference has no spectra"}}}}}}}}}});
+                                                             {"not_fitted", {{"black_box", "the reference has no spectra"}}},}}}}}}});
   try {
     verify::stored_black_box(no_bb);
     ADD_FAILURE() << "no black box";

@@ -142,7 +142,7 @@ class Lab {
     chart_read_ = run_to_end(api, "chart-read", json::object())["id"].get<std::string>();
     const json run = run_to_end(api, "characterize-camera",
                                 {{"reference_run", chart_read_}, {"frames", 2}, {"formats", {"raw"}}, {"keep", {"preview"}},
-                                 {"prior_exclude", {"Canon_20D"}}},
+                                 {"prior_exclude", {"Canon_20D"}},},
                                 std::chrono::seconds(240));
     if (run["status"] != "finished_ok") throw std::runtime_error("characterize-camera: " + run.dump().substr(0, 2000));
     characterize_ = run["id"].get<std::string>();

@@ -61,7 +61,8 @@ std::vector<float> read_exr(const fs::path& exr, const fs::path& work) {
   std::ofstream(work / "read_exr.py") << py;
   std::vector<float> px;
   [&] {
-    run("reading " + exr.string(), "/usr/bin/python3 " + (work / "read_exr.py").string() + " " + exr.string() + " " +
+    run("reading " + exr.string(),
+        "/usr/bin/python3 " + (work / "read_exr.py").string() + " " + exr.string() + " " +
                                        raw.string() + " " + std::to_string(kWidth) + " " + std::to_string(kHeight),
         work / "read_exr.log");
   }();
@@ -86,7 +87,8 @@ TEST(BlenderRender, TheExportedScenesFloorLuminanceIsTheSimulatorsWithinTheRende
   auto scene = std::make_shared<sim::Scene>(config, std::make_shared<sim::SimClock>(1.0));
   std::ofstream(work / "chart.json") << testing::chart_read_run(*scene, 21).dump();
   std::ofstream(work / "grid.json") << testing::cabinet_grid_run(*scene, {sim::Lamp::d65}, {100.0}, 22).dump();
-  run("colorlab scene", std::string(COLORLAB_BIN_DIR) + "/colorlab scene " + (work / "chart.json").string() + " " +
+  run("colorlab scene",
+      std::string(COLORLAB_BIN_DIR) + "/colorlab scene " + (work / "chart.json").string() + " " +
                             (work / "grid.json").string() + " --lamp D65 -o " + (work / "scene").string(),
       work / "scene.log");
   const json exported = json::parse(read_file(work / "scene" / "scene.json"));

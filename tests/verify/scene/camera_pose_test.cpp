@@ -75,9 +75,9 @@ json characterize_run(const ca::ChartLocation& loc, int width, int height) {
   for (const auto& c : loc.corners) corners.push_back({c.x, c.y});
   json row{{"step", "chart/raw"}, {"quantity", "chart_location"}, {"value", loc.confidence},
            {"data", {{"format", "raw"}, {"corners", corners}, {"width", width}, {"height", height},
-                     {"reprojection_rms_px", loc.reprojection_rms_px}}}};
+                     {"reprojection_rms_px", loc.reprojection_rms_px},}},};
   return {{"run", {{"id", "0193c0de-0000-7000-8000-0000000cc0de"}, {"campaign", "characterize-camera"},
-                   {"params", json::object()}, {"status", "finished_ok"}}},
+                   {"params", json::object()}, {"status", "finished_ok"},}},
           {"measurements", json::array({row})}};
 }
 

@@ -90,7 +90,7 @@ ca::FitTarget target_of(const std::string& name) {
 
 std::string illuminant_of_lamp(const std::string& lamp) {
   static const std::map<std::string, std::string> table{{"D65", "D65"}, {"D50", "D50"}, {"A", "A"},
-                                                        {"TL84", "F11"}, {"CWF", "F2"}};
+                                                        {"TL84", "F11"}, {"CWF", "F2"},};
   auto it = table.find(lamp);
   if (it == table.end())
     throw Error(ErrorClass::bad_parameter, "lamp " + lamp + " has no standard spectrum to compare colour under",

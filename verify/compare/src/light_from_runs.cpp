@@ -109,7 +109,8 @@ void add_floor_luminance(MeasuredScene& scene, const std::vector<nlohmann::json>
                 "pick a lamp and dimmer level the run photographed (its params: lamps, dimmer_levels)");
   const double rms = residual_n > 0 ? std::sqrt(residual_sq / residual_n) : 0.0;
   if (!(rms > 0))
-    throw Error(ErrorClass::bad_data, "the floor map's flat field has no calibration residual to judge it by (" +
+    throw Error(ErrorClass::bad_data,
+                "the floor map's flat field has no calibration residual to judge it by (" +
                                           std::to_string(residual_n) + " calibration spots)",
                 "run floor-luminance with more calibration spots than the flat field has terms (degree + 2)");
   for (auto& c : cells) c.relative_sd = rms;

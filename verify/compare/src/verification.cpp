@@ -62,7 +62,7 @@ nlohmann::json Verification::summary() const {
         const auto top = std::max_element(c->budget.begin(), c->budget.end(),
                                           [](const auto& a, const auto& b) { return a.second < b.second; });
         blind.push_back({{"where", c->where}, {"expanded", c->expanded},
-                         {"dominant_source", top == c->budget.end() ? "" : top->first}});
+                         {"dominant_source", top == c->budget.end() ? "" : top->first},});
       }
     }
     std::sort(diffs.begin(), diffs.end());
@@ -89,7 +89,7 @@ nlohmann::json Verification::to_json() const {
     items.push_back({{"kind", c.kind}, {"where", c.where}, {"rendered", c.rendered}, {"measured", c.measured},
                      {"difference", c.difference}, {"expanded", c.expanded}, {"mahalanobis", c.mahalanobis},
                      {"threshold", c.threshold}, {"verdict", to_string(c.verdict)}, {"cannot_tell", c.cannot_tell},
-                     {"budget", budget}});
+                     {"budget", budget},});
   }
   nlohmann::json floor = nlohmann::json::array();
   for (const auto& row : floor_ratio) {

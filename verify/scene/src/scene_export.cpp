@@ -182,7 +182,7 @@ json chart_part(const CabinetGeometry& cab, const json& doc, double& first_nm, d
     const double bx = (layout.column[k] - (layout.columns - 1) / 2.0) * pitch, by = (layout.row[k] - (layout.rows - 1) / 2.0) * pitch;
     const double fx = cab.chart_center_x_mm + bx, fy = cab.chart_center_y_mm - by;
     patches.push_back({{"id", pid}, {"index", *idx}, {"center_m", {fx * mm, fy * mm}}, {"size_m", size * mm},
-                       {"reflectance", spectrum(f, s, values)}});
+                       {"reflectance", spectrum(f, s, values)},});
   }
   for (int i = 0; i < static_cast<int>(layout.ids.size()); ++i)
     if (!seen[static_cast<std::size_t>(i)]) malformed(id, "patch " + layout.ids[static_cast<std::size_t>(i)] + " was not read");
@@ -328,6 +328,8 @@ json camera_part(const CabinetGeometry& cab, const json& chart_doc, const json* 
   for (const auto& a : p.axes) axes.push_back({a[0], a[1], a[2]});
   json corners = json::array();
   for (const auto& q : s.corners_px) corners.push_back({q[0], q[1]});
+  // Laid out by hand: clang-format 14 joins the break inside "how"'s message into one 207-column line.
+  // clang-format off
   return {{"position_m", {p.position_mm[0] * mm, p.position_mm[1] * mm, p.position_mm[2] * mm}},
           {"look_at_m", {(p.position_mm[0] + t * z[0]) * mm, (p.position_mm[1] + t * z[1]) * mm, (p.position_mm[2] + t * z[2]) * mm}},
           {"up", {-p.axes[1][0], -p.axes[1][1], -p.axes[1][2]}},
@@ -347,6 +349,7 @@ json camera_part(const CabinetGeometry& cab, const json& chart_doc, const json* 
           {"how", "solvePnP (OpenCV, IPPE) of the chart locator's four outer grid corners on the " + format +
                       " photograph against the chart's geometry where the cabinet puts it, with the intrinsics above; "
                       "σ from the corners' stated accuracy through the solution's Jacobian"}};
+  // clang-format on
 }
 
 }  // namespace
@@ -391,7 +394,7 @@ json export_scene(const CabinetGeometry& cab, const std::vector<json>& runs, con
       level = {{"source", "fitted"}, {"run", run_id(*r.grid)}, {"spots", fit->spots}, {"rms_residual_pct", fit->rms_pct},
                {"standard_error_pct", fit->standard_error_pct},
                {"how", "least squares of the LS-110 floor readings at this dimmer against ρ_floor·L·F(spot), F the "
-                       "emitter's analytic form factor: one factor per lamp"}};
+                       "emitter's analytic form factor: one factor per lamp"},};
     } else if (e->luminance_cd_m2 > 0 && o.dimmer_percent == 100.0) {
       luminance = e->luminance_cd_m2;
       level = {{"source", "configured"}, {"how", "the lab configuration's [[cabinet.emitter]] luminance_cd_m2 at 100 %"}};
@@ -412,7 +415,7 @@ json export_scene(const CabinetGeometry& cab, const std::vector<json>& runs, con
          {"emitter", {{"center_m", {e->x_mm * mm, e->y_mm * mm, cab.height_mm * mm}},
                       {"size_m", {e->length_mm * mm, e->width_mm * mm}},
                       {"normal", {0, 0, -1}},
-                      {"kind", "Lambertian rectangle, emitting downwards only"}}},
+                      {"kind", "Lambertian rectangle, emitting downwards only"},}},
          {"luminance_cd_m2", luminance},
          {"level", level},
          {"spectral_radiance", spectrum(first_nm, step_nm, radiance)},
@@ -425,20 +428,20 @@ json export_scene(const CabinetGeometry& cab, const std::vector<json>& runs, con
           {"units", {{"length", "m"}, {"spectral_radiance", "W·sr⁻¹·m⁻²·nm⁻¹"}, {"luminance", "cd/m²"}}},
           {"coordinates", "x from the cabinet's left inner wall, y from its open front edge towards the back, z up from the floor"},
           {"bands", {{"first_nm", first_nm}, {"step_nm", step_nm}, {"count", bands}, {"ybar", ybar_bands},
-                     {"note", "each band is its centre's value held over ±step/2 (box bands, JCGT 2021's default)"}}},
+                     {"note", "each band is its centre's value held over ±step/2 (box bands, JCGT 2021's default)"},}},
           {"cabinet", {{"width_m", cab.width_mm * mm}, {"depth_m", cab.depth_mm * mm}, {"height_m", cab.height_mm * mm},
                        {"front", "open"},
                        {"walls_reflectance", 0.0},
                        {"walls_note", "black: the exported scene carries direct light only, as the simulator's geometric cabinet computes it"},
                        {"floor_reflectance", cab.floor_reflectance},
-                       {"grid_pitch_m", {cab.grid_pitch_x_mm * mm, cab.grid_pitch_y_mm * mm}}}},
+                       {"grid_pitch_m", {cab.grid_pitch_x_mm * mm, cab.grid_pitch_y_mm * mm}},}},
           {"lamps", lamp_parts},
           {"chart", chart},
           {"camera", camera_part(cab, *r.chart, r.camera, o)},
           {"luminance_scale", {{"instrument", "LS-110"},
                                {"source_run", r.grid ? json(run_id(*r.grid)) : json(nullptr)},
                                {"dimmer_percent", o.dimmer_percent},
-                               {"spots", grid_spots}}}};
+                               {"spots", grid_spots},}}};
 }
 
 void write_scene(const json& scene, const std::filesystem::path& dir) {

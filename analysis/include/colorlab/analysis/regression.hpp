@@ -46,7 +46,8 @@ struct FitOptions {
   FitTarget target = FitTarget::xyz_then_lab;
   double ridge = 0;         // Tikhonov weight on the coefficients of the 0..1-scaled terms (0 = plain least squares)
   double input_scale = 0;   // RGB divisor; 0 = largest training value, so inputs lie in 0..1
-  SmoothingSearch spline_search = SmoothingSearch::eigen;  // splines only
+  // splines only
+  SmoothingSearch spline_search = SmoothingSearch::eigen;
 };
 
 class PolynomialModel {

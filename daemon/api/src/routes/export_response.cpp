@@ -47,11 +47,14 @@ std::string ti3_body(const MeasurementPages& pages, campaigns::RunReader& runs, 
                       reference, format);
   }
   auto patches = all_measurements(pages, run.id, {.step_prefix = "patch/", .quantity = "reflectance_spectrum"});
+  // Laid out by hand: clang-format 14 would align the message's second literal under the first line's last one.
+  // clang-format off
   if (patches.empty())
     throw Error(ErrorClass::unsupported,
                 "run " + run.id + " (" + run.campaign + ") has no patch readings: a .ti3 pairs patches' device values with "
                 "their colour, as a chart-read or characterize-camera run records them",
                 "export it as csv or json, which hold every measurement as stored");
+  // clang-format on
   return reference_ti3(run, patches);
 }
 

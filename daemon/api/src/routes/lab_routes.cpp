@@ -40,7 +40,7 @@ HttpResponse get_root(ApiContext& ctx, const HttpRequest&, const PathParams&) {
                                   {"running_executions", ctx.executions.running()},
                                   {"features", features},
                                   {"limits", {{"max_request_body", protocol::kMaxRequestBody},
-                                              {"max_page_limit", protocol::kMaxPageLimit}}}});
+                                              {"max_page_limit", protocol::kMaxPageLimit},}}});
 }
 
 HttpResponse get_instruments(ApiContext& ctx, const HttpRequest&, const PathParams&) {

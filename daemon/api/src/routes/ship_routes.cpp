@@ -76,7 +76,7 @@ HttpResponse get_shipping(ApiContext& ctx, const HttpRequest&, const PathParams&
   if (!ctx.blobs->config().keep_unshipped && agent.is_null()) {
     return HttpResponse::json(200, json{{"enabled", false}, {"shipped_position", position}, {"last_event", nullptr},
                                         {"lag", nullptr}, {"agent", nullptr}, {"last_error", nullptr},
-                                        {"agent_seen_s_ago", nullptr}});
+                                        {"agent_seen_s_ago", nullptr},});
   }
   // A read-only connection of its own: the pool's connections belong to their threads' snapshots, and this one
   // reads the log after the agent's position only.

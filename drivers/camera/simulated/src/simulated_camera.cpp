@@ -65,7 +65,8 @@ Camera::Connected SimulatedCamera::do_connect() {
   std::error_code ec;
   std::filesystem::create_directories(options_.capture_dir, ec);
   if (ec) {
-    throw Error(ErrorClass::io_error, "cannot create capture directory " + options_.capture_dir.string() + ": " +
+    throw Error(ErrorClass::io_error,
+                "cannot create capture directory " + options_.capture_dir.string() + ": " +
                                           ec.message(),
                 "check the path and permissions");
   }
@@ -89,7 +90,7 @@ void SimulatedCamera::do_disconnect() noexcept {}
 void SimulatedCamera::do_configure(const CameraSettings& s) {
   if (unplugged_) {
     throw Error(ErrorInfo{.cls = ErrorClass::no_comms, .message = name() + " is unplugged",
-                          .hint = "reconnect the camera", .retryable = true});
+                          .hint = "reconnect the camera", .retryable = true,});
   }
   std::lock_guard lock(fault_mutex_);
   if (s.iso) exposure_.iso = *s.iso;

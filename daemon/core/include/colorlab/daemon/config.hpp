@@ -21,7 +21,8 @@ struct SimulatorConfig {
 
 // [campaigns]: where the lab's own scripts live, and how executions survive restarts.
 struct CampaignConfig {
-  std::optional<std::filesystem::path> directory;  // default: <state_dir>/campaigns
+  // default: <state_dir>/campaigns
+  std::optional<std::filesystem::path> directory;
   int max_resume_attempts = 3;       // restarts in a row without a committed step before the crash-loop guard trips
   // The guard suspends the execution and retries it itself after a back-off that doubles from
   // crash_loop_backoff_s up to crash_loop_backoff_max_s (the daemon's own seconds, not lab seconds), at
@@ -62,7 +63,8 @@ struct NotifyConfig {
 struct AccessConfig {
   std::string loopback_scope = "read";  // what loopback TCP may do without a key: read | control | admin
   bool allow_plaintext = false;         // a listener beyond loopback without TLS (then warned about)
-  std::optional<std::filesystem::path> tls_certificate;  // PEM; with tls_private_key, TCP speaks TLS
+  // PEM; with tls_private_key, TCP speaks TLS
+  std::optional<std::filesystem::path> tls_certificate;
   std::optional<std::filesystem::path> tls_private_key;
   double control_lease_s = 600;
 };

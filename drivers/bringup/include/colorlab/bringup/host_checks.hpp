@@ -40,6 +40,7 @@ nlohmann::json host_identity();                          // user, uid, groups, t
 nlohmann::json udev_rules_state(const HostPaths& paths); // installed where, read by udevd or not
 nlohmann::json serial_ports(const HostPaths& paths);     // libserialport's list with by-id links and access
 nlohmann::json usb_devices(const HostPaths& paths);      // sysfs, each with its /dev/bus/usb node's access
-nlohmann::json relay_boards();                           // dcttech boards by hidapi, each with its hidraw node's access
+// dcttech boards by hidapi, each with its hidraw node's access
+nlohmann::json relay_boards();
 
 }  // namespace colorlab::bringup

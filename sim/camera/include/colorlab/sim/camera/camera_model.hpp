@@ -27,7 +27,8 @@ struct ChartPose {
   double tilt_deg = 0;       // about the chart's horizontal axis (positive: its top edge leans away)
   double swing_deg = 0;      // about its vertical axis (positive: its right edge leans away)
   double distance_mm = 1200; // camera to chart centre; the focal length keeps the chart at chart_height_fraction
-  double shift_x = 0, shift_y = 0;  // chart centre offset as a fraction of the frame width / height
+  // chart centre offset as a fraction of the frame width / height
+  double shift_x = 0, shift_y = 0;
   double k1 = 0, k2 = 0;     // radial lens distortion (OpenCV's model, coordinates normalised by the focal length)
 };
 // A plausible bench pose for a seed: a few degrees of rotation and tilt, some shift, mild barrel distortion.
