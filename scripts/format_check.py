@@ -160,9 +160,11 @@ def examine(path, exe, against=None):
   with open(path, encoding="utf-8") as f:
     now = f.read()
   if against:
-    before_text = subprocess.run(["git", "show", f"{against}:{path}"], check=True, capture_output=True,
-                                 text=True).stdout
-    after_text = now
+    shown = subprocess.run(["git", "show", f"{against}:{path}"], capture_output=True, text=True)
+    if shown.returncode != 0:  # a file new since REV has nothing to compare with
+      return {"path": path, "changed": False, "problems": [f"not in {against}: {shown.stderr.strip()}"],
+              "added": [], "removed": [], "long": [], "joined": [], "long_before": 0, "long_after": 0}
+    before_text, after_text = shown.stdout, now
   else:
     before_text, after_text = now, clang_format(path, exe)
   result = {"path": path, "changed": before_text != after_text, "problems": [], "added": [], "removed": [],
