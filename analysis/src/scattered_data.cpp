@@ -185,8 +185,8 @@ FitWithHat SplineFitter::fit(const ChartData& train, const SplineOptions& o) {
   // A fixed λ is one solve; the search decomposes once (eigen) or solves at every λ (direct, the reference).
   std::optional<Smoother> smoother;
   if (!o.smoothing && o.search == SmoothingSearch::eigen) smoother.emplace(K, P, w, Y);
-  auto solve = [&](double l, bool want_coefficients) {
-    return smoother ? smoother->at(l, true, want_coefficients) : solve_at(K, P, w, Y, l, true);
+  auto solve = [&](double l, bool want_coefficients, bool want_hat = true) {
+    return smoother ? smoother->at(l, true, want_coefficients) : solve_at(K, P, w, Y, l, want_hat);
   };
   double lambda = o.smoothing.value_or(0);
   if (!o.smoothing) {
@@ -213,11 +213,12 @@ FitWithHat SplineFitter::fit(const ChartData& train, const SplineOptions& o) {
     if (!std::isfinite(best))
       throw Error(ErrorClass::bad_data, model.method_ + ": no smoothing value gives finite leave-one-out errors");
   }
-  Solved s = solve(lambda, true);
+  const bool want_hat = o.hat_matrix || !o.smoothing;  // a search has it anyway
+  Solved s = solve(lambda, true, want_hat);
   model.smoothing_ = lambda;
   model.kernel_ = s.c;
   model.poly_ = s.d;
-  model.dof_ = s.trace;
+  model.dof_ = want_hat ? s.trace : std::numeric_limits<double>::quiet_NaN();
   return {std::move(model), std::move(s)};
 }
 
@@ -262,7 +263,9 @@ FitReport spline_report(const ChartData& data, const SplineOptions& o, const CvS
   const Eigen::MatrixXd Y = target_of(data, o.target);
   Eigen::MatrixXd pred = Eigen::MatrixXd::Constant(n, 3, std::numeric_limits<double>::quiet_NaN());
   try {
-    const FitWithHat fitted = SplineFitter::fit(data, o);
+    SplineOptions with_hat = o;
+    with_hat.hat_matrix = true;
+    const FitWithHat fitted = SplineFitter::fit(data, with_hat);
     const SplineModel& model = fitted.model;
     r.terms = model.base_terms();
     r.parameters = model.effective_parameters();
