@@ -24,6 +24,16 @@ Eigen::MatrixXd cubic_kernel(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b)
   return k;
 }
 
+// The training kernel: symmetric, so each pair's pow once (‖u − v‖ and ‖v − u‖ are the same number to the bit).
+Eigen::MatrixXd cubic_kernel(const Eigen::MatrixXd& a) {
+  Eigen::MatrixXd k(a.rows(), a.rows());
+  for (Eigen::Index i = 0; i < a.rows(); ++i) {
+    k(i, i) = 0;
+    for (Eigen::Index j = i + 1; j < a.rows(); ++j) k(i, j) = k(j, i) = std::pow((a.row(i) - a.row(j)).norm(), 3);
+  }
+  return k;
+}
+
 // The base terms plus the constant and linear coordinate terms the r³ kernel needs; a constant already in the base
 // is not repeated (a duplicate column would make the system singular).
 Eigen::MatrixXd polynomial_part(const TermSet& base, const Eigen::MatrixXd& rgb_scaled, const Eigen::MatrixXd& u) {
@@ -170,7 +180,7 @@ FitWithHat SplineFitter::fit(const ChartData& train, const SplineOptions& o) {
   model.input_scale_ = o.input_scale > 0 ? o.input_scale : (train.rgb.maxCoeff() > 0 ? train.rgb.maxCoeff() : 1.0);
   const Eigen::MatrixXd scaled = train.rgb / model.input_scale_;
   model.centres_ = cube_root_coordinates(train.rgb, model.input_scale_);
-  const Eigen::MatrixXd K = cubic_kernel(model.centres_, model.centres_);
+  const Eigen::MatrixXd K = cubic_kernel(model.centres_);
   const Eigen::MatrixXd P = polynomial_part(model.base_, scaled, model.centres_);
   const Eigen::Index n = K.rows();
   Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(P);
@@ -247,7 +257,7 @@ Eigen::MatrixXd spline_loo_targets(const ChartData& data, const SplineOptions& o
   if (!o.smoothing) throw Error(ErrorClass::bad_parameter, "spline_loo_targets needs the smoothing λ");
   const double scale = o.input_scale > 0 ? o.input_scale : (data.rgb.maxCoeff() > 0 ? data.rgb.maxCoeff() : 1.0);
   const Eigen::MatrixXd u = cube_root_coordinates(data.rgb, scale);
-  const Eigen::MatrixXd K = cubic_kernel(u, u);
+  const Eigen::MatrixXd K = cubic_kernel(u);
   const Eigen::MatrixXd P = polynomial_part(term_set_by_name(o.base), data.rgb / scale, u);
   const Eigen::MatrixXd Y = target_of(data, o.target);
   return loo_predictions(solve_at(K, P, target_weights(data, o.target), Y, *o.smoothing, true), Y);
