@@ -21,18 +21,25 @@ Eigen::RowVectorXd trapezoid_weights(const std::vector<double>& g) {
 }  // namespace
 
 ReflectanceIntegrator::ReflectanceIntegrator(const SpectralSet& illuminant, const SpectralSet& observer,
-                                             const std::vector<double>& reflectance_grid, IntegrationOptions opt)
-    : grid_(reflectance_grid) {
+                                             const std::vector<double>& reflectance_grid, IntegrationOptions opt) {
   illuminant.check_shape();
   observer.check_shape();
   if (illuminant.size() != 1) detail::fail(illuminant.source + ": expected exactly one illuminant spectrum");
   if (observer.size() != 3) detail::fail(observer.source + ": expected three colour matching functions");
   validate_emission(illuminant);
+  *this = IntegratorGrids(illuminant.wavelengths, observer, reflectance_grid, opt).integrator(illuminant);
+}
+
+IntegratorGrids::IntegratorGrids(const std::vector<double>& illuminant_grid, const SpectralSet& observer,
+                                 const std::vector<double>& reflectance_grid, IntegrationOptions opt)
+    : illuminant_grid_(illuminant_grid), reflectance_grid_(reflectance_grid), step_nm_(opt.step_nm) {
+  observer.check_shape();
+  if (observer.size() != 3) detail::fail(observer.source + ": expected three colour matching functions");
   if (reflectance_grid.size() < 2) detail::fail("reflectance grid needs at least 2 wavelengths");
   double lo = observer.wavelengths.front(), hi = observer.wavelengths.back();
   if (!opt.extrapolate_illuminant) {
-    lo = std::max(lo, illuminant.wavelengths.front());
-    hi = std::min(hi, illuminant.wavelengths.back());
+    lo = std::max(lo, illuminant_grid.front());
+    hi = std::min(hi, illuminant_grid.back());
   }
   if (!opt.extrapolate_reflectance) {
     lo = std::max(lo, reflectance_grid.front());
@@ -46,23 +53,34 @@ ReflectanceIntegrator::ReflectanceIntegrator(const SpectralSet& illuminant, cons
   std::vector<double> fine = uniform_grid(lo, hi, opt.step_nm);
   if (fine.back() < hi - 1e-9) fine.push_back(hi);
   std::vector<double> lamp_points = fine;
-  for (double& w : lamp_points) w = std::clamp(w, illuminant.wavelengths.front(), illuminant.wavelengths.back());
-  const Eigen::RowVectorXd S = illuminant.values * resampling_matrix(illuminant.wavelengths, lamp_points, opt.illuminant).transpose();
-  const Eigen::MatrixXd cmf = observer.values * resampling_matrix(observer.wavelengths, fine, opt.observer).transpose();
+  for (double& w : lamp_points) w = std::clamp(w, illuminant_grid.front(), illuminant_grid.back());
+  illuminant_ = resampling_matrix(illuminant_grid, lamp_points, opt.illuminant);
+  cmf_ = observer.values * resampling_matrix(observer.wavelengths, fine, opt.observer).transpose();
   std::vector<double> clamped = fine;
   for (double& w : clamped) w = std::clamp(w, reflectance_grid.front(), reflectance_grid.back());
   // Sprague where the grid allows it, the natural spline on short or irregular grids.
   const Interpolation refl_method = opt.reflectance == Interpolation::sprague && !sprague_applicable(reflectance_grid)
                                         ? Interpolation::cubic_spline
                                         : opt.reflectance;
-  const Eigen::MatrixXd Rm = resampling_matrix(reflectance_grid, clamped, refl_method);  // fine × bands
+  reflectance_ = resampling_matrix(reflectance_grid, clamped, refl_method);
+}
+
+ReflectanceIntegrator IntegratorGrids::integrator(const SpectralSet& illuminant) const {
+  illuminant.check_shape();
+  if (illuminant.size() != 1) detail::fail(illuminant.source + ": expected exactly one illuminant spectrum");
+  if (illuminant.wavelengths != illuminant_grid_) detail::fail(illuminant.source + ": not on the illuminant grid these weights were built for");
+  validate_emission(illuminant);
+  const Eigen::RowVectorXd S = illuminant.values * illuminant_.transpose();
   // CIE 15 sums S·x̄·R·Δλ over the grid (rectangle rule); the normalisation k cancels Δλ anyway.
-  const Eigen::RowVectorXd w = Eigen::RowVectorXd::Constant(static_cast<Eigen::Index>(fine.size()), opt.step_nm).cwiseProduct(S);
-  Eigen::MatrixXd lamp_cmf = cmf.array().rowwise() * w.array();  // 3 × fine
+  const Eigen::RowVectorXd w = Eigen::RowVectorXd::Constant(cmf_.cols(), step_nm_).cwiseProduct(S);
+  Eigen::MatrixXd lamp_cmf = cmf_.array().rowwise() * w.array();  // 3 × fine
   const double k = 100.0 / lamp_cmf.row(1).sum();
   lamp_cmf *= k;
-  weights_ = lamp_cmf * Rm;
-  white_ = {lamp_cmf.row(0).sum(), 100.0, lamp_cmf.row(2).sum()};
+  ReflectanceIntegrator out;
+  out.grid_ = reflectance_grid_;
+  out.weights_ = lamp_cmf * reflectance_;
+  out.white_ = {lamp_cmf.row(0).sum(), 100.0, lamp_cmf.row(2).sum()};
+  return out;
 }
 
 Xyz ReflectanceIntegrator::xyz(const Eigen::Ref<const Eigen::RowVectorXd>& r) const {

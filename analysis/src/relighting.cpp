@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 #include <map>
+#include <memory>
 
 #include "colorlab/analysis/blackbox.hpp"
 #include "colorlab/analysis/color_difference.hpp"
@@ -22,6 +23,86 @@ double quantile(std::vector<double> v, double q) {
   const auto lo = static_cast<std::size_t>(std::floor(pos));
   const auto hi = std::min(lo + 1, v.size() - 1);
   return v[lo] + (v[hi] - v[lo]) * (pos - static_cast<double>(lo));
+}
+
+// The posterior's square root per channel, decomposed once for any number of draws.
+class CurveSampler {
+ public:
+  explicit CurveSampler(const SensitivityEstimate& s) : mean_(s.curves) {
+    for (std::size_t c = 0; c < 3; ++c) {
+      // Eigen-decomposition rather than Cholesky: the mixture covariance is only positive semi-definite.
+      const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(s.covariance[c]);
+      vectors_[c] = eig.eigenvectors();
+      root_[c] = eig.eigenvalues().cwiseMax(0.0).cwiseSqrt();
+    }
+  }
+  // One set of curves, clipped at 0 as the sensitivities are.
+  Eigen::MatrixXd draw(std::mt19937& rng) const {
+    std::normal_distribution<double> nd(0, 1);  // fresh per draw: a draw's stream does not depend on the one before
+    Eigen::MatrixXd out = mean_;
+    for (std::size_t c = 0; c < 3; ++c) {
+      Eigen::VectorXd z(root_[c].size());
+      for (Eigen::Index k = 0; k < z.size(); ++k) z(k) = nd(rng);
+      out.row(static_cast<Eigen::Index>(c)) += (vectors_[c] * root_[c].cwiseProduct(z)).transpose();
+    }
+    return out.cwiseMax(0.0);
+  }
+
+ private:
+  Eigen::MatrixXd mean_;
+  std::array<Eigen::MatrixXd, 3> vectors_;
+  std::array<Eigen::VectorXd, 3> root_;
+};
+
+}  // namespace
+
+// The lamp-independent part of chart_under_lamp: every resampling that depends only on the grids.
+struct RelightingGrids {
+  Eigen::MatrixXd reflectance;  // n × fine: the reflectances at 1 nm over the curves' range (Sprague or cubic)
+  Eigen::MatrixXd lamp;         // fine × the lamp's bands (linear)
+  Eigen::MatrixXd curve;        // fine × the curves' bands: a curve linear between its wavelengths
+  IntegratorGrids reference;    // CIE 1931 2° reference colours for any spectrum on the lamp's wavelengths
+
+  RelightingGrids(const SpectralSet& refl, const std::vector<double>& lamp_grid, const std::vector<double>& grid)
+      : reference(lamp_grid, load_observer(Observer::cie1931_2deg), refl.wavelengths) {
+    const auto fine = uniform_grid(grid.front(), grid.back(), 1.0);
+    reflectance = resample(refl, fine, sprague_applicable(refl.wavelengths) ? Interpolation::sprague : Interpolation::cubic_spline).values;
+    lamp = resampling_matrix(lamp_grid, fine, Interpolation::linear);
+    curve = resampling_matrix(grid, fine, Interpolation::linear);
+  }
+};
+
+namespace {
+
+// The chart under one lamp from grids built for the reflectances, the lamp's wavelengths and the curves' grid.
+ChartUnderLamp relight(const SpectralSet& refl, const LampSpectrum& lamp, const std::vector<double>& grid,
+                       std::shared_ptr<const RelightingGrids> grids) {
+  const ReflectanceIntegrator integ = grids->reference.integrator(lamp.spd);  // first: it validates the spectrum
+  // RAW = Σ_fine r·l·S_fine with S_fine = M · s (M: fine × bands) for a curve linear between the grid's wavelengths.
+  const Eigen::MatrixXd l = lamp.spd.values * grids->lamp.transpose();
+  const Eigen::RowVectorXd e = l.row(0);
+  ChartUnderLamp out;
+  out.lamp = lamp.name;
+  out.lamp_measured = lamp.measured;
+  out.lamp_warning = lamp.warning();
+  out.wavelengths = grid;
+  out.reflectances = refl;
+  out.lamp_spd = lamp.spd;
+  out.radiance = (grids->reflectance.array().rowwise() * e.array()).matrix() * grids->curve;
+  out.white = e * grids->curve;
+
+  ChartData& c = out.reference;
+  c.ids = refl.names;
+  c.white = kIccD50White;
+  const auto xyz = integ.xyz(refl);
+  c.xyz.resize(static_cast<Eigen::Index>(xyz.size()), 3);
+  for (std::size_t i = 0; i < xyz.size(); ++i) {
+    const Xyz a = bradford_adapt(xyz[i], integ.white(), kIccD50White);
+    c.xyz.row(static_cast<Eigen::Index>(i)) << a.X, a.Y, a.Z;
+  }
+  c.lab = xyz_rows_to_lab(c.xyz, c.white);
+  out.grids = std::move(grids);
+  return out;
 }
 
 }  // namespace
@@ -64,6 +145,7 @@ LampSpectrum measured_lamp(const std::string& lamp, SpectralSet spd) {
 
 ChartUnderLamp chart_under_lamp(const SpectralSet& refl, const LampSpectrum& lamp, const std::vector<double>& grid) {
   refl.check_shape();
+  lamp.spd.check_shape();
   validate_reflectance(refl, 0.02);
   if (grid.size() < 3) throw Error(ErrorClass::bad_parameter, "chart under a lamp: the sensitivities' grid needs at least 3 wavelengths");
   const double lo = grid.front(), hi = grid.back();
@@ -72,34 +154,7 @@ ChartUnderLamp chart_under_lamp(const SpectralSet& refl, const LampSpectrum& lam
       throw Error(ErrorClass::bad_data, "chart under lamp " + lamp.name + ": " + s->source + " covers " +
                                             std::to_string(s->wavelengths.front()) + "–" + std::to_string(s->wavelengths.back()) +
                                             " nm, the sensitivities " + std::to_string(lo) + "–" + std::to_string(hi) + " nm");
-  const auto fine = uniform_grid(lo, hi, 1.0);
-  const SpectralSet r = resample(refl, fine, sprague_applicable(refl.wavelengths) ? Interpolation::sprague : Interpolation::cubic_spline);
-  const SpectralSet l = resample(lamp.spd, fine, Interpolation::linear);
-  // A curve linear between the grid's wavelengths is S_fine = M · s (M: fine × bands); RAW = Σ_fine r·l·S_fine.
-  const Eigen::MatrixXd M = resampling_matrix(grid, fine, Interpolation::linear);
-  const Eigen::RowVectorXd e = l.values.row(0);
-  ChartUnderLamp out;
-  out.lamp = lamp.name;
-  out.lamp_measured = lamp.measured;
-  out.lamp_warning = lamp.warning();
-  out.wavelengths = grid;
-  out.reflectances = refl;
-  out.lamp_spd = lamp.spd;
-  out.radiance = (r.values.array().rowwise() * e.array()).matrix() * M;
-  out.white = e * M;
-
-  ChartData& c = out.reference;
-  c.ids = refl.names;
-  c.white = kIccD50White;
-  const ReflectanceIntegrator integ(lamp.spd, load_observer(Observer::cie1931_2deg), refl.wavelengths);
-  const auto xyz = integ.xyz(refl);
-  c.xyz.resize(static_cast<Eigen::Index>(xyz.size()), 3);
-  for (std::size_t i = 0; i < xyz.size(); ++i) {
-    const Xyz a = bradford_adapt(xyz[i], integ.white(), kIccD50White);
-    c.xyz.row(static_cast<Eigen::Index>(i)) << a.X, a.Y, a.Z;
-  }
-  c.lab = xyz_rows_to_lab(c.xyz, c.white);
-  return out;
+  return relight(refl, lamp, grid, std::make_shared<const RelightingGrids>(refl, lamp.spd.wavelengths, grid));
 }
 
 ChartData ChartUnderLamp::predict(const Eigen::MatrixXd& curves) const {
@@ -116,7 +171,9 @@ ChartData ChartUnderLamp::predict(const Eigen::MatrixXd& curves) const {
 }
 
 ChartUnderLamp ChartUnderLamp::under(const SpectralSet& spd) const {
-  return chart_under_lamp(reflectances, LampSpectrum{lamp, spd, lamp_measured}, wavelengths);
+  const LampSpectrum drawn{lamp, spd, lamp_measured};
+  if (!grids || spd.wavelengths != lamp_spd.wavelengths) return chart_under_lamp(reflectances, drawn, wavelengths);
+  return relight(reflectances, drawn, wavelengths, grids);
 }
 
 SpectralSet draw_nominal_lamp(const SpectralSet& standard, const std::vector<double>& grid, std::mt19937& rng) {
@@ -136,19 +193,7 @@ SpectralSet draw_nominal_lamp(const SpectralSet& standard, const std::vector<dou
   return out;
 }
 
-Eigen::MatrixXd SensitivityEstimate::draw(std::mt19937& rng) const {
-  std::normal_distribution<double> nd(0, 1);
-  Eigen::MatrixXd out = curves;
-  for (std::size_t c = 0; c < 3; ++c) {
-    // Eigen-decomposition rather than Cholesky: the mixture covariance is only positive semi-definite.
-    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(covariance[c]);
-    const Eigen::VectorXd root = eig.eigenvalues().cwiseMax(0.0).cwiseSqrt();
-    Eigen::VectorXd z(root.size());
-    for (Eigen::Index k = 0; k < z.size(); ++k) z(k) = nd(rng);
-    out.row(static_cast<Eigen::Index>(c)) += (eig.eigenvectors() * root.cwiseProduct(z)).transpose();
-  }
-  return out.cwiseMax(0.0);
-}
+Eigen::MatrixXd SensitivityEstimate::draw(std::mt19937& rng) const { return CurveSampler(*this).draw(rng); }
 
 SensitivityEstimate estimate_sensitivities(const ChartUnderLamp& photographed, const Eigen::MatrixXd& raw, const SensitivityPrior& prior) {
   if (raw.rows() != photographed.radiance.rows())
@@ -179,16 +224,24 @@ LampCharacterization characterize_across_lamps(const SensitivityEstimate& s, con
     if (!model.spline()) return fit_method(chosen.method, chart, fo);
     SplineOptions so = spline_options(chosen.method, fo);
     so.smoothing = model.spline()->smoothing();
+    so.hat_matrix = !o.share_draw_work;
     return Characterization(fit_spline(chart, so));
   };
   // A nominal lamp's own uncertainty is drawn with the curves (its own stream: the curves' draws stay the same with
   // or without it). It moves the chart's camera values and its reference colours together, as a real lamp would.
   const bool draw_lamp = o.nominal_lamp_uncertainty && !target.lamp_measured;
+  auto chart_under = [&](const SpectralSet& spd) {
+    return o.share_draw_work ? target.under(spd)
+                             : chart_under_lamp(target.reflectances, LampSpectrum{target.lamp, spd, target.lamp_measured}, target.wavelengths);
+  };
+  std::optional<CurveSampler> sampler;
+  if (o.share_draw_work && o.draws > 0) sampler.emplace(s);
   std::vector<Characterization> draws;
+  draws.reserve(static_cast<std::size_t>(o.draws));
   std::mt19937 rng(o.seed), lamp_rng(o.seed + 0x9e3779b9u);
   for (int d = 0; d < o.draws; ++d) {
-    const Eigen::MatrixXd curves = s.draw(rng);
-    draws.push_back(refit(draw_lamp ? target.under(draw_nominal_lamp(target.lamp_spd, target.wavelengths, lamp_rng)).predict(curves)
+    const Eigen::MatrixXd curves = sampler ? sampler->draw(rng) : s.draw(rng);
+    draws.push_back(refit(draw_lamp ? chart_under(draw_nominal_lamp(target.lamp_spd, target.wavelengths, lamp_rng)).predict(curves)
                                     : target.predict(curves)));
   }
 

@@ -24,6 +24,16 @@ Eigen::MatrixXd cubic_kernel(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b)
   return k;
 }
 
+// The training kernel: symmetric, so each pair's pow once (‖u − v‖ and ‖v − u‖ are the same number to the bit).
+Eigen::MatrixXd cubic_kernel(const Eigen::MatrixXd& a) {
+  Eigen::MatrixXd k(a.rows(), a.rows());
+  for (Eigen::Index i = 0; i < a.rows(); ++i) {
+    k(i, i) = 0;
+    for (Eigen::Index j = i + 1; j < a.rows(); ++j) k(i, j) = k(j, i) = std::pow((a.row(i) - a.row(j)).norm(), 3);
+  }
+  return k;
+}
+
 // The base terms plus the constant and linear coordinate terms the r³ kernel needs; a constant already in the base
 // is not repeated (a duplicate column would make the system singular).
 Eigen::MatrixXd polynomial_part(const TermSet& base, const Eigen::MatrixXd& rgb_scaled, const Eigen::MatrixXd& u) {
@@ -170,7 +180,7 @@ FitWithHat SplineFitter::fit(const ChartData& train, const SplineOptions& o) {
   model.input_scale_ = o.input_scale > 0 ? o.input_scale : (train.rgb.maxCoeff() > 0 ? train.rgb.maxCoeff() : 1.0);
   const Eigen::MatrixXd scaled = train.rgb / model.input_scale_;
   model.centres_ = cube_root_coordinates(train.rgb, model.input_scale_);
-  const Eigen::MatrixXd K = cubic_kernel(model.centres_, model.centres_);
+  const Eigen::MatrixXd K = cubic_kernel(model.centres_);
   const Eigen::MatrixXd P = polynomial_part(model.base_, scaled, model.centres_);
   const Eigen::Index n = K.rows();
   Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(P);
@@ -186,8 +196,8 @@ FitWithHat SplineFitter::fit(const ChartData& train, const SplineOptions& o) {
   // A fixed λ is one solve; the search decomposes once (eigen) or solves at every λ (direct, the reference).
   std::optional<Smoother> smoother;
   if (!o.smoothing && o.search == SmoothingSearch::eigen) smoother.emplace(K, P, w, Y);
-  auto solve = [&](double l, bool want_coefficients) {
-    return smoother ? smoother->at(l, true, want_coefficients) : solve_at(K, P, w, Y, l, true);
+  auto solve = [&](double l, bool want_coefficients, bool want_hat = true) {
+    return smoother ? smoother->at(l, true, want_coefficients) : solve_at(K, P, w, Y, l, want_hat);
   };
   double lambda = o.smoothing.value_or(0);
   if (!o.smoothing) {
@@ -214,11 +224,12 @@ FitWithHat SplineFitter::fit(const ChartData& train, const SplineOptions& o) {
     if (!std::isfinite(best))
       throw Error(ErrorClass::bad_data, model.method_ + ": no smoothing value gives finite leave-one-out errors");
   }
-  Solved s = solve(lambda, true);
+  const bool want_hat = o.hat_matrix || !o.smoothing;  // a search has it anyway
+  Solved s = solve(lambda, true, want_hat);
   model.smoothing_ = lambda;
   model.kernel_ = s.c;
   model.poly_ = s.d;
-  model.dof_ = s.trace;
+  model.dof_ = want_hat ? s.trace : std::numeric_limits<double>::quiet_NaN();
   return {std::move(model), std::move(s)};
 }
 
@@ -247,7 +258,7 @@ Eigen::MatrixXd spline_loo_targets(const ChartData& data, const SplineOptions& o
   if (!o.smoothing) throw Error(ErrorClass::bad_parameter, "spline_loo_targets needs the smoothing λ");
   const double scale = o.input_scale > 0 ? o.input_scale : (data.rgb.maxCoeff() > 0 ? data.rgb.maxCoeff() : 1.0);
   const Eigen::MatrixXd u = cube_root_coordinates(data.rgb, scale);
-  const Eigen::MatrixXd K = cubic_kernel(u, u);
+  const Eigen::MatrixXd K = cubic_kernel(u);
   const Eigen::MatrixXd P = polynomial_part(term_set_by_name(o.base), data.rgb / scale, u);
   const Eigen::MatrixXd Y = target_of(data, o.target);
   return loo_predictions(solve_at(K, P, target_weights(data, o.target), Y, *o.smoothing, true), Y);
@@ -263,7 +274,9 @@ FitReport spline_report(const ChartData& data, const SplineOptions& o, const CvS
   const Eigen::MatrixXd Y = target_of(data, o.target);
   Eigen::MatrixXd pred = Eigen::MatrixXd::Constant(n, 3, std::numeric_limits<double>::quiet_NaN());
   try {
-    const FitWithHat fitted = SplineFitter::fit(data, o);
+    SplineOptions with_hat = o;
+    with_hat.hat_matrix = true;
+    const FitWithHat fitted = SplineFitter::fit(data, with_hat);
     const SplineModel& model = fitted.model;
     r.terms = model.base_terms();
     r.parameters = model.effective_parameters();

@@ -2,7 +2,8 @@
 // sensitivities, beside today's same-lamp selection and ArgyllCMS colprof -ax / -am, in one run on the same data.
 //
 //   bench_analysis_across_lamps [--quality m] [--cameras Canon_20D,…] [--conditions A,F11] [--draws 40] [--argyll 1]
-//                               [--noise 0.005] [--keep DIR] [--ab 1] [--remedy 1 [--pareto FILE]] [--band-before 1]
+//                               [--noise 0.005] [--keep DIR] [--ab 1] [--band-ab 1] [--remedy 1 [--pareto FILE]]
+//                               [--band-before 1]
 //
 // --band-before 1: beside each case's band, the band without the nominal lamp's own uncertainty (the sensitivities
 // and the family's misfit only, as before it was carried): coverage and mean radius against the mean ΔE00 it covers.
@@ -12,6 +13,11 @@
 //
 // --ab 1: the spline's λ search both ways, interleaved case by case (the LU per λ, then one eigendecomposition):
 // today's selection and the across-lamps fit timed and their ΔE00 compared (docs/PERFORMANCE.md, issue 26).
+//
+// --band-ab 1: the fit with its band (--draws posterior refits) both ways, interleaved case by case: every draw
+// rebuilding the chart's resampling, the posterior's decomposition and the spline's hat matrix (A, before), and that
+// work shared across the draws (B, AcrossLampsOptions::share_draw_work): CPU and wall time, the band's radii compared
+// patch by patch, its coverage and the point fit's mean / max ΔE00 under each (docs/PERFORMANCE.md, issue 26).
 //
 // Fairness (issue 26): the training photograph is the SG under D65 with 0.5 % multiplicative RAW noise (seed 1); the
 // sensitivities are estimated from it with the camera left out of the prior; the test chart (CC24) is photographed
@@ -91,6 +97,8 @@ std::string fmt(const Figure& f) {
 struct Timer {
   Clock::time_point wall = Clock::now();
   std::clock_t cpu = std::clock();
+  double cpu_ms() const { return 1000.0 * static_cast<double>(std::clock() - cpu) / CLOCKS_PER_SEC; }
+  double wall_ms() const { return std::chrono::duration<double, std::milli>(Clock::now() - wall).count(); }
   std::string ms() const {
     std::ostringstream s;
     s << std::fixed << std::setprecision(0) << 1000.0 * static_cast<double>(std::clock() - cpu) / CLOCKS_PER_SEC << " ms cpu ("
@@ -147,7 +155,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> cameras = kCameras;
   std::vector<std::string> condition_names = {"A", "F11", "F2"};
   std::optional<fs::path> keep, pareto;
-  bool argyll = true, remedy = false, ab = false, band_before = false;
+  bool argyll = true, remedy = false, ab = false, band_before = false, band_ab = false;
   int draws = 40;
   double noise = 0.005;
   for (int i = 1; i + 1 < argc; i += 2) {
@@ -161,6 +169,7 @@ int main(int argc, char** argv) {
     else if (a == "--noise") noise = std::stod(v);
     else if (a == "--remedy") remedy = v == "1";
     else if (a == "--ab") ab = v == "1";
+    else if (a == "--band-ab") band_ab = v == "1";
     else if (a == "--band-before") band_before = v == "1";
     else if (a == "--pareto") pareto = v;
     else {
@@ -214,6 +223,15 @@ int main(int argc, char** argv) {
   std::string worst_case;
   std::vector<std::string> timing_rows, remedy_rows, ab_rows;
   double ab_worst = 0;
+  // --band-ab: per path (false = A, rebuilt per draw; true = B, shared), CPU and wall ms of fit + band, coverage.
+  struct BandPath {
+    std::vector<double> cpu, wall;
+    long inside = 0;
+    int cases_below_80 = 0;
+  };
+  std::map<bool, BandPath> band_paths;
+  std::vector<std::string> band_ab_rows;
+  double band_ab_radius = 0, band_ab_de = 0;
   // The Pareto chart's points: per remedy, the sums over cases of mean and max ΔE00, the worst max, the cases.
   struct Point {
     int photographs = 0;
@@ -343,6 +361,42 @@ int main(int argc, char** argv) {
             << fit_t[ca::SmoothingSearch::direct] << " | " << fit_t[ca::SmoothingSearch::eigen] << " |";
         ab_rows.push_back(row.str());
       }
+      if (band_ab) {
+        // A (false) and B (true) interleaved, the order alternating so that load drift favours neither.
+        const std::vector<bool> order = band_ab_rows.size() % 2 == 0 ? std::vector{false, true} : std::vector{true, false};
+        std::map<bool, Eigen::VectorXd> radius;
+        std::map<bool, ca::ErrorStats> point;
+        std::map<bool, std::string> took;
+        std::map<bool, long> in_band;
+        for (const bool shared : order) {
+          ca::AcrossLampsOptions bo;
+          bo.draws = draws;
+          bo.share_draw_work = shared;
+          Timer tb;
+          const auto lc = ca::characterize_across_lamps(est, sg_assumed.at(cond.name), bo);
+          BandPath& p = band_paths[shared];
+          p.cpu.push_back(tb.cpu_ms());
+          p.wall.push_back(tb.wall_ms());
+          took[shared] = tb.ms();
+          point[shared] = ca::evaluate(lc.apply(test.rgb), test.lab);
+          radius[shared] = lc.uncertainty95(test.rgb);
+          long in = 0;
+          for (Eigen::Index i = 0; i < radius[shared].size(); ++i) in += point[shared].de00[static_cast<std::size_t>(i)] <= radius[shared](i);
+          in_band[shared] = in;
+          p.inside += in;
+          p.cases_below_80 += static_cast<double>(in) < 0.8 * static_cast<double>(radius[shared].size());
+        }
+        const double dr = (radius[false] - radius[true]).cwiseAbs().maxCoeff();
+        const double dd = std::max(std::abs(point[false].s00.mean - point[true].s00.mean), std::abs(point[false].s00.max - point[true].s00.max));
+        band_ab_radius = std::max(band_ab_radius, dr);
+        band_ab_de = std::max(band_ab_de, dd);
+        const auto n = static_cast<double>(radius[true].size());
+        std::ostringstream row;
+        row << "| " << cam << " | " << cond.name << " | " << relit.family << " | " << took[false] << " | " << took[true] << " | " << std::fixed
+            << std::setprecision(0) << 100.0 * static_cast<double>(in_band[false]) / n << " % | " << 100.0 * static_cast<double>(in_band[true]) / n
+            << " % | " << std::scientific << std::setprecision(1) << dr << " | " << dd << " |" << std::defaultfloat;
+        band_ab_rows.push_back(row.str());
+      }
       const Eigen::VectorXd band = relit.uncertainty95(test.rgb);
       long inside = 0;
       for (Eigen::Index i = 0; i < band.size(); ++i) inside += e.de00[static_cast<std::size_t>(i)] <= band(i);
@@ -422,6 +476,29 @@ int main(int argc, char** argv) {
                  "|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const auto& r : ab_rows) std::cout << r << "\n";
     std::cout << "largest |direct − eigen| of the mean and max ΔE00 above: " << std::setprecision(4) << ab_worst << "\n";
+  }
+  if (band_ab) {
+    std::cout << "\n| camera | test lamp | chosen | fit + band, A (rebuilt per draw) | fit + band, B (shared) | inside, A | inside, B | "
+                 "largest |A − B| of a patch's radius (ΔE00) | |A − B| of mean / max ΔE00 |\n|---|---|---|---|---|---|---|---|---|\n";
+    for (const auto& r : band_ab_rows) std::cout << r << "\n";
+    for (const bool shared : {false, true}) {
+      const BandPath& p = band_paths[shared];
+      auto stats = [](std::vector<double> v) {
+        std::sort(v.begin(), v.end());
+        double sum = 0;
+        for (const double x : v) sum += x;
+        std::ostringstream s;
+        s << std::fixed << std::setprecision(0) << v.front() << "–" << v.back() << " ms, mean " << sum / static_cast<double>(v.size())
+          << ", median " << v[v.size() / 2];
+        return s.str();
+      };
+      std::cout << (shared ? "B (shared across the draws)" : "A (rebuilt per draw, before)") << ": fit + " << draws
+                << " posterior refits " << stats(p.cpu) << " CPU; wall " << stats(p.wall) << "; truth inside the 95 % band "
+                << std::fixed << std::setprecision(1) << 100.0 * static_cast<double>(p.inside) / static_cast<double>(std::max(1L, patches_all))
+                << " % of " << patches_all << " patches, cases below 80 %: " << p.cases_below_80 << "\n";
+    }
+    std::cout << "largest |A − B| of a patch's band radius: " << std::scientific << std::setprecision(1) << band_ab_radius
+              << " ΔE00; of a case's mean or max ΔE00: " << band_ab_de << std::defaultfloat << "\n";
   }
   if (remedy) {
     std::cout << "\n| camera | test lamp | photographs (training lamps) | mean / max ΔE00 | selection time |\n|---|---|---|---|---|\n";

@@ -212,3 +212,53 @@ TEST(AcrossLamps, NominalLampDrawsAreSmoothAndMeasuredLampsAreNotDrawn) {
   EXPECT_EQ(band_on, band_off) << "a measured lamp carries no nominal lamp's uncertainty";
   EXPECT_GT(band_on.minCoeff(), 0.0);
 }
+
+// The band's draws share what does not depend on the draw (the chart's resampling, the posterior's decomposition)
+// and refit a spline without its hat matrix (issue 26's speed): the same arithmetic as rebuilding all of it per
+// draw, so the same band to the last digit — and a chart rebuilt under another spectrum through the kept grids is the
+// chart built from scratch under it.
+TEST(AcrossLamps, BandSharingTheDrawsWorkEqualsRebuildingIt) {
+  const std::vector<double> grid = ca::uniform_grid(400, 720, 10);
+  ca::SpectralSet refl;
+  refl.wavelengths = ca::uniform_grid(380, 730, 10);
+  refl.values.resize(40, static_cast<Eigen::Index>(refl.wavelengths.size()));
+  for (int i = 0; i < 40; ++i) {
+    refl.names.push_back("p" + std::to_string(i));
+    for (std::size_t j = 0; j < refl.wavelengths.size(); ++j)
+      refl.values(i, static_cast<Eigen::Index>(j)) =
+          0.5 + 0.4 * std::sin(0.3 * i + (refl.wavelengths[j] - 380) / (40.0 + 3 * i)) * std::cos(0.7 * i);
+  }
+  ca::SensitivityEstimate est;
+  est.wavelengths = grid;
+  est.curves.resize(3, static_cast<Eigen::Index>(grid.size()));
+  for (int c = 0; c < 3; ++c) {
+    for (std::size_t j = 0; j < grid.size(); ++j)
+      est.curves(c, static_cast<Eigen::Index>(j)) = std::exp(-0.5 * std::pow((grid[j] - (600.0 - 70 * c)) / 35.0, 2));
+    est.covariance[static_cast<std::size_t>(c)] = 1e-4 * Eigen::MatrixXd::Identity(est.curves.cols(), est.curves.cols());
+  }
+  const auto f11 = ca::chart_under_lamp(refl, ca::nominal_lamp("TL84"), grid);  // nominal: every draw draws the lamp too
+  std::mt19937 rng(5);
+  const ca::SpectralSet drawn = ca::draw_nominal_lamp(f11.lamp_spd, grid, rng);
+  const auto kept = f11.under(drawn);
+  const auto fresh = ca::chart_under_lamp(refl, ca::LampSpectrum{"TL84", drawn, false}, grid);
+  EXPECT_EQ(kept.radiance, fresh.radiance);
+  EXPECT_EQ(kept.white, fresh.white);
+  EXPECT_EQ(kept.reference.xyz, fresh.reference.xyz);
+  EXPECT_EQ(kept.reference.lab, fresh.reference.lab);
+
+  for (const std::string method : {"rbf:ccm", "rootpoly:2"}) {
+    SCOPED_TRACE(method);
+    ca::AcrossLampsOptions shared, rebuilt;
+    shared.methods = rebuilt.methods = {method};
+    shared.targets = rebuilt.targets = {ca::FitTarget::xyz_then_lab};
+    shared.draws = rebuilt.draws = 6;
+    rebuilt.share_draw_work = false;
+    const auto a = ca::characterize_across_lamps(est, f11, shared), b = ca::characterize_across_lamps(est, f11, rebuilt);
+    ASSERT_EQ(a.family, method);
+    const auto rgb = f11.predict(est.curves).rgb;
+    const Eigen::VectorXd band = a.uncertainty95(rgb);
+    EXPECT_EQ(band, b.uncertainty95(rgb));
+    EXPECT_EQ(a.apply(rgb), b.apply(rgb));
+    EXPECT_GT(band.minCoeff(), 0.0);
+  }
+}

@@ -49,9 +49,30 @@ class ReflectanceIntegrator {
   const Eigen::MatrixXd& weights() const { return weights_; }  // 3 × bands
 
  private:
+  friend class IntegratorGrids;
+  ReflectanceIntegrator() = default;
   std::vector<double> grid_;
   Eigen::MatrixXd weights_;
   Xyz white_;
+};
+
+// What a ReflectanceIntegrator resamples, for every illuminant tabulated on one grid: kept where many spectra on the
+// same wavelengths are integrated (each posterior draw of a nominal lamp, relighting.hpp), so that each integrator
+// costs two small products instead of three resampling matrices. integrator(s) is ReflectanceIntegrator(s, observer,
+// reflectance_grid, options), the same arithmetic.
+class IntegratorGrids {
+ public:
+  IntegratorGrids(const std::vector<double>& illuminant_grid, const SpectralSet& observer, const std::vector<double>& reflectance_grid,
+                  IntegrationOptions options = {});
+  // illuminant: one spectrum on illuminant_grid (Error(bad_data) otherwise).
+  ReflectanceIntegrator integrator(const SpectralSet& illuminant) const;
+
+ private:
+  std::vector<double> illuminant_grid_, reflectance_grid_;
+  double step_nm_ = 1;
+  Eigen::MatrixXd illuminant_;   // fine × illuminant bands
+  Eigen::MatrixXd cmf_;          // 3 × fine: the observer on the fine grid
+  Eigen::MatrixXd reflectance_;  // fine × reflectance bands
 };
 
 // Convenience: reflectances under a named/loaded illuminant.

@@ -18,6 +18,7 @@
 // under B.
 #include <Eigen/Dense>
 #include <array>
+#include <memory>
 #include <optional>
 #include <random>
 #include <string>
@@ -43,6 +44,8 @@ LampSpectrum nominal_lamp(const std::string& lamp);
 // A measured spectrum (one row, non-negative, not all zero); throws Error(bad_data) otherwise.
 LampSpectrum measured_lamp(const std::string& lamp, SpectralSet spd);
 
+struct RelightingGrids;  // relighting.cpp: what rebuilding a chart under another spectrum on the same grids reuses
+
 // The chart under one lamp, precomputed so that a chart can be predicted from any curves cheaply.
 struct ChartUnderLamp {
   std::string lamp;
@@ -56,10 +59,15 @@ struct ChartUnderLamp {
   ChartData reference;       // ids, XYZ (CIE 1931 2° under the lamp, Bradford to ICC D50) and L*a*b*; rgb empty
   SpectralSet reflectances;  // what the chart was built from: kept so that it can be rebuilt under a drawn lamp
   SpectralSet lamp_spd;
+  // The resampling that does not depend on the lamp's values (reflectances at 1 nm, the lamp's and the curves'
+  // resampling matrices, the reference colours' integration grids): under() a spectrum on lamp_spd's wavelengths
+  // reuses it — a posterior draw's chart then costs two small products, not six resampling matrices.
+  std::shared_ptr<const RelightingGrids> grids;
 
   // rgb = RAW ÷ RAW of the perfect white under this lamp, per channel; curves: 3 × bands.
   ChartData predict(const Eigen::MatrixXd& curves) const;
-  // The same chart under another spectrum for the same lamp (a draw of what a nominal lamp may really emit).
+  // The same chart under another spectrum for the same lamp (a draw of what a nominal lamp may really emit); the same
+  // arithmetic as chart_under_lamp(reflectances, that spectrum, wavelengths).
   ChartUnderLamp under(const SpectralSet& spd) const;
 };
 // grid: the sensitivities' wavelengths (inside the reflectances' and the lamp's range).
@@ -102,6 +110,11 @@ struct AcrossLampsOptions {
   // band carries the sensitivities and the family's misfit only (the bench's before/after; docs/ACCURACY.md §6).
   bool nominal_lamp_uncertainty = true;
   SmoothingSearch spline_search = SmoothingSearch::eigen;  // direct: the reference path (bench A/B)
+  // What the draws share is computed once: the posterior's decomposition, the chart's resampling (under()), and a
+  // spline refit solves for its coefficients only, not its hat matrix (the band uses the model, not its leverages).
+  // false: the reference path, as before 2026-11-29 — each draw rebuilds all of it (bench --band-ab 1; the same band
+  // to the last digit, AcrossLamps.BandSharingTheDrawsWorkEqualsRebuildingIt).
+  bool share_draw_work = true;
 };
 
 // One characterization per lamp, named by it.

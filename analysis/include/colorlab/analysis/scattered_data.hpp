@@ -35,6 +35,10 @@ struct SplineOptions {
   // the best λ's mean (the one-standard-error rule of Breiman et al. 1984).
   std::optional<double> smoothing_tolerance;                      // log-spaced grid
   SmoothingSearch search = SmoothingSearch::eigen;  // same λ and fit either way, to rounding; eigen is ~10× cheaper
+  // false, at a given λ: the coefficients only, without the hat matrix (an n-column solve, most of a refit's time);
+  // effective_parameters() is then NaN. For refits whose model alone is used (the across-lamps band's draws).
+  // spline_report always solves for it: its LOO errors are the hat's leverages.
+  bool hat_matrix = true;
 };
 
 class SplineModel {
