@@ -24,23 +24,30 @@ ChartInRendering locate_chart_in_rendering(const Rendering& r, const json& chart
     throw Error(ErrorClass::unsupported, "a reflective spectral rendering has no luminance to find the chart in",
                 "render the scene's radiance (JCGT's emissive S0 layer)");
   // Luminance in the renderer's unit, then 16-bit linear counts with the image's bright end near full scale (the
-  // 99.9th percentile, so a lamp in view does not leave the chart in the lowest bits).
+  // 99.9th percentile, so a lamp in view does not leave the chart in the lowest bits). Y is linear in the channels,
+  // so it is one dot product per pixel with the conversion's Y row (read off unit vectors), in float: at 3504 × 2336
+  // the per-pixel 3 × N product and two double copies of the image cost more than the locator itself (perf,
+  // bench_verify_speed).
   const detail::ToXyz to_xyz(r);
   const int n = r.channels();
-  std::vector<double> y(static_cast<std::size_t>(r.width) * static_cast<std::size_t>(r.height));
-  Eigen::VectorXd ch(n);
+  std::vector<float> y_row(static_cast<std::size_t>(n));
+  for (int c = 0; c < n; ++c) y_row[static_cast<std::size_t>(c)] = static_cast<float>(to_xyz(Eigen::VectorXd::Unit(n, c)).Y);
+  std::vector<float> y(static_cast<std::size_t>(r.width) * static_cast<std::size_t>(r.height));
   for (std::size_t i = 0; i < y.size(); ++i) {
     const float* p = r.pixels.data() + i * static_cast<std::size_t>(n);
-    for (int c = 0; c < n; ++c) ch[c] = p[c];
-    y[i] = std::max(0.0, to_xyz(ch).Y);
+    float sum = 0;
+    for (int c = 0; c < n; ++c) sum += y_row[static_cast<std::size_t>(c)] * p[c];
+    y[i] = std::max(0.0f, sum);
   }
-  std::vector<double> sorted = y;
+  std::vector<float> sorted = y;
   const auto k = static_cast<std::ptrdiff_t>(0.999 * static_cast<double>(sorted.size() - 1));
   std::nth_element(sorted.begin(), sorted.begin() + k, sorted.end());
   const double top = sorted[static_cast<std::size_t>(k)];
+  std::vector<float>().swap(sorted);
   if (!(top > 0)) throw Error(ErrorClass::bad_data, "the rendering is black: no chart to find in it");
   std::vector<std::uint16_t> grey(y.size());
-  for (std::size_t i = 0; i < y.size(); ++i) grey[i] = static_cast<std::uint16_t>(std::min(65535.0, std::round(y[i] / top * 60000.0)));
+  const double to_counts = 60000.0 / top;
+  for (std::size_t i = 0; i < y.size(); ++i) grey[i] = static_cast<std::uint16_t>(std::min(65535.0, std::round(y[i] * to_counts)));
 
   ca::PhotoView view;
   view.data = grey.data();
