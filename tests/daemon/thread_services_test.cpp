@@ -2,8 +2,9 @@
 // threaded tests under ThreadSanitizer, docs/TESTING.md). The step committer's second writer commits two
 // executions' steps while the first writer appends events on the io thread; the event hub watches the log
 // through its own read connection and wakes streams waiting on two pool threads, which read the events through
-// theirs; the notifier takes notifications from several threads at once. What is checked holds on any machine:
-// every step once and in order, every waiter sees every step, every notification delivered once. Every wait is
+// theirs; the blob store's check runs on its thread while two threads keep frames and the io thread asks how it
+// goes; the notifier takes notifications from several threads at once. What is checked holds on any machine:
+// every step once and in order, every waiter sees every step, every kept frame whole, every notification delivered once. Every wait is
 // bounded and says what it waited for.
 #include <atomic>
 #include <chrono>
@@ -11,6 +12,7 @@
 #include <future>
 #include <map>
 #include <set>
+#include <span>
 #include <string>
 #include <thread>
 #include <vector>
@@ -24,10 +26,12 @@
 #include <boost/asio/use_future.hpp>
 #include <gtest/gtest.h>
 
+#include "colorlab/daemon/blob_service.hpp"
 #include "colorlab/daemon/event_hub.hpp"
 #include "colorlab/daemon/notifier.hpp"
 #include "colorlab/daemon/read_connections.hpp"
 #include "colorlab/daemon/step_committer.hpp"
+#include "colorlab/store/blob_store.hpp"
 #include "colorlab/store/store.hpp"
 #include "colorlab/testing/temp_dir.hpp"
 
@@ -222,6 +226,74 @@ TEST(ThreadServices, NotificationsFromSeveralThreadsAreEachDeliveredOnce) {
     seen.insert({d.value("sender", -1), d.value("n", -1)});
   }
   EXPECT_EQ(seen.size(), static_cast<std::size_t>(kThreads * kEach));
+}
+
+TEST(ThreadServices, TheBlobCheckRunsOnItsThreadWhileFramesAreKeptFromTwoOthers) {
+  TempDir dir;
+  IoThread main;
+  Store writer(dir / "colorlab.db");
+  BlobService blobs(main.io, writer, dir.path(), {});
+  auto keep = [&blobs](const std::string& text) {
+    return blobs.keep_bytes("n", "raw", "application/octet-stream", json::object(),
+                            std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+  };
+  // Eight frames a committed step owns, before the check starts.
+  store::NewRun run;
+  run.campaign = "frame-average";
+  run.params = json::object();
+  run.instruments = json::array();
+  run.script_sha256 = "s";
+  run.script_source = "x";
+  const auto e = writer.create_execution(run).execution;
+  store::StepRecord step;
+  step.step = "s";
+  for (int i = 0; i < 8; ++i) {
+    const auto b = keep("committed frame " + std::to_string(i));
+    step.blobs.push_back({b.sha256, "frame/" + std::to_string(i), b.kind, b.media_type, b.size, b.meta});
+  }
+  writer.commit_step(e, step);
+
+  // The check starts on the io thread (it reads the rows through the writer there); two campaign threads keep frames
+  // meanwhile, as the frame keeper's worker does during a night.
+  auto started = asio::co_spawn(main.io, [&blobs]() -> asio::awaitable<void> {
+    blobs.start_check();
+    co_return;
+  }, asio::use_future);
+  ASSERT_EQ(started.wait_for(60s), std::future_status::ready) << "the io thread did not start the check within 60 s";
+  started.get();
+  std::vector<std::future<std::vector<records::BlobRef>>> keepers;
+  for (int t = 0; t < 2; ++t) {
+    keepers.push_back(std::async(std::launch::async, [&keep, t] {
+      std::vector<records::BlobRef> kept;
+      for (int i = 0; i < 10; ++i) kept.push_back(keep("frame " + std::to_string(i) + " of thread " + std::to_string(t)));
+      return kept;
+    }));
+  }
+  json report;
+  const auto deadline = std::chrono::steady_clock::now() + 120s;
+  while (std::chrono::steady_clock::now() < deadline) {
+    report = blobs.check_report();  // the API's question, from another thread than the check's and the io thread
+    if (report.value("state", "") != "running") break;
+    std::this_thread::sleep_for(5ms);
+  }
+  ASSERT_EQ(report.value("state", ""), "done") << report.dump();
+  EXPECT_EQ(report.value("verified", ""), "sha256");
+  EXPECT_EQ(report.value("rows", 0), 8);
+  EXPECT_TRUE(report["missing"].empty()) << report.dump();
+  EXPECT_TRUE(report["mismatched"].empty()) << report.dump();
+  EXPECT_TRUE(report["partial"].empty()) << report.dump();
+  for (auto& k : keepers) {
+    ASSERT_EQ(k.wait_for(60s), std::future_status::ready) << "keeping frames did not end within 60 s";
+    for (const auto& b : k.get()) {
+      EXPECT_EQ(store::BlobStore::hash_file(blobs.files().path_of(b.sha256)), b.sha256) << "a kept frame is not whole";
+    }
+  }
+  // The check's event was appended on the io thread, the writer's (before the report said done).
+  auto events = asio::co_spawn(main.io, [&writer]() -> asio::awaitable<std::size_t> {
+    co_return writer.events(0, 100, std::string("blobs")).size();
+  }, asio::use_future);
+  ASSERT_EQ(events.wait_for(60s), std::future_status::ready);
+  EXPECT_EQ(events.get(), 1u);
 }
 
 }  // namespace
