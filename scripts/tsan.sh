@@ -5,8 +5,8 @@
 # fail in a way that does not say why; the report files do). Not part of CI.
 #   scripts/tsan.sh [--whole] [CTEST ARGS...]    e.g. --repeat until-fail:3
 # Without --whole: the HTTP server, the camera's frame pipeline and the daemon's thread-owning services
-# (daemon_thread_services_tests), about 60 compilations. With --whole: also the programs that link the whole
-# daemon and the integration tests that run colorlabd, about 250 more.
+# (daemon_thread_services_tests), 51 compilations. With --whole: also the programs that link the whole
+# daemon and the integration tests that run colorlabd, about 200 more.
 # Runs under `setarch -R` (GCC 12's TSan cannot map its shadow memory when vm.mmap_rnd_bits is above 28) and
 # `nice -n 19`.
 set -euo pipefail
