@@ -4,9 +4,9 @@
 # the colorlabd and colorlab-sim the integration tests start (a daemon stopped by a report can make its test
 # fail in a way that does not say why; the report files do). Not part of CI.
 #   scripts/tsan.sh [--whole] [CTEST ARGS...]    e.g. --repeat until-fail:3
-# Without --whole: the HTTP server, the camera's frame pipeline, the store's WAL bound with a reader reading and the
-# daemon's thread-owning services (daemon_thread_services_tests), 52 compilations. With --whole: also the programs that link the whole
-# daemon and the integration tests that run colorlabd, about 200 more.
+# Without --whole: the HTTP server, the camera's frame pipeline, the store's WAL bound with a reader reading and
+# the daemon's thread-owning services (daemon_thread_services_tests), 52 compilations. With --whole: also the
+# programs that link the whole daemon and the integration tests that run colorlabd, about 200 more.
 # Runs under `setarch -R` (GCC 12's TSan cannot map its shadow memory when vm.mmap_rnd_bits is above 28) and
 # `nice -n 19`.
 set -euo pipefail
@@ -31,7 +31,8 @@ names = [t["name"] for t in json.load(sys.stdin)["tests"]
 print("^(" + "|".join(re.escape(n) for n in names) + ")$" if names else "^$no-test")
 ' "${targets[@]}")
 reports=$(mktemp -d /tmp/colorlab-tsan-XXXXXX)
-export TSAN_OPTIONS="suppressions=$(pwd)/tests/tsan.supp halt_on_error=1 second_deadlock_stack=1 log_path=$reports/report"
+TSAN_OPTIONS="suppressions=$(pwd)/tests/tsan.supp halt_on_error=1 second_deadlock_stack=1"
+export TSAN_OPTIONS="$TSAN_OPTIONS log_path=$reports/report"
 status=0
 setarch -R nice -n 19 ctest --test-dir build-tsan -R "$regex" -j1 --timeout 900 --output-on-failure "$@" || status=$?
 if compgen -G "$reports/report*" >/dev/null; then

@@ -1,11 +1,11 @@
 // colorlabd's services that own a thread, driven across threads as the daemon drives them (issue 24: the daemon's
-// threaded tests under ThreadSanitizer, docs/TESTING.md). The step committer's second writer commits two
-// executions' steps while the first writer appends events on the io thread; the event hub watches the log
-// through its own read connection and wakes streams waiting on two pool threads, which read the events through
-// theirs; the blob store's check runs on its thread while two threads keep frames and the io thread asks how it
-// goes; the notifier takes notifications from several threads at once. What is checked holds on any machine:
-// every step once and in order, every waiter sees every step, every kept frame whole, every notification delivered once. Every wait is
-// bounded and says what it waited for.
+// threaded tests under ThreadSanitizer, docs/TESTING.md). The step committer's second writer commits two executions'
+// steps while the first writer appends events on the io thread; the event hub watches the log through its own read
+// connection and wakes streams waiting on two pool threads, which read the events through theirs; the blob store's
+// check runs on its thread while two threads keep frames and a third asks how it goes; the notifier takes
+// notifications from several threads at once. What is checked holds on any machine: every step once and in order,
+// every waiter sees every step, every kept frame whole, every notification delivered once. Every wait is bounded and
+// says what it waited for.
 #include <atomic>
 #include <chrono>
 #include <fstream>
@@ -117,7 +117,8 @@ TEST(ThreadServices, TwoWritersCommitWhileTheHubWakesStreamsOnPoolThreadsAndEach
   // Two streams, each on its own strand of the pool, as two connections would be.
   std::vector<std::future<std::map<std::string, std::vector<std::string>>>> streams;
   for (int i = 0; i < 2; ++i) {
-    streams.push_back(asio::co_spawn(asio::make_strand(pool), follow(hub, readers, start, 2 * kSteps), asio::use_future));
+    streams.push_back(
+        asio::co_spawn(asio::make_strand(pool), follow(hub, readers, start, 2 * kSteps), asio::use_future));
   }
   // Both executions commit through the second writer while the first writer records other events on the io thread.
   auto commit_all = [&committer](store::ExecutionRecord e) -> asio::awaitable<void> {
@@ -234,8 +235,9 @@ TEST(ThreadServices, TheBlobCheckRunsOnItsThreadWhileFramesAreKeptFromTwoOthers)
   Store writer(dir / "colorlab.db");
   BlobService blobs(main.io, writer, dir.path(), {});
   auto keep = [&blobs](const std::string& text) {
+    const auto* bytes = reinterpret_cast<const std::uint8_t*>(text.data());
     return blobs.keep_bytes("n", "raw", "application/octet-stream", json::object(),
-                            std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+                            std::span<const std::uint8_t>(bytes, text.size()));
   };
   // Eight frames a committed step owns, before the check starts.
   store::NewRun run;
@@ -265,7 +267,9 @@ TEST(ThreadServices, TheBlobCheckRunsOnItsThreadWhileFramesAreKeptFromTwoOthers)
   for (int t = 0; t < 2; ++t) {
     keepers.push_back(std::async(std::launch::async, [&keep, t] {
       std::vector<records::BlobRef> kept;
-      for (int i = 0; i < 10; ++i) kept.push_back(keep("frame " + std::to_string(i) + " of thread " + std::to_string(t)));
+      for (int i = 0; i < 10; ++i) {
+        kept.push_back(keep("frame " + std::to_string(i) + " of thread " + std::to_string(t)));
+      }
       return kept;
     }));
   }
