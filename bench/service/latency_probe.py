@@ -125,6 +125,8 @@ def split_answer(ms, t, client=None):
         handler, cpu, store = t.get("handler", 0.0), t.get("cpu", 0.0), t.get("store", 0.0)
         out = {"queued": t.get("queue", 0.0), "handler_cpu": min(cpu, handler), "store": store,
                "handler_waiting": max(0.0, handler - min(cpu, handler) - store), "later": t.get("later", 0.0),
+               # The rest of app: a pool route's continuation waiting for an HTTP-pool thread (docs/API.md).
+               "app_other": max(0.0, app - t.get("queue", 0.0) - handler - t.get("later", 0.0)),
                "outside": max(0.0, ms - app)}
     if client is not None:
         waiting, on_cpu, in_gc = client
@@ -321,7 +323,8 @@ def io_thread_log(log_path, start, end):
 
 def attribution(times):
     """The answers beyond slow_ms: how many, the ms in each part summed, and how many each part dominated."""
-    parts = ("queued", "handler_cpu", "handler_waiting", "store", "later", "client_waiting", "client_cpu", "rest")
+    parts = ("queued", "handler_cpu", "handler_waiting", "store", "later", "app_other", "client_waiting", "client_cpu",
+             "rest")
     total = {p: 0.0 for p in parts + ("outside", "client_gc")}
     dominated = {p: 0 for p in parts}
     for _, _, split in times.slow:
