@@ -21,8 +21,17 @@ Target (issue 27): the slowest answer of every route <= 50 ms in the busy phase.
 Attribution (load-independent where it can be): every answer carries colorlabd's Server-Timing header (queue: waiting
 for the io thread or the HTTP pool; handler, of it cpu on a CPU and store on the store's writer; later; app: the
 daemon's whole). Each answer slower than --slow-ms is split into: queued, handler on a CPU, handler waiting for a CPU
-or blocked, on the store's writer, and outside the daemon's handling (client - app: writing the answer, the network,
-the client's own turn on a CPU). Per phase the probe also reads the io (main) thread's CPU time and its time waiting
+or blocked, on the store's writer, and outside the daemon's handling (client - app), which is split further:
+
+- client_waiting: the client's own thread runnable but waiting for a CPU during the request, and client_cpu: its own
+  time on a CPU (Python, requests, its garbage collector: gc, a part of client_cpu), both from the client thread's
+  /proc/thread-self/schedstat read just before the request and just after the whole answer is read. Each client is
+  its own process (one thread, no GIL shared with the others), so a client's wait is the kernel's, not another
+  client's.
+- rest: what is left, neither the daemon's app time nor the client's own: the daemon reading the request before its
+  clock starts (an HTTP pool thread waiting for a CPU), writing the answer after it stops, and the kernel's loopback.
+  The daemon logs its writing time for answers slower than --stage-ms ("slow answer: ... writing N ms"), and per phase
+  the probe reads each daemon thread group's wait for a CPU (threads named by colorlabd: the HTTP pool, the workers). Per phase the probe also reads the io (main) thread's CPU time and its time waiting
 for a CPU (/proc/PID/task/PID/schedstat), and from the daemon's log (COLORLAB_IO_LAG_MS=5, COLORLAB_IO_SLOW_MS set to
 --stage-ms) the longest stage on the io thread and the most CPU the thread spent in one late tick's interval: its
 longest task, in CPU time, which the machine's load does not lengthen.
@@ -31,7 +40,9 @@ Usage: bench/service/latency_probe.py [--build build] [--time-scale 50] [--idle-
 Run it niced when the machine is shared: nice -n 10 python3 bench/service/latency_probe.py
 """
 import argparse
+import gc
 import json
+import multiprocessing
 import os
 import re
 import subprocess
@@ -64,7 +75,7 @@ READ_ROUTES = ["/v1", "/v1/instruments", "/v1/runs", "/v1/runs/{id}", "/v1/contr
 TERMINAL = ("finished_ok", "finished_error", "aborted", "interrupted")
 
 
-def start_daemon(build, state, scale, log_path=None, stage_ms=20):
+def start_daemon(build, state, scale, log_path=None, stage_ms=20, priority=None):
     os.makedirs(os.path.join(state, "s", "campaigns"), exist_ok=True)
     with open(os.path.join(state, "s", "campaigns", "probe-ask.lua"), "w") as f:
         f.write(PROBE_ASK)
@@ -72,6 +83,9 @@ def start_daemon(build, state, scale, log_path=None, stage_ms=20):
     with open(cfg, "w") as f:
         # The probe's clients start, answer, pause and resume over loopback TCP, as a lab's own console would.
         f.write(f"[simulator]\nenabled = true\ntime_scale = {scale}\nseed = 1\n[access]\nloopback_scope = \"control\"\n")
+        if priority is not None:
+            # The A/B switch: [priority] as given (0 0: everything at colorlabd's own priority, as before issue 27).
+            f.write(f"[priority]\nheavy_work_nice = {priority[0]}\nsimulator_nice = {priority[1]}\n")
     log = open(log_path or os.path.join(state, "colorlabd.log"), "w")
     env = dict(os.environ)
     # The io thread's diagnostics (io_watch.hpp): stages and late ticks beyond stage_ms, each split by CPU time.
@@ -102,14 +116,27 @@ def server_timing(response):
     return {k: float(v) for k, v in TIMING_PART.findall(response.headers.get("Server-Timing", ""))}
 
 
-def split_answer(ms, t):
-    """Where one answer's time went (ms), from its Server-Timing and the client's own time."""
-    if "app" not in t:
-        return {"outside": ms}
-    handler, cpu, store = t.get("handler", 0.0), t.get("cpu", 0.0), t.get("store", 0.0)
-    return {"queued": t.get("queue", 0.0), "handler_cpu": min(cpu, handler), "store": store,
-            "handler_waiting": max(0.0, handler - min(cpu, handler) - store), "later": t.get("later", 0.0),
-            "outside": max(0.0, ms - t["app"])}
+def split_answer(ms, t, client=None):
+    """Where one answer's time went (ms), from its Server-Timing and the client's own time. `client`: the client
+    thread's (waiting for a CPU, on a CPU, of that in its garbage collector) during the request, in ms."""
+    app = t.get("app")
+    out = {"outside": ms} if app is None else {}
+    if app is not None:
+        handler, cpu, store = t.get("handler", 0.0), t.get("cpu", 0.0), t.get("store", 0.0)
+        out = {"queued": t.get("queue", 0.0), "handler_cpu": min(cpu, handler), "store": store,
+               "handler_waiting": max(0.0, handler - min(cpu, handler) - store), "later": t.get("later", 0.0),
+               # The rest of app: a pool route's continuation waiting for an HTTP-pool thread (docs/API.md).
+               "app_other": max(0.0, app - t.get("queue", 0.0) - handler - t.get("later", 0.0)),
+               "outside": max(0.0, ms - app)}
+    if client is not None:
+        waiting, on_cpu, in_gc = client
+        # The client's own parts come out of "outside": while the daemon handles, the client is blocked reading.
+        own = min(out["outside"], waiting + on_cpu)
+        out["client_waiting"] = min(waiting, own)
+        out["client_cpu"] = own - out["client_waiting"]
+        out["client_gc"] = min(in_gc, out["client_cpu"])
+        out["rest"] = out["outside"] - own
+    return out
 
 
 class Times:
@@ -122,10 +149,12 @@ class Times:
         self.slow = []           # (route, ms, split) of every answer beyond slow_ms
         self.handler_cpu = {}    # route -> [sum ms, max ms, max handler ms]
         self.missing_timing = 0
+        self.all_splits = []
 
-    def add(self, route, ms, status, timing):
-        split = split_answer(ms, timing)
+    def add(self, route, ms, status, timing, client=None):
+        split = split_answer(ms, timing, client)
         with self.lock:
+            self.all_splits.append({"client_waiting": split.get("client_waiting", 0.0)})
             self.by_route.setdefault(route, []).append(ms)
             if status >= 500 or status == 0:
                 self.errors[route] = self.errors.get(route, 0) + 1
@@ -141,7 +170,30 @@ class Times:
             c[2] = max(c[2], timing.get("handler", 0.0))
 
 
-def timed(session, times, route, method, url, **kw):
+class ClientClock:
+    """This client thread's own scheduling, from /proc/thread-self/schedstat (ns on a CPU, ns runnable waiting for
+    one), and the time its garbage collector ran. The CPU figure is the kernel's, updated at least every tick; the
+    waiting figure is exact each time the thread is put on a CPU, which is when it reads it."""
+
+    def __init__(self):
+        self.fd = os.open("/proc/thread-self/schedstat", os.O_RDONLY)
+        self.gc_s = 0.0
+        self._gc_t0 = 0.0
+        gc.callbacks.append(self._gc)
+
+    def _gc(self, phase, _info):
+        if phase == "start":
+            self._gc_t0 = time.perf_counter()
+        else:
+            self.gc_s += time.perf_counter() - self._gc_t0
+
+    def read(self):
+        on_cpu, waiting = os.pread(self.fd, 128, 0).split()[:2]
+        return int(on_cpu), int(waiting), self.gc_s
+
+
+def timed(session, times, route, method, url, clock=None, **kw):
+    c0 = clock.read() if clock else None
     t0 = time.perf_counter()
     try:
         r = session.request(method, url, timeout=30, **kw)
@@ -149,11 +201,35 @@ def timed(session, times, route, method, url, **kw):
         status = r.status_code
     except requests.RequestException:
         r, status = None, 0
-    times.add(route, (time.perf_counter() - t0) * 1000.0, status, server_timing(r))
+    ms = (time.perf_counter() - t0) * 1000.0
+    client = None
+    if clock:
+        c1 = clock.read()
+        client = ((c1[1] - c0[1]) / 1e6, (c1[0] - c0[0]) / 1e6, (c1[2] - c0[2]) * 1000.0)
+    times.add(route, ms, status, server_timing(r), client)
     return r
 
 
-def reader(url, times, stop, run_id):
+class Records:
+    """A client process's answers, sent to the parent at the end: (route, ms, status, Server-Timing, client)."""
+
+    def __init__(self):
+        self.rows = []
+
+    def add(self, route, ms, status, timing, client=None):
+        self.rows.append((route, ms, status, timing, client))
+
+
+def client_process(target, args, stop, out):
+    """One client in a process of its own: its thread's wait for a CPU is then its own, not a GIL's."""
+    records = Records()
+    try:
+        target(*args[:1], records, stop, *args[1:], clock=ClientClock())
+    finally:
+        out.put(records.rows)
+
+
+def reader(url, times, stop, run_id, clock=None):
     s = requests.Session()
     while not stop.is_set():
         for route in READ_ROUTES:
@@ -162,7 +238,7 @@ def reader(url, times, stop, run_id):
             path = route.replace("{id}", run_id[0]) if "{id}" in route else route
             if "{id}" in route and not run_id[0]:
                 continue
-            r = timed(s, times, route, "GET", url + path)
+            r = timed(s, times, route, "GET", url + path, clock)
             if route == "/v1/runs" and r is not None and r.ok:
                 items = r.json().get("items", [])
                 if items:
@@ -170,18 +246,19 @@ def reader(url, times, stop, run_id):
             time.sleep(0.02)
 
 
-def operator(url, times, stop, ended_id):
+def operator(url, times, stop, ended_id, clock=None):
     """Operator answers, pause and resume, on the main thread's handlers. Any unfinished execution holds the
     night's queue, so none is kept waiting beside the study: the answer goes to a request that is no longer
     open (404) and pause/resume to an ended execution (409) — the same routes, found and refused on the main
     thread, which is where they would wait behind heavy work."""
     session = requests.Session()
     while not stop.is_set():
-        timed(session, times, "POST /v1/requests/{id}", "POST", url + "/v1/requests/" + ended_id[1], json={"answer": "go"})
+        timed(session, times, "POST /v1/requests/{id}", "POST", url + "/v1/requests/" + ended_id[1], clock,
+              json={"answer": "go"})
         timed(session, times, "POST /v1/executions/{id}/pause", "POST", url + f"/v1/executions/{ended_id[0]}/pause",
-              json={})
+              clock, json={})
         timed(session, times, "POST /v1/executions/{id}/resume", "POST", url + f"/v1/executions/{ended_id[0]}/resume",
-              json={})
+              clock, json={})
         time.sleep(0.02)
 
 
@@ -246,36 +323,73 @@ def io_thread_log(log_path, start, end):
 
 def attribution(times):
     """The answers beyond slow_ms: how many, the ms in each part summed, and how many each part dominated."""
-    parts = ("queued", "handler_cpu", "handler_waiting", "store", "later", "outside")
-    total = {p: 0.0 for p in parts}
+    parts = ("queued", "handler_cpu", "handler_waiting", "store", "later", "app_other", "client_waiting", "client_cpu",
+             "rest")
+    total = {p: 0.0 for p in parts + ("outside", "client_gc")}
     dominated = {p: 0 for p in parts}
     for _, _, split in times.slow:
-        for p in parts:
+        for p in total:
             total[p] += split.get(p, 0.0)
+        # "outside" stands for its parts when the client's own were measured.
+        split = split if "rest" in split else dict(split, rest=split.get("outside", 0.0))
         dominated[max(parts, key=lambda p: split.get(p, 0.0))] += 1
-    return {"answers": len(times.slow), "ms_by_part": total, "dominated_by": dominated}
+    slow = [{"route": r, "ms": ms, "split": sp} for r, ms, sp in sorted(times.slow, key=lambda x: -x[1])]
+    return {"answers": len(times.slow), "ms_by_part": total, "dominated_by": dominated, "each": slow}
+
+
+def thread_groups(pid):
+    """The daemon's threads by name (colorlabd names its pools: http-pool, workers, decode, …): {name: [n, s on a
+    CPU, s waiting for one]} so far."""
+    out = {}
+    try:
+        tids = os.listdir(f"/proc/{pid}/task")
+    except OSError:
+        return out
+    for tid in tids:
+        try:
+            with open(f"/proc/{pid}/task/{tid}/comm") as f:
+                name = f.read().strip()
+            with open(f"/proc/{pid}/task/{tid}/schedstat") as f:
+                on_cpu, waiting = f.read().split()[:2]
+        except (OSError, ValueError):
+            continue  # a thread that ended meanwhile
+        g = out.setdefault("io (main)" if tid == str(pid) else name, [0, 0.0, 0.0])
+        g[0] += 1
+        g[1] += int(on_cpu) / 1e9
+        g[2] += int(waiting) / 1e9
+    return out
 
 
 def probe(url, until, label, ended_id, pid=None, log_path=None, slow_ms=50.0):
     times = Times(slow_ms)
-    stop = threading.Event()
-    run_id = [""]
-    threads = [threading.Thread(target=reader, args=(url, times, stop, run_id)) for _ in range(2)]
-    threads.append(threading.Thread(target=operator, args=(url, times, stop, ended_id)))
+    ctx = multiprocessing.get_context("fork")
+    stop = ctx.Event()
+    out = ctx.Queue()
+    clients = [ctx.Process(target=client_process, args=(reader, (url, [""]), stop, out)) for _ in range(2)]
+    clients.append(ctx.Process(target=client_process, args=(operator, (url, ended_id), stop, out)))
     load0 = os.getloadavg()
     sched0 = main_thread_schedstat(pid) if pid else None
+    groups0 = thread_groups(pid) if pid else {}
     log0 = os.path.getsize(log_path) if log_path else 0
     t0 = time.monotonic()
-    for t in threads:
-        t.start()
+    for c in clients:
+        c.start()
     try:
         until()
     finally:
         stop.set()
-        for t in threads:
-            t.join()
+        # Drained before joining: a child blocks on exit until its rows have gone through the pipe.
+        for _ in clients:
+            for row in out.get(timeout=120):
+                times.add(*row)
+        for c in clients:
+            c.join(timeout=60)
     wall = time.monotonic() - t0
     sched1 = main_thread_schedstat(pid) if pid else None
+    groups1 = thread_groups(pid) if pid else {}
+    threads = {name: {"threads": g[0], "cpu_s": g[1] - groups0.get(name, [0, 0.0, 0.0])[1],
+                      "waiting_for_cpu_s": g[2] - groups0.get(name, [0, 0.0, 0.0])[2]}
+               for name, g in sorted(groups1.items())}
     main_thread = None
     if sched0 and sched1:
         main_thread = {"cpu_s": sched1[0] - sched0[0], "waiting_for_cpu_s": sched1[1] - sched0[1],
@@ -284,7 +398,14 @@ def probe(url, until, label, ended_id, pid=None, log_path=None, slow_ms=50.0):
     return {"phase": label, "wall_s": wall, "load_before": load0, "load_after": os.getloadavg(),
             "routes": summarize(times), "errors": times.errors, "worst": times.worst,
             "handler_cpu": times.handler_cpu, "slow_answers": attribution(times),
-            "missing_server_timing": times.missing_timing, "main_thread": main_thread, "io_thread_log": io_log}
+            "missing_server_timing": times.missing_timing, "main_thread": main_thread, "io_thread_log": io_log,
+            "daemon_threads": threads, "client_own": client_own(times)}
+
+
+def client_own(times):
+    """Over every answer: how many had the client wait for a CPU more than 10 ms, and the longest such wait."""
+    waits = [split.get("client_waiting", 0.0) for split in times.all_splits]
+    return {"answers": len(waits), "waited_over_10ms": sum(1 for w in waits if w > 10), "max_wait_ms": max(waits or [0])}
 
 
 def summarize(times):
@@ -321,6 +442,16 @@ def print_attribution(phase):
     s = phase["slow_answers"]
     print(f"  answers beyond the limit: {s['answers']}; ms summed by part: {fmt(s['ms_by_part'])}; "
           f"dominated by: " + ", ".join(f"{k} {v}" for k, v in s["dominated_by"].items() if v))
+    for a in s["each"][:20]:
+        print(f"    {a['route']:34s} {a['ms']:7.1f}: {fmt(a['split'])}")
+    c = phase.get("client_own")
+    if c:
+        print(f"  the clients' own wait for a CPU: {c['waited_over_10ms']} of {c['answers']} answers over 10 ms, "
+              f"longest {c['max_wait_ms']:.1f} ms")
+    if phase.get("daemon_threads"):
+        print("  daemon threads (n; s on a CPU; s waiting for a CPU): " + "; ".join(
+            f"{name} ({g['threads']}) {g['cpu_s']:.1f}, {g['waiting_for_cpu_s']:.1f}"
+            for name, g in phase["daemon_threads"].items() if g["cpu_s"] >= 0.05 or g["waiting_for_cpu_s"] >= 0.05))
     if phase["missing_server_timing"]:
         print(f"  answers without Server-Timing: {phase['missing_server_timing']}")
     m = phase["main_thread"]
@@ -345,9 +476,12 @@ def main():
     ap.add_argument("--slow-ms", type=float, default=50.0, help="answers beyond this are attributed (default 50)")
     ap.add_argument("--stage-ms", type=int, default=20,
                     help="the daemon logs io-thread stages and late ticks beyond this (COLORLAB_IO_SLOW_MS; default 20)")
+    ap.add_argument("--priority", nargs=2, type=int, metavar=("HEAVY", "SIM"),
+                    help="colorlabd's [priority] heavy_work_nice and simulator_nice (default: colorlabd's own defaults;"
+                         " 0 0 = as before issue 27)")
     a = ap.parse_args()
     with tempfile.TemporaryDirectory(prefix="latency-probe-") as state:
-        proc, url, log_path = start_daemon(a.build, state, a.time_scale, a.log, a.stage_ms)
+        proc, url, log_path = start_daemon(a.build, state, a.time_scale, a.log, a.stage_ms, a.priority)
         try:
             ended = answered_execution(url)
             idle = probe(url, lambda: time.sleep(a.idle_s), "idle", ended, proc.pid, log_path, a.slow_ms)
@@ -356,7 +490,7 @@ def main():
         finally:
             proc.terminate()
             proc.wait(timeout=60)
-    result = {"time_scale": a.time_scale, "phases": [idle, busy], "study_state": study.get("state"),
+    result = {"time_scale": a.time_scale, "priority": a.priority, "phases": [idle, busy], "study_state": study.get("state"),
               "cpus": os.cpu_count()}
     for phase in (idle, busy):
         print(f"\n{phase['phase']}: {phase['wall_s']:.0f} s, load average {phase['load_before'][0]:.2f} -> "

@@ -18,6 +18,7 @@
 #include "colorlab/core/error.hpp"
 #include "colorlab/core/ids.hpp"
 #include "colorlab/core/log.hpp"
+#include "colorlab/core/thread_priority.hpp"
 #include "colorlab/campaigns/catalogue.hpp"
 #include "colorlab/campaigns/lab.hpp"
 #include "colorlab/api/access.hpp"
@@ -159,6 +160,9 @@ void Daemon::Impl::on_discovery_change(const drivers::DiscoveryChange& change) {
 Daemon::Daemon(DaemonConfig config) : impl_(std::make_unique<Impl>()) {
   auto& d = *impl_;
   d.config = std::move(config);
+  // Before any heavy thread starts (the blob check, cameras' decode threads): they lower themselves by it.
+  core::set_heavy_thread_nice(d.config.priority.heavy_work_nice);
+  d.config.simulator.nice = d.config.priority.simulator_nice;
   // The database first: if it is unusable, nothing else should start.
   d.store = std::make_unique<store::Store>(d.config.database_path());
   d.blobs = std::make_unique<BlobService>(d.io, *d.store, d.config.state_dir, d.config.blobs);
@@ -230,7 +234,7 @@ Daemon::Daemon(DaemonConfig config) : impl_(std::make_unique<Impl>()) {
     }
   });
   // Fits, analyses and dry runs' analyses: off the io thread (worker_pool.hpp).
-  d.workers = std::make_unique<WorkerPool>(d.io.get_executor(), with_test_hooks(WorkerPoolOptions{}));
+  d.workers = std::make_unique<WorkerPool>(d.io.get_executor(), with_test_hooks(WorkerPoolOptions{.nice = d.config.priority.heavy_work_nice}));
   d.committer = std::make_unique<StepCommitter>(d.io.get_executor(), d.config.database_path());
   ExecutionOptions execution_options;
   execution_options.workers = d.workers.get();
@@ -272,6 +276,7 @@ Daemon::Daemon(DaemonConfig config) : impl_(std::make_unique<Impl>()) {
 #ifdef COLORLAB_VERSION
   report_options.version = COLORLAB_VERSION;
 #endif
+  report_options.nice = d.config.priority.heavy_work_nice;
   d.reports = std::make_unique<ReportService>(report_options);
   d.api->reports = d.reports.get();
 

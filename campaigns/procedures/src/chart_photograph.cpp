@@ -5,12 +5,14 @@
 #include <map>
 
 #include <boost/asio/co_spawn.hpp>
+#include <boost/asio/post.hpp>
 #include <boost/asio/thread_pool.hpp>
 #include <boost/asio/use_awaitable.hpp>
 
 #include "chart_sampling.hpp"
 #include "frame_keeping.hpp"
 #include "colorlab/core/error.hpp"
+#include "colorlab/core/thread_priority.hpp"
 #include "colorlab/drivers/camera/asio_camera.hpp"
 #include "colorlab/drivers/camera/camera_instrument.hpp"
 
@@ -234,6 +236,10 @@ asio::awaitable<json> sample_all(std::shared_ptr<RawSum> raw, std::vector<std::f
 // from the daemon and the simulated lab. Joined at exit.
 asio::thread_pool& chart_worker() {
   static asio::thread_pool pool(1);
+  // Averaging, locating and sampling are heavy: below the daemon's answering threads (core/thread_priority.hpp).
+  // Posted first, so the thread is lowered before its first job.
+  static const bool lowered = (asio::post(pool, [] { core::become_heavy_thread("chart"); }), true);
+  (void)lowered;
   return pool;
 }
 

@@ -6,10 +6,12 @@
 #include <cstring>
 
 #include <boost/asio/co_spawn.hpp>
+#include <boost/asio/post.hpp>
 #include <boost/asio/thread_pool.hpp>
 #include <boost/asio/use_awaitable.hpp>
 
 #include "colorlab/core/error.hpp"
+#include "colorlab/core/thread_priority.hpp"
 
 namespace colorlab::campaigns::detail {
 
@@ -25,6 +27,10 @@ namespace {
 // One thread for writing kept frames: an fsync of a large file must not hold the daemon's io thread.
 asio::thread_pool& keeping_worker() {
   static asio::thread_pool pool(1);
+  // Hashing and writing large frames is heavy: below the daemon's answering threads (core/thread_priority.hpp).
+  // Posted first, so the thread is lowered before its first frame.
+  static const bool lowered = (asio::post(pool, [] { core::become_heavy_thread("keeping"); }), true);
+  (void)lowered;
   return pool;
 }
 

@@ -13,6 +13,7 @@
 #include "colorlab/core/error.hpp"
 #include "colorlab/core/ids.hpp"
 #include "colorlab/core/log.hpp"
+#include "colorlab/core/thread_priority.hpp"
 
 namespace colorlab::daemon {
 
@@ -64,6 +65,7 @@ void BlobService::start_check() {
     report_ = json{{"state", "running"}, {"started_at", now_iso8601()}, {"rows", rows.size()}};
   }
   check_thread_ = std::thread([this, rows = std::move(rows), started]() mutable {
+    core::become_heavy_thread("blob-check");  // hashes every file: heavy, and nobody waits on it
     json report;
     try {
       report = run_check(std::move(rows), started);

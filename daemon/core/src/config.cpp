@@ -265,6 +265,18 @@ static DaemonConfig from_toml(const toml::table& root, const std::filesystem::pa
           bad(file, anode.source(), "unknown key 'api." + ak + "'");
         }
       }
+    } else if (k == "priority") {
+      auto t = node.as_table();
+      if (!t) bad(file, node.source(), "[priority] must be a table");
+      for (const auto& [pkey, pnode] : *t) {
+        std::string pk(pkey.str());
+        auto v = pnode.value<int64_t>();
+        if (pk != "heavy_work_nice" && pk != "simulator_nice") bad(file, pnode.source(), "unknown key 'priority." + pk + "'");
+        if (!v || *v < 0 || *v > 19 || !pnode.is_integer()) {
+          bad(file, pnode.source(), "priority." + pk + " must be a whole number from 0 (as colorlabd) to 19 (lowest)");
+        }
+        (pk == "heavy_work_nice" ? c.priority.heavy_work_nice : c.priority.simulator_nice) = static_cast<int>(*v);
+      }
     } else if (k == "queue") {
       auto t = node.as_table();
       if (!t) bad(file, node.source(), "[queue] must be a table");

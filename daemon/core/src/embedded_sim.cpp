@@ -4,6 +4,7 @@
 #include <poll.h>
 #include <signal.h>
 #include <sys/prctl.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -57,6 +58,12 @@ EmbeddedSim::EmbeddedSim(const std::filesystem::path& sim_binary, const Simulato
   if (pid_ == 0) {
     ::prctl(PR_SET_PDEATHSIG, SIGTERM);
     if (::getppid() != parent) _exit(1);
+    // Below the daemon (docs/configuration.md, "CPU priority"): before exec, so all its threads inherit it.
+    if (config.nice > 0) {
+      errno = 0;
+      const int now = ::getpriority(PRIO_PROCESS, 0);
+      if (errno == 0) ::setpriority(PRIO_PROCESS, 0, now + config.nice > 19 ? 19 : now + config.nice);
+    }
     ::dup2(fds[1], STDOUT_FILENO);
     std::vector<char*> argv;
     for (auto& a : args) argv.push_back(a.data());

@@ -9,12 +9,14 @@
 #include <vector>
 
 #include <fcntl.h>
+#include <pthread.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include "colorlab/core/data_paths.hpp"
 #include "colorlab/core/log.hpp"
+#include "colorlab/core/thread_priority.hpp"
 
 extern char** environ;
 
@@ -71,6 +73,8 @@ ReportService::State ReportService::request(const std::string& key, const std::v
 }
 
 void ReportService::work() {
+  pthread_setname_np(pthread_self(), "reports");
+  core::lower_this_thread(options_.nice, "the report thread");
   std::unique_lock lock(mutex_);
   while (true) {
     wake_.wait(lock, [this] { return stopping_ || !queue_.empty(); });

@@ -6,7 +6,7 @@ namespace colorlab::daemon {
 
 StepCommitter::StepCommitter(boost::asio::any_io_executor io, const std::filesystem::path& database_path)
     : store_(std::make_unique<store::Store>(database_path, store::Store::SecondWriter{})),
-      thread_(std::make_unique<WorkerPool>(std::move(io), WorkerPoolOptions{1, 0, {}})) {}
+      thread_(std::make_unique<WorkerPool>(std::move(io), WorkerPoolOptions{1, 0, {}, 0, "committer"})) {}
 
 StepCommitter::~StepCommitter() { shutdown(); }
 

@@ -4,7 +4,10 @@
 #include <cstdlib>
 #include <fstream>
 
+#include <pthread.h>
+
 #include "colorlab/core/log.hpp"
+#include "colorlab/core/thread_priority.hpp"
 
 namespace colorlab::daemon {
 
@@ -127,6 +130,8 @@ void WorkerPool::hold_at_latch() const {
 }
 
 void WorkerPool::work() {
+  pthread_setname_np(pthread_self(), options_.name.substr(0, 15).c_str());
+  core::lower_this_thread(options_.nice, "a worker-pool thread (" + options_.name + ")");
   for (;;) {
     Job job;
     {

@@ -1,6 +1,7 @@
 #include "colorlab/http/server.hpp"
 
 #include <fcntl.h>
+#include <pthread.h>
 #include <sys/sendfile.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -614,7 +615,11 @@ void Server::start() {
   if (impl_->pool && impl_->threads.empty()) {
     impl_->pool_work.emplace(impl_->pool->get_executor());
     for (unsigned i = 0; i < o.threads; ++i) {
-      impl_->threads.emplace_back([pool = impl_->pool.get()] { pool->run(); });
+      impl_->threads.emplace_back([pool = impl_->pool.get()] {
+        // Named, so per-thread figures (the latency probe's, top -H) tell the pool that answers from the heavy work.
+        pthread_setname_np(pthread_self(), "http-pool");
+        pool->run();
+      });
     }
   }
 }

@@ -2,6 +2,8 @@
 
 #include <pthread.h>
 
+#include "colorlab/core/thread_priority.hpp"
+
 namespace colorlab::drivers::camera {
 
 WorkerThread::WorkerThread(std::string name) : name_(std::move(name)) {
@@ -28,6 +30,9 @@ void WorkerThread::post(std::function<void()> task) {
 }
 
 void WorkerThread::run() {
+  // A camera's device thread captures and transfers full-size frames (the simulated DSLR reads them from its card
+  // folder): heavy, so below the daemon's answering threads like the decode thread (core/thread_priority.hpp).
+  core::lower_this_thread(core::heavy_thread_nice(), name_);
   std::unique_lock lock(mutex_);
   for (;;) {
     wake_.wait(lock, [&] { return stopping_ || !tasks_.empty(); });

@@ -17,6 +17,14 @@ struct SimulatorConfig {
   std::optional<std::filesystem::path> config;  // its TOML; none = the default lab
   std::optional<double> time_scale;
   std::optional<std::uint64_t> seed;
+  int nice = 0;  // nice steps the child runs below colorlabd: colorlabd copies [priority] simulator_nice here
+};
+
+// [priority]: CPU priority of the heavy work beside the threads that answer (docs/configuration.md,
+// "CPU priority"; core/thread_priority.hpp). Nice steps below colorlabd's own; 0 = the same.
+struct PriorityConfig {
+  int heavy_work_nice = 10;  // worker pool (fits, analyses), RAW decoding, reports, the blob check
+  int simulator_nice = 10;   // the embedded simulated lab: a real lab's instruments have their own processors
 };
 
 // [campaigns]: where the lab's own scripts live, and how executions survive restarts.
@@ -97,6 +105,7 @@ struct DaemonConfig {
   QueueConfig queue;
   NotifyConfig notify;
   ApiConfig api;
+  PriorityConfig priority;
   BlobConfig blobs;
   AccessConfig access;
   // The light cabinet's geometry ([cabinet], docs/verify.md "The cabinet in the lab configuration"), validated when

@@ -26,6 +26,9 @@ class ReportService {
     std::string version;  // part of the file name: a new colorlabd makes its reports anew
     std::chrono::seconds timeout{600};
     std::chrono::seconds retry_after_failure{60};
+    // Nice steps the report thread runs below the daemon, and so the Python client it spawns, which
+    // inherits them ([priority] heavy_work_nice; core/thread_priority.hpp).
+    int nice = 0;
   };
   struct State {
     enum class Kind { ready, generating, failed } kind = Kind::generating;

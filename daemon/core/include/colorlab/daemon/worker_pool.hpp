@@ -41,6 +41,10 @@ struct WorkerPoolOptions {
   // A test hook (COLORLAB_TEST_WORKER_LATCH): before each job, the worker creates `<latch>.held`
   // and waits until `<latch>.release` exists, so a test can hold a job and see what still answers.
   std::filesystem::path latch;
+  // Nice steps the workers run below their creator ([priority] heavy_work_nice, thread_priority.hpp):
+  // the io thread and the HTTP pool then preempt a fit. 0 for the step committer, which a step waits on.
+  int nice = 0;
+  std::string name = "workers";  // the threads' name (top -H, /proc/PID/task/TID/comm); 15 characters at most
 };
 
 // The queue is full: the caller should try again shortly (retry_after_s).

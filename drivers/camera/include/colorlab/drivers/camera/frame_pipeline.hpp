@@ -18,6 +18,8 @@
 #include <optional>
 #include <thread>
 
+#include "colorlab/core/thread_priority.hpp"
+
 namespace colorlab::drivers::camera {
 
 struct PipelineRun {
@@ -39,7 +41,11 @@ class FramePipeline {
   using Consume = std::function<void(Item&&, std::size_t index)>;
 
   explicit FramePipeline(std::size_t depth = 2) : depth_(depth == 0 ? 1 : depth) {
-    consumer_ = std::thread([this] { consumer_loop(); });
+    consumer_ = std::thread([this] {
+      // Decoding full-size RAW frames is heavy: below the daemon's answering threads (issue 27).
+      core::become_heavy_thread("decode");
+      consumer_loop();
+    });
   }
   ~FramePipeline() {
     {
