@@ -1,0 +1,260 @@
+// The lab's lens calibration (issue 23): the simulator photographs its SG through one fixed lens — its intrinsics
+// and radial distortion are the truth — at several poses; the chart locator finds each on the raw mosaic and its
+// detected patch centres go into calibrate_lens (OpenCV calibrateCamera). The recovered lens must lie within its
+// own stated uncertainty of the truth, and a camera pose computed with it (the export's, from the located chart's
+// corners) must be closer to the simulator's camera than one computed with the nominal lens. Plus the [[lens]]
+// table's parsing, refusals and the choice of a calibration by name or photograph size.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <numbers>
+#include <unistd.h>
+
+#include "colorlab/analysis/chart_layout.hpp"
+#include "colorlab/analysis/chart_locate.hpp"
+#include "colorlab/core/error.hpp"
+#include "colorlab/sim/camera/camera_model.hpp"
+#include "colorlab/verify/cabinet.hpp"
+#include "colorlab/verify/lens_calibration.hpp"
+#include "colorlab/verify/scene_export.hpp"
+#include "simulated_runs.hpp"
+
+namespace colorlab::verify {
+namespace {
+
+namespace cam = colorlab::sim::camera;
+namespace ca = colorlab::analysis;
+using nlohmann::json;
+
+// Each parameter within k = 3 of its stated one-σ uncertainty: six parameters together, a calibrated σ passes
+// all six with probability 0.997⁶ ≈ 98 %.
+constexpr double kSigmas = 3.0;
+constexpr int kWidth = 1752, kHeight = 1168;
+constexpr double kPitchMm = 19.0;  // the SG's patch pitch (the chart's known geometry; the scale does not enter the intrinsics)
+
+// The simulator's lens: a ~31 mm lens on the 22.5 mm sensor, principal point off the centre, barrel distortion.
+cam::LensIntrinsics true_lens() { return {2450.0, 2452.0, kWidth / 2.0 - 0.5 + 14.0, kHeight / 2.0 - 0.5 - 9.0, -0.09, 0.04}; }
+
+cam::ChartPose pose(double tilt, double swing, double rot, double sx, double sy, double distance) {
+  cam::ChartPose p;
+  p.tilt_deg = tilt, p.swing_deg = swing, p.rotation_deg = rot, p.shift_x = sx, p.shift_y = sy, p.distance_mm = distance;
+  p.lens = true_lens();
+  return p;
+}
+
+ca::PhotoView raw_view(const cam::RawFrame& f) {
+  ca::PhotoView v;
+  v.data = f.pixels.data();
+  v.width = f.width;
+  v.height = f.height;
+  v.channels = 1;
+  v.type = ca::SampleType::u16;
+  v.bit_depth = 12;
+  v.black_level = f.black_level;
+  v.cfa = ca::CfaPattern::rggb;
+  return v;
+}
+
+std::shared_ptr<sim::Scene> make_scene() {
+  sim::SceneConfig sc;
+  sc.seed = 4;
+  sc.lamps_on_at_start = {sim::Lamp::d65};
+  return std::make_shared<sim::Scene>(sc, std::make_shared<sim::SimClock>());
+}
+
+// The simulator photographs the chart at one pose through the fixed lens; the locator finds it as
+// characterize-camera does (no lens given: the lens is what is being calibrated).
+ca::ChartLocation photograph_and_locate(const std::shared_ptr<sim::Scene>& scene, const cam::ChartPose& p) {
+  cam::CameraConfig cc;
+  cc.width = kWidth, cc.height = kHeight;
+  cc.pose = p;
+  const cam::CameraModel camera(scene, cc);
+  cam::CameraSettings settings;
+  settings.shutter_s = 1.0 / 30;
+  const cam::RawFrame frame = camera.render(settings, 1);
+  ca::LocateOptions lo;
+  for (std::size_t k = 0; k < scene->chart().patches.size(); ++k) {
+    if (!lo.reference) lo.reference.emplace();
+    lo.reference->luminance.push_back(scene->patch_xyz(static_cast<int>(k))[1]);
+  }
+  return ca::locate_chart(raw_view(frame), ca::ChartType::sg140, lo);
+}
+
+// The calibration points of one photograph: each detected patch's centroid as photographed, and its centre on the
+// chart's plane from the SG's layout.
+CalibrationView view_of(const ca::ChartLocation& loc) {
+  const auto& layout = ca::chart_layout(ca::ChartType::sg140);
+  CalibrationView v;
+  for (int k = 0; k < layout.size(); ++k) {
+    const auto& s = loc.patches[static_cast<std::size_t>(k)];
+    if (!s.detected) continue;
+    v.image_px.push_back({s.observed.x, s.observed.y});
+    v.chart_mm.push_back({layout.centre_x(k) * kPitchMm, layout.centre_y(k) * kPitchMm});
+  }
+  return v;
+}
+
+// Where the simulator's camera is in the cabinet (chart_pose.cpp's definition with the fixed lens, carried to the
+// floor by Scene::chart_to_floor_mm), as camera_pose_test.cpp derives it.
+Eigen::Vector3d true_position_mm(const cam::ChartPose& p, const sim::Scene& scene) {
+  const double deg = std::numbers::pi / 180;
+  const Eigen::Matrix3d R = (Eigen::AngleAxisd(p.rotation_deg * deg, Eigen::Vector3d::UnitZ()) *
+                             Eigen::AngleAxisd(p.tilt_deg * deg, Eigen::Vector3d::UnitX()) *
+                             Eigen::AngleAxisd(p.swing_deg * deg, Eigen::Vector3d::UnitY())).toRotationMatrix();
+  const Eigen::Vector3d t = R * Eigen::Vector3d(-sim::chart_width_mm / 2, -sim::chart_height_mm / 2, 0) +
+                            Eigen::Vector3d(p.shift_x * kWidth * p.distance_mm / p.lens->fx, p.shift_y * kHeight * p.distance_mm / p.lens->fy,
+                                            p.distance_mm);
+  const Eigen::Vector3d c = -R.transpose() * t;
+  const auto [fx, fy] = scene.chart_to_floor_mm(c.x(), c.y());
+  return {fx, fy, -c.z()};
+}
+
+json characterize_run(const ca::ChartLocation& loc) {
+  json corners = json::array();
+  for (const auto& c : loc.corners) corners.push_back({c.x, c.y});
+  json row{{"step", "chart/raw"}, {"quantity", "chart_location"}, {"value", loc.confidence},
+           {"data", {{"format", "raw"}, {"corners", corners}, {"width", kWidth}, {"height", kHeight},
+                     {"reprojection_rms_px", loc.reprojection_rms_px}}}};
+  return {{"run", {{"id", "0193c0de-0000-7000-8000-0000000cc0de"}, {"campaign", "characterize-camera"},
+                   {"params", json::object()}, {"status", "finished_ok"}}},
+          {"measurements", json::array({row})}};
+}
+
+TEST(LensCalibrationSim, RecoversTheSimulatorsLensWithinItsStatedUncertainty) {
+  const auto scene = make_scene();
+  // Six bench poses: tilted different ways, the chart pushed towards each corner of the frame and across its
+  // middle, so the distortion is seen where it is large.
+  const std::vector<cam::ChartPose> poses{pose(20, 0, 0, -0.18, -0.15, 800),  pose(-20, 15, 3, 0.18, -0.15, 850),
+                                          pose(10, -20, -3, -0.18, 0.15, 800), pose(-15, -15, 5, 0.18, 0.15, 850),
+                                          pose(0, 25, -4, 0, 0, 750),         pose(25, 10, 2, 0.05, 0, 900)};
+  std::vector<CalibrationView> views;
+  for (const auto& p : poses) views.push_back(view_of(photograph_and_locate(scene, p)));
+  LensCalibration l = calibrate_lens(views, kWidth, kHeight);
+
+  const cam::LensIntrinsics t = true_lens();
+  const double truth[6] = {t.fx, t.fy, t.cx, t.cy, t.k1, t.k2};
+  const double got[6] = {l.intrinsics.fx, l.intrinsics.fy, l.intrinsics.cx, l.intrinsics.cy, l.intrinsics.k1, l.intrinsics.k2};
+  const double sigma[6] = {l.sigma.fx, l.sigma.fy, l.sigma.cx, l.sigma.cy, l.sigma.k1, l.sigma.k2};
+  const char* names[6] = {"fx", "fy", "cx", "cy", "k1", "k2"};
+  std::printf("[ calibration ] %d photographs, %d points, RMS %.3f px\n", l.photographs, l.points, l.rms_px);
+  for (int i = 0; i < 6; ++i) {
+    std::printf("[ calibration ] %s = %.5g (truth %.5g, σ %.3g, off %.2f σ)\n", names[i], got[i], truth[i], sigma[i],
+                std::abs(got[i] - truth[i]) / sigma[i]);
+    EXPECT_GT(sigma[i], 0) << names[i];
+    EXPECT_LE(std::abs(got[i] - truth[i]), kSigmas * sigma[i]) << names[i] << " = " << got[i] << ", truth " << truth[i] << ", σ " << sigma[i];
+  }
+
+  // The stated σ is not so wide that it says nothing: a lens 2 % off in focal length lies outside the band.
+  EXPECT_GT(0.02 * t.fx, kSigmas * l.sigma.fx);
+  EXPECT_GT(0.02 * t.fy, kSigmas * l.sigma.fy);
+
+  // A pose with it: a seventh photograph, located as characterize-camera locates (no lens), exported with the
+  // stored calibration and with the nominal lens.
+  l.camera = "simulated DSLR", l.lens = "simulated 31 mm", l.source = "calibrate_lens over 6 simulated photographs",
+  l.date = "2026-11-29";
+  const cam::ChartPose eval = pose(12, -8, 2, 0.03, -0.02, 1000);
+  const ca::ChartLocation loc = photograph_and_locate(scene, eval);
+  const std::vector<json> runs{testing::chart_read_run(*scene, 1), characterize_run(loc)};
+  SceneExportOptions o;
+  o.lamps = {"D65"};
+  o.lenses = {l};
+  const json calibrated = export_scene(default_cabinet(), runs, o)["camera"];
+  const json nominal = export_scene(default_cabinet(), runs, SceneExportOptions{{"D65"}, 100.0, std::nullopt, "", {}, ""})["camera"];
+  EXPECT_FALSE(calibrated["estimated"].get<bool>());
+  EXPECT_EQ(calibrated["lens_calibration"]["name"], l.name());
+  EXPECT_NE(calibrated["intrinsics_source"].get<std::string>().find(l.name()), std::string::npos);
+  EXPECT_DOUBLE_EQ(calibrated["distortion"]["k1"].get<double>(), l.intrinsics.k1);
+  EXPECT_TRUE(nominal["estimated"].get<bool>());
+  EXPECT_TRUE(nominal["lens_calibration"].is_null());
+
+  const Eigen::Vector3d want = true_position_mm(eval, *scene);
+  const auto at = [](const json& k) -> Eigen::Vector3d {
+    const auto p = k["position_m"].get<std::vector<double>>();
+    return Eigen::Vector3d(p[0], p[1], p[2]) * 1000;
+  };
+  const double off_cal = (at(calibrated) - want).norm(), off_nom = (at(nominal) - want).norm();
+  std::printf("[ pose ] camera %.1f mm from the simulator's with the calibration, %.1f mm with the nominal lens "
+              "(simulator at %.1f, %.1f, %.1f mm)\n",
+              off_cal, off_nom, want.x(), want.y(), want.z());
+  EXPECT_LT(off_cal, off_nom);
+}
+
+// --- the [[lens]] table -------------------------------------------------------------------------------------
+
+std::string write_file(const std::string& name, const std::string& text) {
+  const auto p = std::filesystem::temp_directory_path() / ("colorlab-lens-test-" + std::to_string(::getpid()) + "-" + name);
+  std::ofstream(p) << text;
+  return p.string();
+}
+
+LensCalibration sample() {
+  LensCalibration l;
+  l.camera = "Canon EOS 20D \"lab\"", l.lens = "EF 28-70mm", l.focal_length_mm = 35, l.focus = "1.2 m";
+  l.width_px = 3504, l.height_px = 2336;
+  l.intrinsics = {4900.5, 4901.25, 1760.125, 1150.5, -0.101, 0.05};
+  l.sigma = {2.5, 2.4, 1.5, 1.25, 0.002, 0.004};
+  l.rms_px = 0.21, l.photographs = 8, l.points = 1100, l.source = "colorlab lens calibrate", l.date = "2026-11-29";
+  return l;
+}
+
+TEST(LensCalibrationTable, WrittenReadAndServedAlike) {
+  const LensCalibration l = sample();
+  const std::string file = write_file("lab.toml", "[cabinet]\nwidth_mm = 1200\n\n" + lens_to_toml(l));
+  const auto back = lenses_from_file(file);
+  ASSERT_EQ(back.size(), 1u);
+  EXPECT_EQ(back[0].name(), "Canon EOS 20D \"lab\" / EF 28-70mm @ 35 mm, focus 1.2 m");
+  EXPECT_EQ(lens_to_json(back[0]), lens_to_json(l));
+  EXPECT_EQ(lens_to_json(lens_from_json(lens_to_json(l), "test")), lens_to_json(l));
+  std::filesystem::remove(file);
+}
+
+TEST(LensCalibrationTable, RefusesWhatIsNoLensWithTheLine) {
+  const std::string ok = "[[lens]]\ncamera = \"A\"\nlens = \"B\"\nwidth_px = 100\nheight_px = 80\nfx = 90\nfy = 90\ncx = 49.5\ncy = 39.5\n";
+  const struct {
+    std::string text, words;
+    int line;
+  } cases[] = {
+      {ok + "colour = 1\n", "unknown key colour", 10},
+      {"[[lens]]\ncamera = \"A\"\nlens = \"B\"\nwidth_px = 100\nheight_px = 80\nfy = 90\ncx = 49.5\ncy = 39.5\n", "missing fx", 1},
+      {ok + "sigma = { fz = 1 }\n", "sigma.fz", 10},
+      {"[[lens]]\ncamera = \"A\"\nlens = \"B\"\nwidth_px = 100\nheight_px = 80\nfx = 90\nfy = 90\ncx = 149.5\ncy = 39.5\n", "principal point", 1},
+      {ok + "\n" + ok, "calibrated twice", 11},
+      {"[[lens]]\nlens = \"B\"\nwidth_px = 100\nheight_px = 80\nfx = 90\nfy = 90\ncx = 49.5\ncy = 39.5\n", "needs camera", 1},
+  };
+  for (const auto& c : cases) {
+    const std::string file = write_file("bad.toml", c.text);
+    try {
+      lenses_from_file(file);
+      ADD_FAILURE() << "accepted: " << c.text;
+    } catch (const Error& e) {
+      EXPECT_EQ(e.cls(), ErrorClass::bad_parameter);
+      EXPECT_NE(std::string(e.what()).find(file + ":" + std::to_string(c.line) + ": lens: "), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(c.words), std::string::npos) << e.what();
+    }
+    std::filesystem::remove(file);
+  }
+}
+
+TEST(LensCalibrationTable, ChosenByNameElseByThePhotographsSize) {
+  LensCalibration a = sample(), b = sample(), c = sample();
+  b.focal_length_mm = 50;
+  c.width_px = 1752, c.height_px = 1168, c.intrinsics.cx = 870, c.intrinsics.cy = 580;
+  const std::vector<LensCalibration> all{a, b, c};
+  EXPECT_EQ(choose_lens(all, "", 1752, 1168)->name(), c.name());       // the only one of that size
+  EXPECT_FALSE(choose_lens(all, "", 4000, 3000).has_value());          // none: nominal, said so by the export
+  EXPECT_EQ(choose_lens(all, b.name(), 3504, 2336)->name(), b.name());
+  EXPECT_THROW(choose_lens(all, "", 3504, 2336), Error);               // two of that size: name one
+  EXPECT_THROW(choose_lens(all, "nothing", 3504, 2336), Error);
+}
+
+TEST(LensCalibrationTable, TooFewPhotographsRefused) {
+  EXPECT_THROW(calibrate_lens({CalibrationView{}, CalibrationView{}}, 100, 80), Error);
+}
+
+}  // namespace
+}  // namespace colorlab::verify
