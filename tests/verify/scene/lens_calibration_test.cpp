@@ -37,13 +37,17 @@ constexpr double kSigmas = 3.0;
 constexpr int kWidth = 1752, kHeight = 1168;
 constexpr double kPitchMm = 19.0;  // the SG's patch pitch (the chart's known geometry; the scale does not enter the intrinsics)
 
-// The simulator's lens: a ~31 mm lens on the 22.5 mm sensor, principal point off the centre, barrel distortion.
-cam::LensIntrinsics true_lens() { return {2450.0, 2452.0, kWidth / 2.0 - 0.5 + 14.0, kHeight / 2.0 - 0.5 - 9.0, -0.09, 0.04}; }
+// The simulator's lens: a ~31 mm lens on the 22.5 mm sensor with barrel distortion. The simulator's posed chart
+// is seen through a pinhole at the frame's centre (fx = fy) whose focal length keeps the chart at
+// chart_height_fraction of the frame: f = fraction · height · distance / chart height. So one lens at several
+// poses is each pose's distance with the fraction that gives this f — no mechanism added to the simulator.
+constexpr double kF = 2450.0;
+cam::LensIntrinsics true_lens() { return {kF, kF, kWidth / 2.0 - 0.5, kHeight / 2.0 - 0.5, -0.09, 0.04}; }
 
 cam::ChartPose pose(double tilt, double swing, double rot, double sx, double sy, double distance) {
   cam::ChartPose p;
   p.tilt_deg = tilt, p.swing_deg = swing, p.rotation_deg = rot, p.shift_x = sx, p.shift_y = sy, p.distance_mm = distance;
-  p.lens = true_lens();
+  p.k1 = true_lens().k1, p.k2 = true_lens().k2;
   return p;
 }
 
@@ -73,7 +77,15 @@ ca::ChartLocation photograph_and_locate(const std::shared_ptr<sim::Scene>& scene
   cam::CameraConfig cc;
   cc.width = kWidth, cc.height = kHeight;
   cc.pose = p;
+  cc.chart_height_fraction = kF * sim::chart_height_mm / (kHeight * p.distance_mm);
   const cam::CameraModel camera(scene, cc);
+  const cam::LensIntrinsics l = camera.lens(), t = true_lens();  // the simulator's own statement of its lens
+  EXPECT_NEAR(l.fx, t.fx, 1e-9);
+  EXPECT_NEAR(l.fy, t.fy, 1e-9);
+  EXPECT_EQ(l.cx, t.cx);
+  EXPECT_EQ(l.cy, t.cy);
+  EXPECT_EQ(l.k1, t.k1);
+  EXPECT_EQ(l.k2, t.k2);
   cam::CameraSettings settings;
   settings.shutter_s = 1.0 / 30;
   const cam::RawFrame frame = camera.render(settings, 1);
@@ -107,7 +119,7 @@ Eigen::Vector3d true_position_mm(const cam::ChartPose& p, const sim::Scene& scen
                              Eigen::AngleAxisd(p.tilt_deg * deg, Eigen::Vector3d::UnitX()) *
                              Eigen::AngleAxisd(p.swing_deg * deg, Eigen::Vector3d::UnitY())).toRotationMatrix();
   const Eigen::Vector3d t = R * Eigen::Vector3d(-sim::chart_width_mm / 2, -sim::chart_height_mm / 2, 0) +
-                            Eigen::Vector3d(p.shift_x * kWidth * p.distance_mm / p.lens->fx, p.shift_y * kHeight * p.distance_mm / p.lens->fy,
+                            Eigen::Vector3d(p.shift_x * kWidth * p.distance_mm / kF, p.shift_y * kHeight * p.distance_mm / kF,
                                             p.distance_mm);
   const Eigen::Vector3d c = -R.transpose() * t;
   const auto [fx, fy] = scene.chart_to_floor_mm(c.x(), c.y());
@@ -157,7 +169,7 @@ TEST(LensCalibrationSim, RecoversTheSimulatorsLensWithinItsStatedUncertainty) {
   // stored calibration and with the nominal lens.
   l.camera = "simulated DSLR", l.lens = "simulated 31 mm", l.source = "calibrate_lens over 6 simulated photographs",
   l.date = "2026-11-29";
-  const cam::ChartPose eval = pose(12, -8, 2, 0.03, -0.02, 1000);
+  const cam::ChartPose eval = pose(-10, 12, -2, -0.03, 0.02, 950);
   const ca::ChartLocation loc = photograph_and_locate(scene, eval);
   const std::vector<json> runs{testing::chart_read_run(*scene, 1), characterize_run(loc)};
   SceneExportOptions o;

@@ -20,11 +20,6 @@
 
 namespace colorlab::sim::camera {
 
-// The pinhole camera of a posed chart, in OpenCV's conventions (pixel centres at integers).
-struct LensIntrinsics {
-  double fx = 0, fy = 0, cx = 0, cy = 0, k1 = 0, k2 = 0;
-};
-
 // Where the chart sits in front of the camera (issue 14). Unset in CameraConfig: the chart square to the sensor,
 // centred, filling chart_height_fraction of the frame height, no lens distortion (the original behaviour).
 struct ChartPose {
@@ -34,13 +29,14 @@ struct ChartPose {
   double distance_mm = 1200; // camera to chart centre; the focal length keeps the chart at chart_height_fraction
   double shift_x = 0, shift_y = 0;  // chart centre offset as a fraction of the frame width / height
   double k1 = 0, k2 = 0;     // radial lens distortion (OpenCV's model, coordinates normalised by the focal length)
-  // A fixed lens (issue 23, lens calibration): these focal lengths, principal point and k1, k2 instead of a focal
-  // length that keeps the chart at chart_height_fraction, a centred principal point and k1, k2 above — so one lens
-  // can photograph the chart at several poses (one CameraModel per pose) and its calibration be checked against it.
-  std::optional<LensIntrinsics> lens;
 };
 // A plausible bench pose for a seed: a few degrees of rotation and tilt, some shift, mild barrel distortion.
 ChartPose random_chart_pose(std::uint64_t seed);
+
+// The pinhole camera of a posed chart, in OpenCV's conventions (pixel centres at integers).
+struct LensIntrinsics {
+  double fx = 0, fy = 0, cx = 0, cy = 0, k1 = 0, k2 = 0;
+};
 
 struct CameraConfig {
   int width = 3504;    // even
