@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <memory>
 #include <numbers>
 #include <unistd.h>
@@ -262,6 +263,54 @@ TEST(LensCalibrationTable, ChosenByNameElseByThePhotographsSize) {
   EXPECT_EQ(choose_lens(all, b.name(), 3504, 2336)->name(), b.name());
   EXPECT_THROW(choose_lens(all, "", 3504, 2336), Error);               // two of that size: name one
   EXPECT_THROW(choose_lens(all, "nothing", 3504, 2336), Error);
+}
+
+std::string read_text(const std::filesystem::path& p) {
+  std::ifstream f(p);
+  return std::string(std::istreambuf_iterator<char>(f), {});
+}
+
+// `colorlab scene` from run files with `--lab`: the lab file's [[lens]] for the located photograph's size is the
+// camera's lens unless --lens overrides it; `colorlab lens list --lab` lists it.
+TEST(LensCalibrationCli, SceneUsesTheLabFilesCalibrationUnlessLensOverrides) {
+  const auto scene = make_scene();
+  const auto dir = std::filesystem::temp_directory_path() / ("colorlab-lens-cli-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  LensCalibration l = sample();
+  l.width_px = kWidth, l.height_px = kHeight, l.intrinsics.cx = 875.5, l.intrinsics.cy = 583.5, l.intrinsics.fx = l.intrinsics.fy = 2450;
+  std::ofstream(dir / "lab.toml") << lens_to_toml(l);
+  ca::ChartLocation loc;
+  const double s = 1000.0 / 262.0;  // a chart seen square-on, 1000 px across 262 mm
+  loc.corners = {{{876 - 131 * s, 584 - 93 * s}, {876 + 131 * s, 584 - 93 * s}, {876 + 131 * s, 584 + 93 * s}, {876 - 131 * s, 584 + 93 * s}}};
+  loc.reprojection_rms_px = 0.2;
+  const std::vector<json> runs{testing::chart_read_run(*scene, 1), characterize_run(loc)};
+  std::ofstream(dir / "chart.json") << runs[0].dump();
+  std::ofstream(dir / "char.json") << runs[1].dump();
+  const std::string base = std::string(COLORLAB_BIN_DIR) + "/colorlab --json ";
+  const std::string scene_cmd = base + "scene " + (dir / "chart.json").string() + " " + (dir / "char.json").string() +
+                                " --lamp D65 --lab " + (dir / "lab.toml").string() + " -o " + (dir / "out").string();
+  const std::string out = " > " + (dir / "log").string() + " 2> " + (dir / "err").string();
+  ASSERT_EQ(std::system((scene_cmd + out).c_str()), 0) << read_text(dir / "err");
+  const json said = json::parse(read_text(dir / "log"));
+  EXPECT_EQ(said["lens_calibrations"], "lab file " + (dir / "lab.toml").string());
+  EXPECT_NE(said["intrinsics"].get<std::string>().find(l.name()), std::string::npos) << said.dump();
+  const json written = json::parse(read_text(dir / "out" / "scene.json"));
+  EXPECT_EQ(written, export_scene(default_cabinet(), runs, {{"D65"}, 100.0, std::nullopt, "", lenses_from_file((dir / "lab.toml").string()), ""}));
+  EXPECT_EQ(written["camera"]["lens_calibration"]["name"], l.name());
+  EXPECT_DOUBLE_EQ(written["camera"]["distortion"]["k1"].get<double>(), l.intrinsics.k1);
+
+  ASSERT_EQ(std::system((scene_cmd + " --lens 3000,3000,870,580" + out).c_str()), 0) << read_text(dir / "err");
+  const json overridden = json::parse(read_text(dir / "out" / "scene.json"))["camera"];
+  EXPECT_EQ(overridden["intrinsics_source"], "lens calibration given with --lens");
+  EXPECT_TRUE(overridden["lens_calibration"].is_null());
+  EXPECT_DOUBLE_EQ(overridden["intrinsics_px"]["fx"].get<double>(), 3000);
+
+  EXPECT_NE(std::system((scene_cmd + " --lens-calibration nothing" + out).c_str()), 0);
+  EXPECT_NE(read_text(dir / "err").find("no lens calibration named"), std::string::npos) << read_text(dir / "err");
+
+  ASSERT_EQ(std::system((base + "lens list --lab " + (dir / "lab.toml").string() + out).c_str()), 0) << read_text(dir / "err");
+  EXPECT_EQ(json::parse(read_text(dir / "log"))["items"], json::array({lens_to_json(l)}));
+  std::filesystem::remove_all(dir);
 }
 
 TEST(LensCalibrationTable, TooFewPhotographsRefused) {
