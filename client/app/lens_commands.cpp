@@ -24,7 +24,7 @@ namespace {
 struct CalibrateOptions {
   std::vector<std::string> photos;
   std::string camera, lens, focus, chart = "sg", cfa, date;
-  double focal_length_mm = 0, black = 0;
+  double focal_length_mm = 0, black = 0, min_confidence = 0.6;
   int bits = 0;
 };
 
@@ -66,7 +66,9 @@ verify::LensCalibration calibrate(const CalibrateOptions& o) {
                   "one calibration holds for one photograph size: use the same camera settings throughout");
     ca::ChartLocation loc;
     try {
-      loc = ca::locate_chart(view, type);
+      ca::LocateOptions lo;
+      lo.min_confidence = o.min_confidence;
+      loc = ca::locate_chart(view, type, lo);
     } catch (const Error& e) {
       throw Error(e.cls(), path + ": " + e.what(), e.hint());
     }
@@ -109,6 +111,9 @@ void add_lens_commands(CLI::App& app, GlobalOptions& global) {
   cal->add_option("--black", o->black, "black level of the counts");
   cal->add_option("--bits", o->bits, "significant bits (12 for a 12-bit raw)");
   cal->add_option("--date", o->date, "the calibration's date (default: today, UTC)");
+  cal->add_option("--min-confidence", o->min_confidence,
+                  "refuse a photograph the locator is less sure of (0..1; only its detected patches are used)")
+      ->capture_default_str();
   cal->callback([&global, o] {
     const verify::LensCalibration l = calibrate(*o);
     if (global.json) std::cout << verify::lens_to_json(l).dump(2) << "\n";

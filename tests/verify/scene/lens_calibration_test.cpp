@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -74,7 +75,20 @@ std::shared_ptr<sim::Scene> make_scene() {
 
 // The simulator photographs the chart at one pose through the fixed lens; the locator finds it as
 // characterize-camera does (no lens given: the lens is what is being calibrated).
-ca::ChartLocation photograph_and_locate(const std::shared_ptr<sim::Scene>& scene, const cam::ChartPose& p) {
+std::string read_text(const std::filesystem::path& p) {
+  std::ifstream f(p);
+  return std::string(std::istreambuf_iterator<char>(f), {});
+}
+
+// Written as a 16-bit PGM (the raw mosaic's counts as they are), for `colorlab lens calibrate`.
+void write_pgm(const cam::RawFrame& f, const std::filesystem::path& path) {
+  std::ofstream o(path, std::ios::binary);
+  o << "P5\n" << f.width << " " << f.height << "\n65535\n";
+  for (const auto v : f.pixels) o.put(static_cast<char>(v >> 8)).put(static_cast<char>(v & 0xff));
+}
+
+ca::ChartLocation photograph_and_locate(const std::shared_ptr<sim::Scene>& scene, const cam::ChartPose& p,
+                                        const std::filesystem::path& pgm = {}, double* black = nullptr) {
   cam::CameraConfig cc;
   cc.width = kWidth, cc.height = kHeight;
   cc.pose = p;
@@ -90,6 +104,8 @@ ca::ChartLocation photograph_and_locate(const std::shared_ptr<sim::Scene>& scene
   cam::CameraSettings settings;
   settings.shutter_s = 1.0 / 30;
   const cam::RawFrame frame = camera.render(settings, 1);
+  if (!pgm.empty()) write_pgm(frame, pgm);
+  if (black) *black = frame.black_level;
   ca::LocateOptions lo;
   for (std::size_t k = 0; k < scene->chart().patches.size(); ++k) {
     if (!lo.reference) lo.reference.emplace();
@@ -145,8 +161,16 @@ TEST(LensCalibrationSim, RecoversTheSimulatorsLensWithinItsStatedUncertainty) {
   const std::vector<cam::ChartPose> poses{pose(20, 0, 0, -0.18, -0.15, 800),  pose(-20, 15, 3, 0.18, -0.15, 850),
                                           pose(10, -20, -3, -0.18, 0.15, 800), pose(-15, -15, 5, 0.18, 0.15, 850),
                                           pose(0, 25, -4, 0, 0, 750),         pose(25, 10, 2, 0.05, 0, 900)};
+  const auto dir = std::filesystem::temp_directory_path() / ("colorlab-lens-sim-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
   std::vector<CalibrationView> views;
-  for (const auto& p : poses) views.push_back(view_of(photograph_and_locate(scene, p)));
+  std::string photos;
+  double black = 0;
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    const auto pgm = dir / ("pose" + std::to_string(i) + ".pgm");
+    views.push_back(view_of(photograph_and_locate(scene, poses[i], pgm, &black)));
+    photos += " " + pgm.string();
+  }
   LensCalibration l = calibrate_lens(views, kWidth, kHeight);
 
   const cam::LensIntrinsics t = true_lens();
@@ -161,6 +185,26 @@ TEST(LensCalibrationSim, RecoversTheSimulatorsLensWithinItsStatedUncertainty) {
     EXPECT_GT(sigma[i], 0) << names[i];
     EXPECT_LE(std::abs(got[i] - truth[i]), kSigmas * sigma[i]) << names[i] << " = " << got[i] << ", truth " << truth[i] << ", σ " << sigma[i];
   }
+
+  // `colorlab lens calibrate` on the same photographs (the raw mosaics as 16-bit PGM): the same calibration, to a
+  // hundredth of its own σ (its chart points are in grid units rather than mm, so the solver's path differs).
+  const std::string cmd = std::string(COLORLAB_BIN_DIR) + "/colorlab --json lens calibrate" + photos +
+                          " --camera cam --lens lens --cfa RGGB --bits 12 --min-confidence 0.05 --black " + std::to_string(black) + " > " +
+                          (dir / "out").string() + " 2> " + (dir / "err").string();
+  if (std::system(cmd.c_str()) != 0) {
+    ADD_FAILURE() << read_text(dir / "err");
+  } else {
+    std::ifstream f(dir / "out");
+    const json cli = json::parse(f);
+    const json mine = lens_to_json(l);
+    for (const char* k : names) {
+      EXPECT_NEAR(cli[k].get<double>(), mine[k].get<double>(), 0.01 * mine["sigma"][k].get<double>()) << k;
+      EXPECT_NEAR(cli["sigma"][k].get<double>(), mine["sigma"][k].get<double>(), 0.01 * mine["sigma"][k].get<double>()) << k;
+    }
+    EXPECT_EQ(cli["points"], l.points);
+    EXPECT_EQ(cli["name"], "cam / lens");
+  }
+  std::filesystem::remove_all(dir);
 
   // The stated σ is not so wide that it says nothing: a lens 2 % off in focal length lies outside the band.
   EXPECT_GT(0.02 * t.fx, kSigmas * l.sigma.fx);
@@ -263,11 +307,6 @@ TEST(LensCalibrationTable, ChosenByNameElseByThePhotographsSize) {
   EXPECT_EQ(choose_lens(all, b.name(), 3504, 2336)->name(), b.name());
   EXPECT_THROW(choose_lens(all, "", 3504, 2336), Error);               // two of that size: name one
   EXPECT_THROW(choose_lens(all, "nothing", 3504, 2336), Error);
-}
-
-std::string read_text(const std::filesystem::path& p) {
-  std::ifstream f(p);
-  return std::string(std::istreambuf_iterator<char>(f), {});
 }
 
 // `colorlab scene` from run files with `--lab`: the lab file's [[lens]] for the located photograph's size is the
