@@ -14,6 +14,7 @@
 #include "access_commands.hpp"
 #include "locate_commands.hpp"
 #include "doctor_command.hpp"
+#include "lens_commands.hpp"
 #include "scene_command.hpp"
 #include "verify_command.hpp"
 #include "backup_commands.hpp"
@@ -42,6 +43,7 @@ int main(int argc, char** argv) {
   colorlab::cli::add_locate_commands(app, global);
   colorlab::cli::add_doctor_command(app, global);
   colorlab::cli::add_scene_command(app, global);
+  colorlab::cli::add_lens_commands(app, global);
   colorlab::cli::add_verify_command(app, global);
   colorlab::cli::add_backup_commands(app);
 #ifdef COLORLAB_HAVE_ANALYZE

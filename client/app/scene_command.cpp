@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "client_support.hpp"
@@ -31,6 +32,7 @@ struct SceneOptions {
   std::vector<std::string> lamps;
   double dimmer = 100.0;
   std::string lens;
+  std::string lens_calibration;
 };
 
 // --lens fx,fy,cx,cy[,k1,k2]: the lab's lens calibration, as `colorlab analyze locate-chart --lens` takes it.
@@ -92,6 +94,19 @@ std::pair<verify::CabinetGeometry, std::string> choose_cabinet(const GlobalOptio
           "daemon (" + answer.value("source", std::string("?")) + ")"};
 }
 
+// The lab's stored lens calibrations, from where the cabinet comes from: --lab's [[lens]]; the daemon's
+// (GET /v1/lab/lenses) when the runs come from it; none for run files alone.
+std::pair<std::vector<verify::LensCalibration>, std::string> lab_lenses(const GlobalOptions& g, const SceneOptions& o) {
+  if (!o.lab.empty()) return {verify::lenses_from_file(o.lab), "lab file " + o.lab};
+  if (std::all_of(o.runs.begin(), o.runs.end(), is_file)) return {{}, "none (run files only)"};
+  const json answer = json::parse(fetch_bytes(g, "/v1/lab/lenses").body);
+  if (!answer.is_object() || !answer.contains("items") || !answer["items"].is_array())
+    throw Error(ErrorClass::bad_data, "GET /v1/lab/lenses: no items in the daemon's answer", "give the lens with --lens");
+  std::vector<verify::LensCalibration> out;
+  for (const auto& i : answer["items"]) out.push_back(verify::lens_from_json(i, "GET /v1/lab/lenses"));
+  return {out, "daemon"};
+}
+
 }  // namespace
 
 void add_scene_command(CLI::App& app, GlobalOptions& global) {
@@ -112,27 +127,33 @@ void add_scene_command(CLI::App& app, GlobalOptions& global) {
       ->capture_default_str();
   cmd->add_option("--lens", o->lens,
                   "the lab's lens calibration fx,fy,cx,cy[,k1,k2] (pixels of the located photograph), for the camera's "
-                  "intrinsics with a characterize-camera run's pose (default: a nominal 50 mm lens, said so in scene.json)");
+                  "intrinsics with a characterize-camera run's pose; overrides the stored calibrations (default: the lab's "
+                  "[[lens]] calibration for the photograph's size, else a nominal 50 mm lens, said so in scene.json)");
+  cmd->add_option("--lens-calibration", o->lens_calibration,
+                  "the stored lens calibration to use, by name (colorlab lens list), when several fit the photograph");
   cmd->callback([&global, o] {
     const auto [cabinet, cabinet_source] = choose_cabinet(global, *o);
     std::vector<json> runs;
     for (const auto& r : o->runs) runs.push_back(load_run(global, r));
-    verify::SceneExportOptions so{o->lamps, o->dimmer, parse_lens(o->lens), ""};
+    verify::SceneExportOptions so{o->lamps, o->dimmer, parse_lens(o->lens), "", {}, o->lens_calibration};
+    std::string lenses_from = "not consulted (--lens given)";
     if (so.lens) so.lens_source = "lens calibration given with --lens";
+    else std::tie(so.lenses, lenses_from) = lab_lenses(global, *o);
     const json scene = verify::export_scene(cabinet, runs, so);
     verify::write_scene(scene, o->output);
     json lamps = json::array();
     for (const auto& l : scene["lamps"]) lamps.push_back({{"name", l["name"]}, {"luminance_cd_m2", l["luminance_cd_m2"]},
                                                            {"level", l["level"]["source"]},});
     json done{{"directory", o->output}, {"files", {"scene.json", "build_scene.py"}}, {"lamps", lamps},
-              {"patches", scene["chart"]["patches"].size()}, {"cabinet", cabinet_source},};
+              {"patches", scene["chart"]["patches"].size()}, {"cabinet", cabinet_source},
+              {"lens_calibrations", lenses_from}, {"intrinsics", scene["camera"].value("intrinsics_source", std::string())},};
     print(global, done, [](const json& j) {
       std::string s = "wrote " + j["directory"].get<std::string>() + "/scene.json and build_scene.py (" +
                       std::to_string(j["patches"].get<std::size_t>()) + " patches";
       for (const auto& l : j["lamps"])
         s += ", " + l["name"].get<std::string>() + " " + std::to_string(l["luminance_cd_m2"].get<double>()) + " cd/m² (" +
              l["level"].get<std::string>() + ")";
-      s += "; cabinet: " + j["cabinet"].get<std::string>();
+      s += "; cabinet: " + j["cabinet"].get<std::string>() + "; camera intrinsics: " + j["intrinsics"].get<std::string>();
       return s + ")\nrender: blender -b --factory-startup -noaudio -P " + j["directory"].get<std::string>() +
              "/build_scene.py -- --mode bands\n";
     });

@@ -270,6 +270,8 @@ Daemon::Daemon(DaemonConfig config) : impl_(std::make_unique<Impl>()) {
   d.api->console_dir = shipped_console_dir();
   d.api->cabinet = {{"source", d.config.cabinet ? "config" : "default"},
                     {"cabinet", verify::cabinet_to_json(d.config.cabinet.value_or(verify::default_cabinet()))}};
+  d.api->lenses = {{"items", nlohmann::json::array()}};
+  for (const auto& l : d.config.lenses) d.api->lenses["items"].push_back(verify::lens_to_json(l));
   ReportService::Options report_options;
   report_options.directory = d.config.state_dir / "reports";
   report_options.unix_socket = d.config.socket_path();

@@ -147,6 +147,7 @@ ChartLocation locate_chart(const PhotoView& photo, ChartType type, const LocateO
   double pitch_px = 0;
   std::vector<bool> detected(static_cast<std::size_t>(L.size()), false);
   std::vector<cv::Point2d> observed(static_cast<std::size_t>(L.size()));  // undistorted centroid of each detected patch
+  std::vector<cv::Point2d> seen(static_cast<std::size_t>(L.size()));      // the same centroid as photographed
   Score conf;
   const std::vector<cv::Point2d> grid_corners{{0, 0}, {L.grid_width(), 0}, {L.grid_width(), L.grid_height()}, {0, L.grid_height()}};
 
@@ -179,7 +180,10 @@ ChartLocation locate_chart(const PhotoView& photo, ChartType type, const LocateO
       double bd = 0.3 * pitch_px;
       for (std::size_t q = 0; q < centres.size(); ++q)
         if (cv::norm(centres[q] - p) < bd) bd = cv::norm(centres[q] - p), best = static_cast<int>(q);
-      if (best >= 0) g.emplace_back(L.centre_x(k), L.centre_y(k)), im.push_back(centres[static_cast<std::size_t>(best)]), which.push_back(k);
+      if (best >= 0) {
+        g.emplace_back(L.centre_x(k), L.centre_y(k)), im.push_back(centres[static_cast<std::size_t>(best)]), which.push_back(k);
+        seen[static_cast<std::size_t>(k)] = raw_centres[static_cast<std::size_t>(best)];
+      }
     }
     if (g.size() >= 8) {
       std::vector<unsigned char> inl;
@@ -242,7 +246,10 @@ ChartLocation locate_chart(const PhotoView& photo, ChartType type, const LocateO
       const cv::Point2d cell = apply(best.grid_to_lattice, {L.centre_x(k), L.centre_y(k)});
       const auto it = lat->cells.find({static_cast<int>(std::lround(cell.x)), static_cast<int>(std::lround(cell.y))});
       detected[static_cast<std::size_t>(k)] = it != lat->cells.end();
-      if (it != lat->cells.end()) observed[static_cast<std::size_t>(k)] = centres[static_cast<std::size_t>(it->second)];
+      if (it != lat->cells.end()) {
+        observed[static_cast<std::size_t>(k)] = centres[static_cast<std::size_t>(it->second)];
+        seen[static_cast<std::size_t>(k)] = raw_centres[static_cast<std::size_t>(it->second)];
+      }
     }
   }
 
@@ -283,7 +290,11 @@ ChartLocation locate_chart(const PhotoView& photo, ChartType type, const LocateO
     loc.rotation_deg = ((q % 4) + 4) % 4 * 90;
   }
   loc.patches = sample_chart(photo, L, loc.homography, o);
-  for (int k = 0; k < L.size(); ++k) loc.patches[static_cast<std::size_t>(k)].detected = detected[static_cast<std::size_t>(k)];
+  for (int k = 0; k < L.size(); ++k) {
+    auto& p = loc.patches[static_cast<std::size_t>(k)];
+    p.detected = detected[static_cast<std::size_t>(k)];
+    if (p.detected) p.observed = {seen[static_cast<std::size_t>(k)].x, seen[static_cast<std::size_t>(k)].y};
+  }
 
   if (!groups.empty()) loc.check = check_repeated_neutrals(L, groups, loc.patches, photo.black_level, o.neutral_tolerance);
   else if (!L.neutral_ramp.empty()) loc.check = check_neutral_ramp(L, loc.patches, photo.black_level);

@@ -24,6 +24,7 @@ constexpr Route kRoutes[] = {
     {"GET",    "/v1/ports",                            read,    main,    r::get_ports},
     {"GET",    "/v1/campaigns",                        read,    main,    r::get_campaigns},
     {"GET",    "/v1/lab/cabinet",                      read,    main,    r::get_lab_cabinet},
+    {"GET",    "/v1/lab/lenses",                       read,    main,    r::get_lab_lenses},
     {"GET",    "/v1/events",                           read,    pool,    r::get_events},
     {"GET",    "/v1/events/stream",                    read,    main,    r::get_event_stream},
     {"POST",   "/v1/executions",                       control, main,    r::post_execution},

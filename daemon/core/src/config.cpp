@@ -9,6 +9,7 @@
 #include "colorlab/core/error.hpp"
 #include "colorlab/protocol/api.hpp"
 #include "colorlab/verify/cabinet_toml.hpp"
+#include "colorlab/verify/lens_toml.hpp"
 
 namespace colorlab::daemon {
 
@@ -327,6 +328,11 @@ static DaemonConfig from_toml(const toml::table& root, const std::filesystem::pa
       auto t = node.as_table();
       if (!t) bad(file, node.source(), "[cabinet] must be a table");
       c.cabinet = verify::cabinet_from_toml(*t, file);
+    } else if (k == "lens") {
+      // The lab's lens calibrations, with the lab's other per-camera facts: the same [[lens]] parser as --lab files.
+      auto a = node.as_array();
+      if (!a) bad(file, node.source(), "lens must be [[lens]] tables");
+      c.lenses = verify::lenses_from_toml(*a, file.string());
     } else if (k == "blobs") {
       parse_blobs(node, c.blobs, file);
     } else if (k == "ship") {

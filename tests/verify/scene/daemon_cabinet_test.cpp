@@ -17,6 +17,7 @@
 #include "colorlab/testing/temp_dir.hpp"
 #include "colorlab/verify/cabinet_json.hpp"
 #include "colorlab/verify/cabinet_toml.hpp"
+#include "colorlab/verify/lens_calibration.hpp"
 #include "colorlab/verify/scene_export.hpp"
 
 namespace {
@@ -39,6 +40,37 @@ center_mm = [600, 250]
 size_mm = [900, 120]
 luminance_cd_m2 = 15000
 )";
+
+// The lab's lens calibration for 1752 × 1168 photographs (docs/verify.md "The lens calibration"), kept beside it.
+constexpr const char* kLens = R"(
+[[lens]]
+camera = "simulated DSLR"
+lens = "simulated 31 mm"
+width_px = 1752
+height_px = 1168
+fx = 2450
+fy = 2452
+cx = 889.5
+cy = 574.5
+k1 = -0.09
+k2 = 0.04
+sigma = { fx = 13, fy = 13, cx = 6, cy = 7, k1 = 0.015, k2 = 0.12 }
+source = "test"
+date = "2026-11-29"
+)";
+
+// A characterize-camera run's export with the located chart's corners on a 1752 × 1168 photograph (seen
+// square-on), as a file: `colorlab scene` takes run files beside run ids.
+json characterize_run() {
+  const double s = 1000.0 / 262.0;
+  json corners = json::array({{876 - 131 * s, 584 - 93 * s}, {876 + 131 * s, 584 - 93 * s}, {876 + 131 * s, 584 + 93 * s},
+                              {876 - 131 * s, 584 + 93 * s}});
+  json row{{"step", "chart/raw"}, {"quantity", "chart_location"}, {"value", 1.0},
+           {"data", {{"format", "raw"}, {"corners", corners}, {"width", 1752}, {"height", 1168}, {"reprojection_rms_px", 0.2}}}};
+  return {{"run", {{"id", "0193c0de-0000-7000-8000-0000000cc0de"}, {"campaign", "characterize-camera"},
+                   {"params", json::object()}, {"status", "finished_ok"}}},
+          {"measurements", json::array({row})}};
+}
 
 std::string read_file(const std::filesystem::path& p) {
   std::ifstream f(p);
@@ -84,7 +116,10 @@ TEST(DaemonCabinet, BadGeometryIsATypedErrorNamingTheLine) {
                         Case{"[cabinet]\n\n[[cabinet.emitter]]\nlamp = \"D65\"\ncenter_mm = [600, 580]\nsize_mm = [1000, 100]\n",
                              1, "ceiling"},
                         Case{"[cabinet]\nheight = 600\n", 2, "unknown key cabinet.height"},
-                        Case{"cabinet = 3\n", 1, "[cabinet] must be a table"}}) {
+                        Case{"cabinet = 3\n", 1, "[cabinet] must be a table"},
+                        Case{"[[lens]]\ncamera = \"A\"\nlens = \"B\"\nwidth_px = 100\nheight_px = 80\nfx = 0\nfy = 90\ncx = 49.5\ncy = 39.5\n", 1,
+                             "lens: fx and fy must be > 0"},
+                        Case{"lens = 3\n", 1, "[[lens]] tables"}}) {
     try {
       colorlab::daemon::parse_config(c.toml, dir / "colorlabd.toml");
       ADD_FAILURE() << "accepted:\n" << c.toml;
@@ -113,9 +148,11 @@ TEST(DaemonCabinet, SceneAgainstTheDaemonUsesItsCabinetWithoutLab) {
   TempDir dir;
   std::ofstream(dir / "lab.toml") << "[genicam]\nenabled = false\n";
   std::ofstream(dir / "colorlabd.toml") << "[simulator]\nenabled = true\ntime_scale = 1000\nseed = 5\nconfig = \"lab.toml\"\n\n"
-                                        << kCabinet;
-  std::ofstream(dir / "cabinet.toml") << kCabinet;
+                                        << kCabinet << kLens;
+  std::ofstream(dir / "cabinet.toml") << kCabinet << kLens;
+  std::ofstream(dir / "characterize.json") << characterize_run().dump();
   const verify::CabinetGeometry expected = verify::cabinet_from_file(dir / "cabinet.toml");
+  const auto lenses = verify::lenses_from_file((dir / "cabinet.toml").string());
   DaemonProcess daemon(dir / "state", dir / "colorlabd.toml");
   colorlab::client::Endpoint ep;
   ep.unix_socket = daemon.unix_socket();
@@ -124,6 +161,14 @@ TEST(DaemonCabinet, SceneAgainstTheDaemonUsesItsCabinetWithoutLab) {
   const json served = api.get("/v1/lab/cabinet");
   EXPECT_EQ(served["source"], "config");
   EXPECT_EQ(served["cabinet"], verify::cabinet_to_json(expected));
+  // The lens calibration: served as the same table reads through --lab's parser, listed by the CLI.
+  ASSERT_EQ(lenses.size(), 1u);
+  EXPECT_EQ(api.get("/v1/lab/lenses"), json({{"items", json::array({verify::lens_to_json(lenses[0])})}}));
+  const auto listed = colorlab::testing::run_command({colorlab::testing::bin_path("colorlab"), "--socket", daemon.unix_socket(),
+                                                      "--json", "lens", "list"},
+                                                     std::chrono::seconds(60));
+  ASSERT_EQ(listed.exit_code, 0) << listed.err;
+  EXPECT_EQ(json::parse(listed.out)["items"], json::array({verify::lens_to_json(lenses[0])}));
 
   // A chart-read (140 patches, about 2 s at time scale 1000) to export.
   const json e = api.post("/v1/executions", {{"campaign", "chart-read"}, {"params", json::object()}});
@@ -139,15 +184,20 @@ TEST(DaemonCabinet, SceneAgainstTheDaemonUsesItsCabinetWithoutLab) {
   const std::string run = done["run_id"].get<std::string>();
 
   const auto r = colorlab::testing::run_command({colorlab::testing::bin_path("colorlab"), "--socket", daemon.unix_socket(),
-                                                 "--json", "scene", run, "--lamp", "D65", "-o", (dir / "out").string()},
+                                                 "--json", "scene", run, (dir / "characterize.json").string(), "--lamp", "D65",
+                                                 "-o", (dir / "out").string()},
                                                 std::chrono::seconds(60));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(json::parse(r.out)["cabinet"], "daemon (config)") << r.out;
+  EXPECT_EQ(json::parse(r.out)["lens_calibrations"], "daemon") << r.out;
   // The whole scene is what the export makes of that cabinet and the stored run (as --lab FILE would give).
   const json chart = json::parse(
       api.request("GET", "/v1/runs/" + run + "/export?format=json").body);
   const json scene = json::parse(read_file(dir / "out" / "scene.json"));
-  EXPECT_EQ(scene, verify::export_scene(expected, {chart}, {{"D65"}, 100.0}));
+  // The camera's intrinsics: the daemon's stored calibration for the located photograph's size, by default.
+  EXPECT_EQ(scene, verify::export_scene(expected, {chart, characterize_run()}, {{"D65"}, 100.0, std::nullopt, "", lenses, ""}));
+  EXPECT_EQ(scene["camera"]["lens_calibration"]["name"], "simulated DSLR / simulated 31 mm") << scene["camera"].dump();
+  EXPECT_FALSE(scene["camera"]["estimated"].get<bool>());
   EXPECT_DOUBLE_EQ(scene["cabinet"]["height_m"].get<double>(), 0.7) << scene["cabinet"].dump();
   EXPECT_DOUBLE_EQ(scene["cabinet"]["floor_reflectance"].get<double>(), 0.25);
   EXPECT_DOUBLE_EQ(scene["lamps"][0]["luminance_cd_m2"].get<double>(), 15000);

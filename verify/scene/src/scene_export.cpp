@@ -311,9 +311,17 @@ json camera_part(const CabinetGeometry& cab, const json& chart_doc, const json* 
   const double sensor_w = 22.5;
   CameraIntrinsics k;
   std::string source;
+  json calibration = nullptr;
+  const std::optional<LensCalibration> stored =
+      o.lens ? std::nullopt : choose_lens(o.lenses, o.lens_name, static_cast<int>(width), static_cast<int>(height));
   if (o.lens) {
     k = *o.lens;
     source = o.lens_source.empty() ? "the lab's lens calibration" : o.lens_source;
+  } else if (stored) {
+    k = stored->intrinsics;
+    source = "lens calibration \"" + stored->name() + "\" (" + (stored->source.empty() ? "source not stated" : stored->source) +
+             (stored->date.empty() ? "" : ", " + stored->date) + ")";
+    calibration = lens_to_json(*stored);
   } else {
     k.fx = k.fy = 50.0 * width / sensor_w;
     k.cx = width / 2 - 0.5, k.cy = height / 2 - 0.5;
@@ -341,7 +349,8 @@ json camera_part(const CabinetGeometry& cab, const json& chart_doc, const json* 
           {"intrinsics_px", {{"fx", k.fx}, {"fy", k.fy}, {"cx", k.cx}, {"cy", k.cy}}},
           {"distortion", {{"k1", k.k1}, {"k2", k.k2}}},
           {"intrinsics_source", source},
-          {"estimated", !o.lens},
+          {"estimated", !o.lens && !stored},
+          {"lens_calibration", calibration},
           {"pose", {{"source", "located chart"}, {"run", id}, {"format", format}, {"corners_px", corners},
                     {"corner_accuracy_px", s.accuracy_px}, {"reprojection_px", p.reprojection_px},
                     {"position_sigma_m", {p.position_sigma_mm[0] * mm, p.position_sigma_mm[1] * mm, p.position_sigma_mm[2] * mm}},

@@ -57,6 +57,9 @@ struct ChartPatchSample {
   Point2 centre;                    // image pixels (pixel centres at integers)
   Rect region;                      // sampled pixels
   bool detected = false;            // its own square was found (not only predicted by the fit)
+  // When detected: the centroid of its own square as photographed (lens distortion not removed) — the point a lens
+  // calibration needs (issue 23), where `centre` is the fit's prediction.
+  Point2 observed;
   int channels = 1;                 // 1 grey, 3 R, G, B (or the CFA's R, G, B)
   std::array<PatchValue, 3> value;  // robust value per channel
 };

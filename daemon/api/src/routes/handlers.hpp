@@ -16,6 +16,7 @@ HttpResponse get_root(ApiContext& ctx, const HttpRequest& req, const PathParams&
 HttpResponse get_instruments(ApiContext& ctx, const HttpRequest& req, const PathParams& params);
 HttpResponse get_ports(ApiContext& ctx, const HttpRequest& req, const PathParams& params);
 HttpResponse get_lab_cabinet(ApiContext& ctx, const HttpRequest& req, const PathParams& params);
+HttpResponse get_lab_lenses(ApiContext& ctx, const HttpRequest& req, const PathParams& params);
 HttpResponse get_campaigns(ApiContext& ctx, const HttpRequest& req, const PathParams& params);
 
 // ship_routes.cpp: colorlab-ship's lag and last error, read from the bench's own files.

@@ -1,4 +1,4 @@
-// The daemon and the lab as they are now: GET /v1, /v1/instruments, /v1/ports, /v1/campaigns, /v1/lab/cabinet.
+// The daemon and the lab as they are now: GET /v1, /v1/instruments, /v1/ports, /v1/campaigns, /v1/lab/cabinet, /v1/lab/lenses.
 #include <nlohmann/json.hpp>
 
 #include "colorlab/daemon/executions.hpp"
@@ -71,6 +71,11 @@ HttpResponse get_ports(ApiContext& ctx, const HttpRequest&, const PathParams&) {
 // The cabinet's geometry from colorlabd's configuration (validated at start), for `colorlab scene`.
 HttpResponse get_lab_cabinet(ApiContext& ctx, const HttpRequest&, const PathParams&) {
   return HttpResponse::json(200, ctx.cabinet);
+}
+
+// The lab's lens calibrations from colorlabd's configuration (validated at start), for `colorlab scene` and `colorlab lens`.
+HttpResponse get_lab_lenses(ApiContext& ctx, const HttpRequest&, const PathParams&) {
+  return HttpResponse::json(200, ctx.lenses.is_null() ? nlohmann::json{{"items", nlohmann::json::array()}} : ctx.lenses);
 }
 
 }  // namespace colorlab::daemon::routes

@@ -45,6 +45,8 @@ struct ApiContext {
   ReportService* reports = nullptr;   // GET /v1/runs/{id}/report (report_response.hpp)
   // GET /v1/lab/cabinet: {source: "config" | "default", cabinet: cabinet_to_json(...)} (lab_routes.cpp)
   nlohmann::json cabinet;
+  // GET /v1/lab/lenses: {items: [lens_to_json(...)]}, the configuration's [[lens]] calibrations (lab_routes.cpp)
+  nlohmann::json lenses;
 };
 
 }  // namespace colorlab::daemon

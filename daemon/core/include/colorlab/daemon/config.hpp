@@ -9,6 +9,7 @@
 
 #include "colorlab/drivers/factory.hpp"
 #include "colorlab/verify/cabinet.hpp"
+#include "colorlab/verify/lens_calibration.hpp"
 
 namespace colorlab::daemon {
 
@@ -112,6 +113,8 @@ struct DaemonConfig {
   // the file is read and served at GET /v1/lab/cabinet, so `colorlab scene` gets the lab's box without --lab.
   // Absent: the built-in cabinet.
   std::optional<verify::CabinetGeometry> cabinet;
+  // The lab's lens calibrations ([[lens]], docs/verify.md "The lens calibration"), served at GET /v1/lab/lenses.
+  std::vector<verify::LensCalibration> lenses;
 
   std::filesystem::path database_path() const;
   std::filesystem::path socket_path() const;

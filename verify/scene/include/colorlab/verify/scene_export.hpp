@@ -13,6 +13,7 @@
 
 #include "colorlab/verify/cabinet.hpp"
 #include "colorlab/verify/camera_pose.hpp"
+#include "colorlab/verify/lens_calibration.hpp"
 
 namespace colorlab::verify {
 
@@ -25,6 +26,10 @@ struct SceneExportOptions {
   // it the camera's intrinsics are the nominal EOS 20D's (stated so in scene.json).
   std::optional<CameraIntrinsics> lens;
   std::string lens_source;
+  // The lab's stored lens calibrations ([[lens]], lens_calibration.hpp), used when `lens` is not given: the one
+  // named `lens_name`, else the only one for the located photograph's size (choose_lens). scene.json names it.
+  std::vector<LensCalibration> lenses;
+  std::string lens_name;
 };
 
 inline constexpr std::string_view scene_schema = "colorlab-scene/1";
