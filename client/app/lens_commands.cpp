@@ -61,8 +61,9 @@ verify::LensCalibration calibrate(const CalibrateOptions& o) {
     if (!o.cfa.empty()) view.cfa = cfa_of(o.cfa);
     if (width == 0) width = view.width, height = view.height;
     if (view.width != width || view.height != height)
-      throw Error(ErrorClass::bad_parameter, path + " is " + std::to_string(view.width) + " × " + std::to_string(view.height) +
-                                                 ", the first photograph " + std::to_string(width) + " × " + std::to_string(height),
+      throw Error(ErrorClass::bad_parameter,
+                  path + " is " + std::to_string(view.width) + " × " + std::to_string(view.height) +
+                      ", the first photograph " + std::to_string(width) + " × " + std::to_string(height),
                   "one calibration holds for one photograph size: use the same camera settings throughout");
     ca::ChartLocation loc;
     try {

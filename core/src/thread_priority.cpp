@@ -32,13 +32,21 @@ int heavy_thread_nice() { return g_heavy_nice.load(); }
 void lower_this_thread(int steps, std::string_view who) {
   if (steps <= 0) return;
   const auto tid = static_cast<id_t>(this_tid());
+  // Counted from the process's own nice (its main thread's), not this thread's: a heavy thread started by another
+  // heavy thread (a camera's decode thread rebuilt on its device thread) inherits the lowered value, and lowering
+  // it again would stack the steps down to 19.
+  errno = 0;
+  const int base = ::getpriority(PRIO_PROCESS, static_cast<id_t>(::getpid()));
+  const int base_errno = errno;
   errno = 0;
   const int now = ::getpriority(PRIO_PROCESS, tid);
-  if (now == -1 && errno != 0) {
-    log::warning("priority", std::string(who) + ": cannot read its nice value: " + std::strerror(errno));
+  if ((base == -1 && base_errno != 0) || (now == -1 && errno != 0)) {
+    log::warning("priority", std::string(who) + ": cannot read its nice value: " + std::strerror(errno ? errno : base_errno));
     return;
   }
-  if (::setpriority(PRIO_PROCESS, tid, std::min(19, now + steps)) != 0) {
+  const int target = std::min(19, base + steps);
+  if (now >= target) return;
+  if (::setpriority(PRIO_PROCESS, tid, target) != 0) {
     log::warning("priority", std::string(who) + ": cannot lower its CPU priority: " + std::strerror(errno));
   }
 }
@@ -68,7 +76,11 @@ int nice_in_stat(const std::filesystem::path& stat_file) {
   for (int i = 3; i <= 19; ++i) {
     if (!(fields >> field)) throw Error(ErrorClass::bad_data, path + " has fewer than 19 fields: " + stat);
   }
-  return std::stoi(field);
+  try {
+    return std::stoi(field);
+  } catch (const std::exception&) {
+    throw Error(ErrorClass::bad_data, path + ": its nice field is not a number: " + field);
+  }
 }
 
 }  // namespace colorlab::core

@@ -50,6 +50,13 @@ EmbeddedSim::EmbeddedSim(const std::filesystem::path& sim_binary, const Simulato
     args.push_back(std::to_string(*config.seed));
   }
 
+  // Built before fork: the child of a threaded process may call only async-signal-safe functions until exec, and
+  // allocating could deadlock on a malloc lock another thread held at the fork.
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  const std::string exec_failed = "colorlabd: cannot run " + args.front() + "\n";
+
   int fds[2];
   if (::pipe2(fds, O_CLOEXEC) != 0) throw Error(ErrorClass::io_error, std::string("pipe: ") + std::strerror(errno));
   pid_t parent = ::getpid();
@@ -65,11 +72,8 @@ EmbeddedSim::EmbeddedSim(const std::filesystem::path& sim_binary, const Simulato
       if (errno == 0) ::setpriority(PRIO_PROCESS, 0, now + config.nice > 19 ? 19 : now + config.nice);
     }
     ::dup2(fds[1], STDOUT_FILENO);
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
     ::execv(argv[0], argv.data());
-    std::fprintf(stderr, "colorlabd: cannot run %s: %s\n", argv[0], std::strerror(errno));
+    [[maybe_unused]] const auto written = ::write(STDERR_FILENO, exec_failed.data(), exec_failed.size());
     _exit(127);
   }
   ::close(fds[1]);

@@ -218,7 +218,9 @@ TEST(BlenderDaemon, TheDaemonsExportedSceneRenderedByBlenderIsVerifiedThroughThe
     SCOPED_TRACE("the same bands lit by CIE A instead of D65: flagged nearly everywhere, exit 4");
     const auto [rc, result] = verify(wrong_lamp);
     ASSERT_TRUE(result.contains("comparisons")) << result.dump().substr(0, 2000);
-    const auto& t = tally(result).at("colour_7_3");
+    const auto k = tally(result);  // by value: a reference into tally()'s temporary would dangle
+    ASSERT_TRUE(k.count("colour_7_3")) << result.dump().substr(0, 2000);
+    const auto& t = k.at("colour_7_3");
     std::cout << "under A: " << t.differ << "/" << t.compared << " differ in colour_7_3\n";
     EXPECT_GE(static_cast<double>(t.differ) / t.compared, 0.90);
     EXPECT_EQ(rc, 4);

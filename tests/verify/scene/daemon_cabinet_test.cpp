@@ -64,12 +64,12 @@ date = "2026-11-29"
 json characterize_run() {
   const double s = 1000.0 / 262.0;
   json corners = json::array({{876 - 131 * s, 584 - 93 * s}, {876 + 131 * s, 584 - 93 * s}, {876 + 131 * s, 584 + 93 * s},
-                              {876 - 131 * s, 584 + 93 * s}});
+                              {876 - 131 * s, 584 + 93 * s},});
   json row{{"step", "chart/raw"}, {"quantity", "chart_location"}, {"value", 1.0},
-           {"data", {{"format", "raw"}, {"corners", corners}, {"width", 1752}, {"height", 1168}, {"reprojection_rms_px", 0.2}}}};
+           {"data", {{"format", "raw"}, {"corners", corners}, {"width", 1752}, {"height", 1168}, {"reprojection_rms_px", 0.2}}},};
   return {{"run", {{"id", "0193c0de-0000-7000-8000-0000000cc0de"}, {"campaign", "characterize-camera"},
-                   {"params", json::object()}, {"status", "finished_ok"}}},
-          {"measurements", json::array({row})}};
+                   {"params", json::object()}, {"status", "finished_ok"},}},
+          {"measurements", json::array({row})},};
 }
 
 std::string read_file(const std::filesystem::path& p) {

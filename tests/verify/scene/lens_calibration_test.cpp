@@ -148,10 +148,10 @@ json characterize_run(const ca::ChartLocation& loc) {
   for (const auto& c : loc.corners) corners.push_back({c.x, c.y});
   json row{{"step", "chart/raw"}, {"quantity", "chart_location"}, {"value", loc.confidence},
            {"data", {{"format", "raw"}, {"corners", corners}, {"width", kWidth}, {"height", kHeight},
-                     {"reprojection_rms_px", loc.reprojection_rms_px}}}};
+                     {"reprojection_rms_px", loc.reprojection_rms_px},}},};
   return {{"run", {{"id", "0193c0de-0000-7000-8000-0000000cc0de"}, {"campaign", "characterize-camera"},
-                   {"params", json::object()}, {"status", "finished_ok"}}},
-          {"measurements", json::array({row})}};
+                   {"params", json::object()}, {"status", "finished_ok"},}},
+          {"measurements", json::array({row})},};
 }
 
 TEST(LensCalibrationSim, RecoversTheSimulatorsLensWithinItsStatedUncertainty) {

@@ -58,8 +58,8 @@ std::string LensCalibration::name() const {
 
 LensCalibration calibrate_lens(const std::vector<CalibrationView>& views, int width_px, int height_px) {
   if (views.size() < 3)
-    throw Error(ErrorClass::bad_parameter, "lens calibration needs photographs of the chart at 3 or more poses, got " +
-                                               std::to_string(views.size()),
+    throw Error(ErrorClass::bad_parameter,
+                "lens calibration needs photographs of the chart at 3 or more poses, got " + std::to_string(views.size()),
                 "photograph the chart tilted different ways and placed across the frame, corners included");
   if (width_px <= 0 || height_px <= 0) throw Error(ErrorClass::bad_parameter, "lens calibration: the photographs' size must be > 0");
   std::vector<std::vector<cv::Point3f>> object;
@@ -195,7 +195,7 @@ std::string lens_to_toml(const LensCalibration& l) {
 nlohmann::json lens_to_json(const LensCalibration& l) {
   nlohmann::json j{{"name", l.name()}, {"camera", l.camera}, {"lens", l.lens}, {"focus", l.focus},
                    {"width_px", l.width_px}, {"height_px", l.height_px}, {"rms_px", l.rms_px},
-                   {"photographs", l.photographs}, {"points", l.points}, {"source", l.source}, {"date", l.date}};
+                   {"photographs", l.photographs}, {"points", l.points}, {"source", l.source}, {"date", l.date},};
   j["focal_length_mm"] = l.focal_length_mm ? nlohmann::json(*l.focal_length_mm) : nlohmann::json(nullptr);
   nlohmann::json sigma;
   for (std::size_t i = 0; i < kParams.size(); ++i) j[kParams[i]] = param(l.intrinsics, i), sigma[kParams[i]] = param(l.sigma, i);

@@ -19,8 +19,9 @@ namespace colorlab::core {
 void set_heavy_thread_nice(int steps);
 int heavy_thread_nice();
 
-// Lowers the calling thread by `steps` nice steps below its current value (clamped at 19); a
-// failure is logged with `who` and otherwise ignored (the thread still works, only unprioritised).
+// Lowers the calling thread to `steps` nice steps below the process's own nice value (clamped at 19), or leaves it
+// where it is if it is already that low (a heavy thread started by a heavy thread); a failure is logged with `who`
+// and otherwise ignored (the thread still works, only unprioritised).
 void lower_this_thread(int steps, std::string_view who);
 
 // The first call of a heavy thread: names it (`name`, 15 characters at most: top -H, /proc/…/comm, the latency

@@ -24,8 +24,8 @@ struct SimulatorConfig {
 // [priority]: CPU priority of the heavy work beside the threads that answer (docs/configuration.md,
 // "CPU priority"; core/thread_priority.hpp). Nice steps below colorlabd's own; 0 = the same.
 struct PriorityConfig {
-  int heavy_work_nice = 10;  // worker pool (fits, analyses), RAW decoding, reports, the blob check
-  int simulator_nice = 10;   // the embedded simulated lab: a real lab's instruments have their own processors
+  int heavy_work_nice = 0;   // worker pool (fits, analyses), RAW decoding, reports, the blob check
+  int simulator_nice = 0;    // the embedded simulated lab: a real lab's instruments have their own processors
 };
 
 // [campaigns]: where the lab's own scripts live, and how executions survive restarts.
