@@ -64,7 +64,11 @@ double CgatsTable::number(std::size_t row, std::string_view field) const {
 }
 
 std::vector<CgatsTable> parse_cgats(std::string_view text, const std::string& source_name) {
-  enum class State { header, format, data } state = State::header;
+  enum class State {
+    header,
+    format,
+    data
+  } state = State::header;
   std::vector<CgatsTable> tables;
   CgatsTable cur;
   cur.source = source_name;

@@ -124,8 +124,12 @@ CgatsTable argyll_ti3_table(const ChartData& chart, const SpectralSet* spectra, 
   CgatsTable t;
   t.file_type = "CTI3";
   // Argyll names the colour spaces in the direction its profile maps: PCS from device for an input.
-  t.keywords = {{"DESCRIPTOR", o.descriptor}, {"ORIGINATOR", "colorlab"}, {"DEVICE_CLASS", o.device_class},
-                {"COLOR_REP", o.device_class == "INPUT" ? "XYZ_RGB" : "RGB_XYZ"},};
+  t.keywords = {
+      {"DESCRIPTOR", o.descriptor},
+      {"ORIGINATOR", "colorlab"},
+      {"DEVICE_CLASS", o.device_class},
+      {"COLOR_REP", o.device_class == "INPUT" ? "XYZ_RGB" : "RGB_XYZ"},
+  };
   t.fields = {"SAMPLE_ID", "RGB_R", "RGB_G", "RGB_B", "XYZ_X", "XYZ_Y", "XYZ_Z"};
   if (o.with_lab) t.fields.insert(t.fields.end(), {"LAB_L", "LAB_A", "LAB_B"});
   if (spectra) {
@@ -163,9 +167,14 @@ void write_spectra_cgats(const std::filesystem::path& path, const SpectralSet& s
   s.check_shape();
   CgatsTable t;
   t.file_type = file_type;
-  t.keywords = {{"DESCRIPTOR", "colorlab spectra"}, {"ORIGINATOR", "colorlab"},
-                {"SPECTRAL_BANDS", std::to_string(s.bands())}, {"SPECTRAL_START_NM", fmt(s.wavelengths.front())},
-                {"SPECTRAL_END_NM", fmt(s.wavelengths.back())}, {"SPECTRAL_NORM", "100.0"},};
+  t.keywords = {
+      {"DESCRIPTOR", "colorlab spectra"},
+      {"ORIGINATOR", "colorlab"},
+      {"SPECTRAL_BANDS", std::to_string(s.bands())},
+      {"SPECTRAL_START_NM", fmt(s.wavelengths.front())},
+      {"SPECTRAL_END_NM", fmt(s.wavelengths.back())},
+      {"SPECTRAL_NORM", "100.0"},
+  };
   t.fields = {"SAMPLE_ID"};
   for (double w : s.wavelengths) t.fields.push_back("SPEC_" + std::to_string(static_cast<int>(std::lround(w))));
   for (std::size_t i = 0; i < s.size(); ++i) {

@@ -18,7 +18,8 @@ std::vector<Term> parse_list(std::initializer_list<const char*> spec) {
     std::string str(s);
     if (str != "1") {
       for (std::size_t i = 0; i < str.size(); ++i) {
-        int ch = str[i] == 'r' ? 0 : str[i] == 'g' ? 1 : 2;
+        int ch = str[i] == 'r' ? 0 : str[i] == 'g' ? 1
+                                                   : 2;
         int e = 1;
         if (i + 1 < str.size() && std::isdigit(static_cast<unsigned char>(str[i + 1]))) e = str[++i] - '0';
         term.exponent[static_cast<std::size_t>(ch)] += e;
@@ -95,9 +96,9 @@ TermSet dissertation_set(int n) {
           {"r", "g", "b", "rg", "rb", "gb", "r2", "g2", "b2", "r3", "g3", "b3", "r4", "g4", "b4", "1"});
       break;
     case 10:
-      s.terms = parse_list({"r",    "g",    "b",    "rg",     "rb",   "gb",     "rgb",  "r2",   "g2",   "b2",
-                            "r2g2", "r2b2", "g2b2", "r2g2b2", "r3",   "g3",     "b3",   "r3g3", "r3b3", "g3b3",
-                            "r3g3b3", "r4", "g4",   "b4",     "r4g4", "r4b4",   "g4b4", "r4g4b4", "1"});
+      s.terms = parse_list({"r", "g", "b", "rg", "rb", "gb", "rgb", "r2", "g2", "b2",
+                            "r2g2", "r2b2", "g2b2", "r2g2b2", "r3", "g3", "b3", "r3g3", "r3b3", "g3b3",
+                            "r3g3b3", "r4", "g4", "b4", "r4g4", "r4b4", "g4b4", "r4g4b4", "1"});
       break;
     case 11:
       s.terms = parse_list({"r", "g", "b", "rg", "rb", "gb", "r2", "g2", "b2", "r3", "g3", "b3", "r4", "g4", "b4", "r5",
@@ -160,8 +161,17 @@ TermSet root_polynomial_set(int degree) {
       s.terms.push_back(root(e[0], e[1], e[2]));
   }
   if (degree >= 4) {
-    for (auto e : {std::array<double, 3>{3, 1, 0}, {3, 0, 1}, {1, 3, 0}, {0, 3, 1}, {1, 0, 3}, {0, 1, 3}, {2, 1, 1},
-                   {1, 2, 1}, {1, 1, 2},})
+    for (auto e : {
+             std::array<double, 3>{3, 1, 0},
+             {3, 0, 1},
+             {1, 3, 0},
+             {0, 3, 1},
+             {1, 0, 3},
+             {0, 1, 3},
+             {2, 1, 1},
+             {1, 2, 1},
+             {1, 1, 2},
+         })
       s.terms.push_back(root(e[0], e[1], e[2]));
   }
   return s;

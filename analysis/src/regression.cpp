@@ -41,7 +41,7 @@ Solution solve(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y, double ridge,
   if (qr.rank() < m)
     throw Error(ErrorClass::bad_data,
                 what + ": design of " + std::to_string(n) + " patches x " + std::to_string(m) +
-                                          " terms has rank " + std::to_string(qr.rank()) + " (rank-deficient)",
+                    " terms has rank " + std::to_string(qr.rank()) + " (rank-deficient)",
                 "use fewer terms, more (distinct) patches, or ridge");
   Solution s;
   s.coefficients = d.cwiseInverse().asDiagonal() * qr.solve(B);

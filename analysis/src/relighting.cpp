@@ -119,8 +119,14 @@ LampSpectrum nominal_lamp(const std::string& lamp) {
   std::string key = lamp;
   for (auto& c : key) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
   // The cabinet's lamps and the CIE table each is sold as (sim/scene's lamps; colorimetry-notes §6.2).
-  static const std::map<std::string, std::string, std::less<>> table{{"D65", "D65"}, {"D50", "D50"}, {"A", "A"},
-                                                                     {"TL84", "F11"}, {"840", "F11"}, {"CWF", "F2"},};
+  static const std::map<std::string, std::string, std::less<>> table{
+      {"D65", "D65"},
+      {"D50", "D50"},
+      {"A", "A"},
+      {"TL84", "F11"},
+      {"840", "F11"},
+      {"CWF", "F2"},
+  };
   std::string standard = key;
   if (auto it = table.find(key); it != table.end()) standard = it->second;
   LampSpectrum out;

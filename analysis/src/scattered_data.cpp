@@ -188,7 +188,7 @@ FitWithHat SplineFitter::fit(const ChartData& train, const SplineOptions& o) {
   if (P.cols() >= n || qr.rank() < P.cols())
     throw Error(ErrorClass::bad_data,
                 model.method_ + ": " + std::to_string(n) + " patches cannot determine the base's " +
-                                          std::to_string(P.cols()) + " terms (rank " + std::to_string(qr.rank()) + ")",
+                    std::to_string(P.cols()) + " terms (rank " + std::to_string(qr.rank()) + ")",
                 "use a smaller base (rbf:ccm) or more distinct patches");
   const Eigen::VectorXd w = target_weights(train, o.target);
   const Eigen::MatrixXd Y = target_of(train, o.target);

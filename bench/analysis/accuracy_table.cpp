@@ -32,8 +32,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const std::vector<std::string> kCameras = {"Canon_20D",    "Canon_5DMarkII", "Nikon_D3X", "SONY_NEX_5N",
-                                           "Olympus_E_PL2", "Pentax_K_5",     "Phase_One", "Nokia_N900",
+const std::vector<std::string> kCameras = {"Canon_20D", "Canon_5DMarkII", "Nikon_D3X", "SONY_NEX_5N",
+                                           "Olympus_E_PL2", "Pentax_K_5", "Phase_One", "Nokia_N900",
                                            "Point_Grey_Grasshopper_50S5C"};
 const std::vector<std::pair<std::string, std::string>> kConditions = {{"D50", "D50"}, {"D65", "D65"}, {"D65", "A"}, {"D65", "F11"}};
 

@@ -56,8 +56,8 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-const std::vector<std::string> kCameras = {"Canon_20D",    "Canon_5DMarkII", "Nikon_D3X", "SONY_NEX_5N",
-                                           "Olympus_E_PL2", "Pentax_K_5",     "Phase_One", "Nokia_N900",
+const std::vector<std::string> kCameras = {"Canon_20D", "Canon_5DMarkII", "Nikon_D3X", "SONY_NEX_5N",
+                                           "Olympus_E_PL2", "Pentax_K_5", "Phase_One", "Nokia_N900",
                                            "Point_Grey_Grasshopper_50S5C"};
 
 struct Figure {
@@ -443,8 +443,8 @@ int main(int argc, char** argv) {
                      std::vector<double> v(band.data(), band.data() + band.size());
                      std::sort(v.begin(), v.end());
                      return v[v.size() / 2];
-                   }() << ") |"
-                << std::endl;
+                   }()
+                << ") |" << std::endl;
     }
     timing << " |";
     timing_rows.push_back(timing.str());

@@ -21,7 +21,7 @@ ca::ChartData render_chart(const ca::SpectralSet& refl, const ca::SpectralSet& l
   // so neither invents overshoot. Fluorescent lamps come at 5 nm from colord, so their lines survive.
   const ca::SpectralSet r = ca::resample(refl, grid,
                                          ca::sprague_applicable(refl.wavelengths) ? ca::Interpolation::sprague
-                                                                                             : ca::Interpolation::cubic_spline);
+                                                                                  : ca::Interpolation::cubic_spline);
   const ca::SpectralSet l = ca::resample(lamp, grid, ca::Interpolation::linear);
   const ca::SpectralSet s = ca::resample(curves, grid, ca::Interpolation::linear);
   const Eigen::RowVectorXd e = l.values.row(0);

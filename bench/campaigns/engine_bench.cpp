@@ -50,7 +50,8 @@ struct Bench {
   std::shared_ptr<campaigns::CampaignScript> spot, clock;
 
   Bench() {
-    meter_sim = std::make_shared<sim::Ls110Sim>(sim_io.get_executor(), [] { return sim::Ls110Truth{300.0, 0.3}; }, 1, 1.0);
+    meter_sim = std::make_shared<sim::Ls110Sim>(
+        sim_io.get_executor(), [] { return sim::Ls110Truth{300.0, 0.3}; }, 1, 1.0);
     meter_sim->start();
     work = std::make_unique<asio::executor_work_guard<asio::io_context::executor_type>>(sim_io.get_executor());
     sim_thread = std::thread([this] { sim_io.run(); });
@@ -127,8 +128,15 @@ void BM_Ls110Step_Direct(benchmark::State& state) {
         auto r = co_await b.meter->measure_luminance();
         json result{{"luminance", r.luminance}, {"unit", r.unit}, {"instrument", b.meter->id()}, {"raw", r.raw_reply}};
         pending.journal.push_back({i, "meter.measure", json::array(), result});
-        pending.measurements.push_back({"reading/" + std::to_string(i), b.meter->id(), true, "luminance", r.luminance, r.unit,
-                                        {{"raw", r.raw_reply}},});
+        pending.measurements.push_back({
+            "reading/" + std::to_string(i),
+            b.meter->id(),
+            true,
+            "luminance",
+            r.luminance,
+            r.unit,
+            {{"raw", r.raw_reply}},
+        });
         pending.progress = static_cast<double>(i) / kReadings;
         pending.label = "reading/" + std::to_string(i);
       }

@@ -31,7 +31,8 @@ struct Kept {
     json script = json::array();
     for (int i = 0; i < kScriptNumbers; ++i) script.push_back(i * 1.0001);
     const std::string summary = json{{"measurements", {{"luminance", {{"count", 12}, {"unit", "cd/m2"}, {"mean", 80.5}}}}},
-                                     {"script", {{"values", script}}}}.dump();
+                                     {"script", {{"values", script}}}}
+                                    .dump();
     const std::string listed = json{{"measurements", {{"luminance", {{"count", 12}, {"unit", "cd/m2"}, {"mean", 80.5}}}}}}.dump();
     sqlite3* db = nullptr;
     sqlite3_open((dir / "colorlab.db").c_str(), &db);
@@ -101,8 +102,14 @@ void before(benchmark::State& state, const std::string& campaign) {
     sqlite3_bind_text(st, 4, "", -1, SQLITE_STATIC);
     json items = json::array();
     while (sqlite3_step(st) == SQLITE_ROW) {
-      items.push_back({{"id", text(1)}, {"campaign", text(2)}, {"params", json::parse(text(3))}, {"status", text(4)},
-                       {"instruments", json::parse(text(6))}, {"summary", json::parse(text(10))},});
+      items.push_back({
+          {"id", text(1)},
+          {"campaign", text(2)},
+          {"params", json::parse(text(3))},
+          {"status", text(4)},
+          {"instruments", json::parse(text(6))},
+          {"summary", json::parse(text(10))},
+      });
     }
     sqlite3_reset(st);
     bytes = json{{"items", items}}.dump().size();

@@ -53,8 +53,15 @@ class StoreStepWriter {
     colorlab::store::StepRecord step;
     nlohmann::json result{{"luminance", 245.3}, {"unit", "cd/m2"}, {"instrument", "ls110"}, {"raw", "OK00,   245.30"}};
     step.journal.push_back({i_, "meter.measure", nlohmann::json::array(), result});
-    step.measurements.push_back({"reading/" + std::to_string(i_), "ls110", true, "luminance", 245.3, "cd/m2",
-                                 {{"raw", "OK00,   245.30"}},});
+    step.measurements.push_back({
+        "reading/" + std::to_string(i_),
+        "ls110",
+        true,
+        "luminance",
+        245.3,
+        "cd/m2",
+        {{"raw", "OK00,   245.30"}},
+    });
     step.progress = 0.5;
     step.step = "reading/" + std::to_string(i_);
     store_.commit_step(e_, step);

@@ -31,8 +31,10 @@ std::string format_blobs(const json& list) {
 // The file name a download takes in a directory: the name the run gave the frame when this run is known,
 // else the hash (never a path the server names).
 std::string file_name(const std::string& sha, const std::string& kind) {
-  const std::string ext = kind == "preview" ? ".png" : kind == "jpeg" ? ".jpg" : kind.rfind("tiff", 0) == 0 ? ".tif"
-                          : kind == "average" ? ".f4" : "";
+  const std::string ext = kind == "preview" ? ".png" : kind == "jpeg"           ? ".jpg"
+                                                   : kind.rfind("tiff", 0) == 0 ? ".tif"
+                                                   : kind == "average"          ? ".f4"
+                                                                                : "";
   return sha + ext;
 }
 
@@ -83,8 +85,13 @@ void add_blob_commands(CLI::App& app, GlobalOptions& global) {
     }
     write_bytes(path, r.body);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-    json done{{"path", fs::absolute(path).string()}, {"bytes", r.body.size()}, {"sha256", *sha}, {"preview", *preview},
-              {"seconds", seconds},};
+    json done{
+        {"path", fs::absolute(path).string()},
+        {"bytes", r.body.size()},
+        {"sha256", *sha},
+        {"preview", *preview},
+        {"seconds", seconds},
+    };
     print(global, done, [](const json& j) {
       return "wrote " + j["path"].get<std::string>() + " (" + std::to_string(j["bytes"].get<std::size_t>()) + " bytes)\n";
     });

@@ -162,14 +162,16 @@ std::string render_report(const json& r) {
     out << "  " << text(b, "where") << "  " << verdict_word(text(b, "verdict")) << "  (relay board)\n    " << text(b, "message") << "\n";
     if (b.contains("hint")) out << "    hint: " << text(b, "hint") << "\n";
   }
-  if (r.contains("readings")) out << "\n" << text(r, "readings") << "\n";
+  if (r.contains("readings")) out << "\n"
+                                  << text(r, "readings") << "\n";
   if (r.value("interim", false)) {
     out << "\nIdentification done; nothing has been measured.\n";
     return out.str();
   }
   char secs[48];
   std::snprintf(secs, sizeof secs, "%.2f s", r.value("seconds", 0.0));
-  out << "\n" << (r.value("ok", false) ? "All examined instruments answered as expected" : "PROBLEMS FOUND (see above)") << " in "
+  out << "\n"
+      << (r.value("ok", false) ? "All examined instruments answered as expected" : "PROBLEMS FOUND (see above)") << " in "
       << secs << "; exit code " << r.value("exit_code", 0) << "\n";
   return out.str();
 }

@@ -160,7 +160,8 @@ json follow_execution(const client::ApiClient& api, json execution, bool quiet) 
     std::map<std::string, std::string> headers;
     if (!last_event_id.empty()) headers["Last-Event-ID"] = last_event_id;
     try {
-      api.stream("/v1/events/stream", [&](std::string_view bytes) { return parser.feed(bytes); }, headers);
+      api.stream(
+          "/v1/events/stream", [&](std::string_view bytes) { return parser.feed(bytes); }, headers);
     } catch (const Error& e) {
       // A dropped link (the daemon restarting, a network blip): resume from the last event seen.
       if (e.cls() != ErrorClass::no_comms || reconnects >= 30) throw;

@@ -155,7 +155,7 @@ std::string format_run(const json& r) {
     << "  status     " << str(r, "status") << "\n"
     << "  data       "
     << (r.value("simulated", false) ? "SIMULATED instruments (not a measurement of the real lab)"
-                                                         : "real instruments")
+                                    : "real instruments")
     << "\n"
     << "  created    " << str(r, "created_at") << "\n"
     << "  finished   " << str(r, "finished_at") << "\n";

@@ -102,7 +102,8 @@ void add_lens_commands(CLI::App& app, GlobalOptions& global) {
       "calibrate", "Calibrate a lens from photographs of the chart at several poses (OpenCV calibrateCamera); prints the "
                    "[[lens]] table for colorlabd.toml (--json: the calibration as GET /v1/lab/lenses gives it)");
   cal->add_option("PHOTO", o->photos, "3 or more photographs (TIFF, PNG, JPEG, PGM; raw mosaic with --cfa), chart tilted and "
-                                      "placed across the frame")->required();
+                                      "placed across the frame")
+      ->required();
   cal->add_option("--camera", o->camera, "the camera body, e.g. \"Canon EOS 20D #1\"")->required();
   cal->add_option("--lens", o->lens, "the lens, e.g. \"EF 50mm f/1.8 II\"")->required();
   cal->add_option("--focal-length-mm", o->focal_length_mm, "a zoom's focal length setting");

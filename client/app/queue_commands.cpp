@@ -52,8 +52,11 @@ void add_queue_commands(CLI::App& app, GlobalOptions& global) {
     }
     std::map<std::string, std::string> headers;
     if (!add_opts->idempotency_key.empty()) headers["Idempotency-Key"] = add_opts->idempotency_key;
-    json body{{"campaign", add_opts->campaign}, {"params", parse_params(add_opts->params)},
-              {"on_failure", add_opts->on_failure},};
+    json body{
+        {"campaign", add_opts->campaign},
+        {"params", parse_params(add_opts->params)},
+        {"on_failure", add_opts->on_failure},
+    };
     print(global, api.post("/v1/queue", body, headers), format_queue_item);
   });
 

@@ -142,11 +142,20 @@ void add_scene_command(CLI::App& app, GlobalOptions& global) {
     const json scene = verify::export_scene(cabinet, runs, so);
     verify::write_scene(scene, o->output);
     json lamps = json::array();
-    for (const auto& l : scene["lamps"]) lamps.push_back({{"name", l["name"]}, {"luminance_cd_m2", l["luminance_cd_m2"]},
-                                                           {"level", l["level"]["source"]},});
-    json done{{"directory", o->output}, {"files", {"scene.json", "build_scene.py"}}, {"lamps", lamps},
-              {"patches", scene["chart"]["patches"].size()}, {"cabinet", cabinet_source},
-              {"lens_calibrations", lenses_from}, {"intrinsics", scene["camera"].value("intrinsics_source", std::string())},};
+    for (const auto& l : scene["lamps"]) lamps.push_back({
+        {"name", l["name"]},
+        {"luminance_cd_m2", l["luminance_cd_m2"]},
+        {"level", l["level"]["source"]},
+    });
+    json done{
+        {"directory", o->output},
+        {"files", {"scene.json", "build_scene.py"}},
+        {"lamps", lamps},
+        {"patches", scene["chart"]["patches"].size()},
+        {"cabinet", cabinet_source},
+        {"lens_calibrations", lenses_from},
+        {"intrinsics", scene["camera"].value("intrinsics_source", std::string())},
+    };
     print(global, done, [](const json& j) {
       std::string s = "wrote " + j["directory"].get<std::string>() + "/scene.json and build_scene.py (" +
                       std::to_string(j["patches"].get<std::size_t>()) + " patches";

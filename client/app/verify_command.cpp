@@ -157,7 +157,7 @@ void add_verify_command(CLI::App& app, GlobalOptions& global) {
   cmd->add_option("rendering", o->rendering, "the rendering file, made with the exported camera (the floor photograph's view)")
       ->required();
   cmd->add_option("--against", o->against, "run ids: one floor-luminance run (where the floor lies) and optionally one cabinet-grid run; one "
-                  "characterize-camera run for the colour (its chart-read is fetched with it)")
+                                           "characterize-camera run for the colour (its chart-read is fetched with it)")
       ->required();
   cmd->add_option("--scale", o->scale,
                   "renderer unit -> cd/m² (1 for W·m⁻²·sr⁻¹·nm⁻¹ spectral and cd/m² XYZ); omitted: one factor fitted per kind, "

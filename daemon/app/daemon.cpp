@@ -54,16 +54,16 @@ struct Daemon::Impl {
   std::unique_ptr<EmbeddedSim> sim;
   std::unique_ptr<store::Store> store;
   std::unique_ptr<BlobService> blobs;  // the image store (blob_service.hpp)
-  AccessControl access;  // the policy and the control lock (access.hpp)
+  AccessControl access;                // the policy and the control lock (access.hpp)
   campaigns::InstrumentSet instruments;
   std::unique_ptr<campaigns::ScriptCatalogue> catalogue;
   std::unique_ptr<campaigns::Lab> lab;
   campaigns::OperatorDesk desk;
   std::unique_ptr<SimulatorHands> hands;
   std::unique_ptr<StoreRunReader> run_reader;  // lab.runs.* (characterize-camera's reference)
-  std::unique_ptr<WorkerPool> workers;  // fits and dry runs' analyses (worker_pool.hpp); outlives executions
-  std::unique_ptr<StepCommitter> committer;  // steps' commits off the io thread (step_committer.hpp); outlives executions
-  std::unique_ptr<Notifier> notices;  // [notify]: tells the operator (notifier.hpp); outlives executions
+  std::unique_ptr<WorkerPool> workers;         // fits and dry runs' analyses (worker_pool.hpp); outlives executions
+  std::unique_ptr<StepCommitter> committer;    // steps' commits off the io thread (step_committer.hpp); outlives executions
+  std::unique_ptr<Notifier> notices;           // [notify]: tells the operator (notifier.hpp); outlives executions
   std::unique_ptr<Executions> executions;
   std::unique_ptr<NightQueue> queue;
   std::unique_ptr<ReadConnections> readers;

@@ -29,13 +29,26 @@ nlohmann::json to_json(const colorlab::fleet::CycleReport& r) {
   for (const auto& x : r.superseded) {
     s.push_back({{"run_id", x.run_id}, {"bench_digest", x.bench_digest}, {"central_digest", x.central_digest}});
   }
-  return {{"position_before", r.position_before}, {"position_after", r.position_after},
-          {"runs_shipped", r.runs_shipped},       {"measurements", r.measurements},
-          {"events", r.events},                   {"blobs_uploaded", r.blobs_uploaded},
-          {"divergences", d},                     {"superseded", s},
-          {"transactions", r.transactions},
-          {"seconds", {{"read", r.seconds.read}, {"read_wait", r.seconds.read_wait}, {"blobs", r.seconds.blobs}, {"copy", r.seconds.copy},
-                       {"merge", r.seconds.merge}, {"digest", r.seconds.digest}, {"commit", r.seconds.commit},}},};
+  return {
+      {"position_before", r.position_before},
+      {"position_after", r.position_after},
+      {"runs_shipped", r.runs_shipped},
+      {"measurements", r.measurements},
+      {"events", r.events},
+      {"blobs_uploaded", r.blobs_uploaded},
+      {"divergences", d},
+      {"superseded", s},
+      {"transactions", r.transactions},
+      {"seconds", {
+                      {"read", r.seconds.read},
+                      {"read_wait", r.seconds.read_wait},
+                      {"blobs", r.seconds.blobs},
+                      {"copy", r.seconds.copy},
+                      {"merge", r.seconds.merge},
+                      {"digest", r.seconds.digest},
+                      {"commit", r.seconds.commit},
+                  }},
+  };
 }
 
 // One cycle, its outcome noted in <state_dir>/ship/status.json for the bench to show (GET /v1/shipping).
@@ -86,19 +99,33 @@ int main(int argc, char** argv) {
     }
     if (backup->parsed()) {
       auto r = colorlab::fleet::backup(config);
-      std::cout << nlohmann::json{{"name", r.name}, {"database_key", r.database_key},
-                                  {"database_bytes", r.database_bytes}, {"last_event", r.last_event},
-                                  {"runs", r.runs}, {"blobs", r.blobs}, {"blobs_uploaded", r.blobs_uploaded},
-                                  {"blobs_missing", r.blobs_missing}, {"rotated_out", r.rotated_out},}
+      std::cout << nlohmann::json{
+                       {"name", r.name},
+                       {"database_key", r.database_key},
+                       {"database_bytes", r.database_bytes},
+                       {"last_event", r.last_event},
+                       {"runs", r.runs},
+                       {"blobs", r.blobs},
+                       {"blobs_uploaded", r.blobs_uploaded},
+                       {"blobs_missing", r.blobs_missing},
+                       {"rotated_out", r.rotated_out},
+                   }
                        .dump()
                 << std::endl;
       return 0;
     }
     if (restore->parsed()) {
       auto r = colorlab::fleet::restore(config, snapshot, into.empty() ? config.state_dir : std::filesystem::path(into));
-      std::cout << nlohmann::json{{"name", r.name}, {"state_dir", r.state_dir.string()}, {"epoch", r.epoch},
-                                  {"next_event", r.next_event}, {"last_event", r.last_event}, {"runs", r.runs},
-                                  {"blobs_restored", r.blobs_restored}, {"blobs_missing", r.blobs_missing},}
+      std::cout << nlohmann::json{
+                       {"name", r.name},
+                       {"state_dir", r.state_dir.string()},
+                       {"epoch", r.epoch},
+                       {"next_event", r.next_event},
+                       {"last_event", r.last_event},
+                       {"runs", r.runs},
+                       {"blobs_restored", r.blobs_restored},
+                       {"blobs_missing", r.blobs_missing},
+                   }
                        .dump()
                 << std::endl;
       return 0;

@@ -13,11 +13,13 @@ HttpResponse get_run_export(CentralContext& ctx, const HttpRequest& req, const P
   auto pg = ctx.pool.lease();
   const store::RunRecord run = require_run(*pg, id).run;
   CentralRunReader runs(*pg);
-  return rx::export_response(req, format, run,
-                             [&pg](const std::string& run_id, const store::MeasurementFilter& filter,
-                                                     std::int64_t after, unsigned limit) {
-    return central_measurements_page(*pg, run_id, filter, after, limit);
-  }, runs);
+  return rx::export_response(
+      req, format, run,
+      [&pg](const std::string& run_id, const store::MeasurementFilter& filter,
+            std::int64_t after, unsigned limit) {
+        return central_measurements_page(*pg, run_id, filter, after, limit);
+      },
+      runs);
 }
 
 }  // namespace colorlab::fleet::central_routes

@@ -78,8 +78,10 @@ HttpResponse get_root(CentralContext& ctx, const HttpRequest&, const PathParams&
                                   {"started_at", ctx.started_at},
                                   {"read_only", true},
                                   {"features", features},
-                                  {"limits", {{"max_request_body", protocol::kMaxRequestBody},
-                                              {"max_page_limit", protocol::kMaxPageLimit},}}});
+                                  {"limits", {
+                                                 {"max_request_body", protocol::kMaxRequestBody},
+                                                 {"max_page_limit", protocol::kMaxPageLimit},
+                                             }}});
 }
 
 HttpResponse get_benches(CentralContext& ctx, const HttpRequest&, const PathParams&) {
@@ -108,15 +110,20 @@ HttpResponse get_runs(CentralContext& ctx, const HttpRequest& req, const PathPar
   if (page.next_cursor) {
     std::string link = std::string(protocol::kPrefix) + "/runs?limit=" + std::to_string(limit) + "&cursor=" + *page.next_cursor;
     for (const auto& [k, v] : {std::pair<const char*, const std::string&>{"campaign", filter.campaign},
-                               {"status", filter.status}, {"bench", filter.bench}, {"since", filter.since},
+                               {"status", filter.status},
+                               {"bench", filter.bench},
+                               {"since", filter.since},
                                {"until", filter.until}}) {
       if (!v.empty()) link += std::string("&") + k + "=" + http::percent_encode(v);
     }
     next = link;
   }
   return keep_answer(ctx, req, key, validator,
-                     {{"items", items}, {"links", {{"next", next}}},
-                      {"next_cursor", page.next_cursor ? json(*page.next_cursor) : json(nullptr)},});
+                     {
+                         {"items", items},
+                         {"links", {{"next", next}}},
+                         {"next_cursor", page.next_cursor ? json(*page.next_cursor) : json(nullptr)},
+                     });
 }
 
 // The bench's run document plus `bench`; no report link: reports are made on a bench.

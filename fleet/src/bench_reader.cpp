@@ -42,7 +42,8 @@ void add_blob_refs(store::Database& db, const std::string& run_id, RunDigest& d)
 }
 
 const std::string kEnded = "SELECT seq, json_extract(payload, '$.run_id'), json_extract(payload, '$.status') FROM "
-                          "event_log WHERE seq > ?1 AND " + store::kEndEventSql + " ORDER BY seq LIMIT ?2";
+                           "event_log WHERE seq > ?1 AND " +
+                           store::kEndEventSql + " ORDER BY seq LIMIT ?2";
 
 }  // namespace
 

@@ -137,7 +137,10 @@ void central_migrate(Pg& pg) {
             "applied_at timestamptz NOT NULL DEFAULT now())");
     pg.exec("COMMIT");
   } catch (...) {
-    try { pg.exec("ROLLBACK"); } catch (...) {}
+    try {
+      pg.exec("ROLLBACK");
+    } catch (...) {
+    }
     throw;
   }
   for (;;) {
@@ -159,7 +162,10 @@ void central_migrate(Pg& pg) {
       pg.query("INSERT INTO schema_migrations (version) VALUES ($1)", {std::to_string(v + 1)});
       pg.exec("COMMIT");
     } catch (...) {
-      try { pg.exec("ROLLBACK"); } catch (...) {}
+      try {
+        pg.exec("ROLLBACK");
+      } catch (...) {
+      }
       throw;
     }
   }

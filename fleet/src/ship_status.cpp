@@ -54,7 +54,7 @@ void note_cycle_ok(const ShipConfig& c, const CycleReport& r) {
   } else {
     const auto& d = r.divergences.front();
     s["last_error"] = {{"message", "run " + d.run_id + " differs between the bench and central (digest mismatch); "
-                                   "shipping stops before it"},
+                                                       "shipping stops before it"},
                        {"hint", "colorlab-ship verify; central's ship_problems table has both digests"},
                        {"at", now}};
   }

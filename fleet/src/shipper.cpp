@@ -107,7 +107,12 @@ void rollback(Pg& pg) {
   }
 }
 
-enum class Outcome { committed, raced, diverged, superseded };
+enum class Outcome {
+  committed,
+  raced,
+  diverged,
+  superseded
+};
 
 // A bench restored from a snapshot replays what it held then: a run it had not finished may have ended on the
 // dead bench after the snapshot and shipped from there, and the restored bench ends it differently (interrupted).
@@ -133,8 +138,11 @@ bool commit_superseded(Pg& pg, const ShipConfig& c, const RunBatch& b, std::int6
       pg.exec(std::string("INSERT INTO events (") + kStaged[5].columns + ") SELECT " + kStaged[5].columns +
               " FROM stage_events ON CONFLICT (" + kStaged[5].key + ") DO NOTHING");
     }
-    nlohmann::json detail{{"bench_digest", d.bench_digest}, {"central_digest", d.central_digest},
-                          {"bench_ended_event", b.run.ended_event},};
+    nlohmann::json detail{
+        {"bench_digest", d.bench_digest},
+        {"central_digest", d.central_digest},
+        {"bench_ended_event", b.run.ended_event},
+    };
     pg.query("INSERT INTO ship_problems (bench_id, run_id, kind, detail) VALUES ($1, $2, 'superseded_by_restore', $3)",
              {c.bench_id, d.run_id, detail.dump()});
     pg.query("UPDATE benches SET shipped_position = $2, last_seen = now() WHERE id = $1",
@@ -211,7 +219,11 @@ std::string text_array(const std::vector<RunBatch>& group) {
   return a + "}";
 }
 
-enum class GroupOutcome { committed, raced, mismatch };
+enum class GroupOutcome {
+  committed,
+  raced,
+  mismatch
+};
 
 // Consecutive runs' rows and the position after the last of them in one transaction: one fsync'd COMMIT, one
 // COPY a table and one digest statement for all of them (a commit a run cost 0.23-0.44 of raw COPY, see
@@ -304,7 +316,7 @@ int upload_blobs(S3Client& s3, store::BlobStore& files, const ShipConfig& c, con
     if (!std::filesystem::exists(path)) {
       throw Error(ErrorClass::io_error,
                   "run " + b.run.run_id + " references blob " + blob.sha256 +
-                                            ", whose file is missing from " + c.blob_root().string(),
+                      ", whose file is missing from " + c.blob_root().string(),
                   "colorlab blobs check; shipping cannot pass this run until the file is restored");
     }
     s3.put_file(key, path, blob.sha256);
@@ -337,7 +349,11 @@ CycleReport ship_cycle(const ShipConfig& c) {
   create_staging(pg);
 
   int budget = c.batch_runs;
-  enum class Next { go_on, restart, stop };
+  enum class Next {
+    go_on,
+    restart,
+    stop
+  };
   // One transaction's runs into central (commit_group), or on a digest mismatch one run a transaction as shipping
   // always did, to commit the runs before the divergent one, report it and stop before it.
   auto settle = [&](const std::vector<RunBatch>& group) {
@@ -372,7 +388,7 @@ CycleReport ship_cycle(const ShipConfig& c) {
           return Next::stop;
         case Outcome::superseded:
           log::warning("ship", "run " + d.run_id + " ended again on this restored bench; central keeps the copy it "
-                               "shipped before the restore (ship_problems: superseded_by_restore)");
+                                                   "shipped before the restore (ship_problems: superseded_by_restore)");
           report.superseded.push_back(d);
           position = b.run.ended_event;
           write_shipped_position(c.shipped_position_file(), position);

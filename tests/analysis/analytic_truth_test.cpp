@@ -66,7 +66,8 @@ TEST(AnalyticTruthUniformity, PlaneOnTheMeasuredHalfHasClosedFormWindowDeviation
   const auto res = ca::analyse_uniformity(left);
   ASSERT_EQ(res.window_stdev.rows(), 5);
   ASSERT_EQ(res.window_stdev.cols(), 16);
-  auto v_col = [](int j) { return j == 7 || j == 8 ? 0.56 : j == 6 || j == 9 ? 1.36 : 2.0; };
+  auto v_col = [](int j) { return j == 7 || j == 8 ? 0.56 : j == 6 || j == 9 ? 1.36
+                                                                             : 2.0; };
   for (int i = 0; i < 5; ++i)
     for (int j = 0; j < 16; ++j) {
       const double expected = std::sqrt(20.0 / 19.0 * (1.25 * alpha * alpha + v_col(j) * beta * beta));
@@ -199,7 +200,8 @@ TEST(AnalyticTruthAveraging, AlternatingFramesGiveTheClosedFormMeanAndStdEvenAtF
       if (!(N <= 26 || N == 1001 || N == 65535 || N == 65536)) continue;
       const double dn = static_cast<double>(N);
       const double mean = N % 2 ? cs.mu + cs.a / dn : cs.mu;
-      const double sd = N == 1 ? 0.0 : N % 2 ? cs.a * std::sqrt((dn + 1) / dn) : cs.a * std::sqrt(dn / (dn - 1));
+      const double sd = N == 1 ? 0.0 : N % 2 ? cs.a * std::sqrt((dn + 1) / dn)
+                                             : cs.a * std::sqrt(dn / (dn - 1));
       // Float outputs: within 2 ulps of the exact value.
       EXPECT_NEAR(acc.mean()[5], mean, 2 * std::ldexp(mean, -24)) << "N " << N << " μ " << cs.mu;
       EXPECT_NEAR(acc.stddev()[0], sd, 2 * std::ldexp(sd, -24) + 1e-30) << "N " << N << " μ " << cs.mu;
@@ -363,7 +365,8 @@ Eigen::MatrixXd generating_coefficients(const ca::TermSet& set) {
     const auto row = static_cast<Eigen::Index>(t);
     const double degree = e[0] + e[1] + e[2];
     if (degree == 1) {
-      k.row(row) = M.row(e[0] == 1 ? 0 : e[1] == 1 ? 1 : 2);
+      k.row(row) = M.row(e[0] == 1 ? 0 : e[1] == 1 ? 1
+                                                   : 2);
     } else if (degree == 0) {
       k.row(row) << 5, 6, 4;  // a constant (flare) term
     } else {

@@ -17,8 +17,8 @@ namespace ca = colorlab::analysis;
 
 namespace {
 
-constexpr double kZ = 1.96;   // pointwise 95 % band of the posterior
-constexpr int kDraws = 10;    // noise draws per camera (seeds 0–9)
+constexpr double kZ = 1.96;     // pointwise 95 % band of the posterior
+constexpr int kDraws = 10;      // noise draws per camera (seeds 0–9)
 constexpr double kRate = 0.90;  // issue 12's stated rate: the truth inside the band at ≥ 90 % of wavelengths
 
 struct Coverage {

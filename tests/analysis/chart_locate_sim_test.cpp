@@ -158,7 +158,8 @@ TEST(SimulatedPhotosBlock, PatchesAsDarkAsTheSurroundAreNotACoverButACardIs) {
   const auto& c = loc.patches[static_cast<std::size_t>(std::find(L.ids.begin(), L.ids.end(), "L3") - L.ids.begin())];
   for (int y = y0 - 6; y < y1 + 6; ++y)
     for (int x = x0 - 6; x < x1 + 6; ++x) {
-      const int ch = (y % 2) * 2 + (x % 2) == 0 ? 0 : ((y % 2) && (x % 2)) ? 2 : 1;
+      const int ch = (y % 2) * 2 + (x % 2) == 0 ? 0 : ((y % 2) && (x % 2)) ? 2
+                                                                           : 1;
       frame.pixels[static_cast<std::size_t>(y) * frame.width + x] = static_cast<std::uint16_t>(c.value[static_cast<std::size_t>(ch)].value);
     }
   try {

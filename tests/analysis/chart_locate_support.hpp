@@ -23,7 +23,7 @@ using Quad4 = std::array<std::array<double, 2>, 4>;
 
 struct FlatChart {
   int width = 0, height = 0;
-  int margin = 20, pitch = 38, size = 30;  // pixels; size / pitch ≈ the layout's patch size
+  int margin = 20, pitch = 38, size = 30;            // pixels; size / pitch ≈ the layout's patch size
   std::vector<std::array<std::uint16_t, 3>> colour;  // per patch, layout order, 16-bit
   std::vector<std::uint16_t> rgb;                    // interleaved
   // Patch centre and grid corners in pixel-centre-at-integer coordinates of the flat image.
@@ -71,7 +71,8 @@ inline FlatChart draw_flat_chart(const ChartLayout& L, std::uint64_t seed, doubl
 
 inline void write_ppm16(const std::filesystem::path& p, const FlatChart& f) {
   std::ofstream o(p, std::ios::binary);
-  o << "P6\n" << f.width << " " << f.height << "\n65535\n";
+  o << "P6\n"
+    << f.width << " " << f.height << "\n65535\n";
   for (std::uint16_t v : f.rgb) {
     const char b[2] = {static_cast<char>(v >> 8), static_cast<char>(v & 0xFF)};
     o.write(b, 2);
@@ -98,7 +99,7 @@ inline Eigen::Matrix3d perspective(const std::array<std::array<double, 2>, 4>& s
 
 struct Posed {
   std::filesystem::path file;
-  std::vector<std::array<double, 2>> centre;   // truth per patch, output pixel centres at integers
+  std::vector<std::array<double, 2>> centre;    // truth per patch, output pixel centres at integers
   std::array<std::array<double, 2>, 4> corner;  // grid corners in reading order
 };
 

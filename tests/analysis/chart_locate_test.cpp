@@ -18,7 +18,6 @@ using testing::FlatChart;
 using testing::Posed;
 using testing::Quad4;
 
-
 constexpr double kCentreBound = 2.0;  // px, the goal
 
 #define REQUIRE_IMAGEMAGICK() \

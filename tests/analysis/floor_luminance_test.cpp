@@ -69,8 +69,8 @@ TEST(RobustSpotValue, LeavesOutDefectsAndDustKeepsTheNoise) {
   double mean = 0;
   for (double v : px) mean += v / double(px.size());
   auto clean = px;
-  px.push_back(3000);  // hot
-  px.push_back(0);     // dead
+  px.push_back(3000);                                           // hot
+  px.push_back(0);                                              // dead
   for (int i = 0; i < 12; ++i) px.push_back(0.7 * noise(rng));  // a dust shadow's 30 %
   const SpotValue v = robust_spot_value(px);
   EXPECT_EQ(v.total, px.size());

@@ -153,7 +153,7 @@ TEST(AnalysisResampling, InterpolatorsReproduceNodesPolynomialsAndSmoothCurves) 
     if (to[k] >= from[2] && to[k] <= from[from.size() - 3]) {
       EXPECT_NEAR(sq(kk), 1 + x + 0.5 * x * x, 1e-9) << to[k];
     }
-    EXPECT_NEAR(cl(kk), 2 - x, 1e-9) << to[k];                 // natural spline is exact for lines
+    EXPECT_NEAR(cl(kk), 2 - x, 1e-9) << to[k];  // natural spline is exact for lines
     es = std::max(es, std::abs(sg(kk) - f(to[k])));
     ec = std::max(ec, std::abs(cg(kk) - f(to[k])));
     el = std::max(el, std::abs(lg(kk) - f(to[k])));

@@ -45,7 +45,7 @@ inline int run(const std::string& cmd) { return std::system((cmd + " >/dev/null 
 
 }  // namespace colorlab::analysis::testing
 
-#define COLORLAB_REQUIRE_SHARED(var, name)                                                            \
+#define COLORLAB_REQUIRE_SHARED(var, name)                                                          \
   auto var##_opt = ::colorlab::analysis::testing::shared(name);                                     \
   if (!var##_opt) GTEST_SKIP() << "shared data file " << (name) << " not present (../shared/data)"; \
   const std::filesystem::path var = *var##_opt

@@ -54,7 +54,9 @@ Doctor doctor(const std::vector<std::string>& args, const std::string& stdin_tex
     try {
       d.report = json::parse(r.out);
     } catch (const json::exception&) {
-      ADD_FAILURE() << "doctor did not print JSON (exit " << r.exit_code << "):\n" << r.out << "\n" << r.err;
+      ADD_FAILURE() << "doctor did not print JSON (exit " << r.exit_code << "):\n"
+                    << r.out << "\n"
+                    << r.err;
     }
   }
   return d;

@@ -39,7 +39,7 @@ double sensitivity(int channel, double nm) {
 
 struct Synthetic {
   json camera, reference;
-  Eigen::MatrixXd truth;  // n × 3 noiseless counts
+  Eigen::MatrixXd truth;      // n × 3 noiseless counts
   analysis::ChartData chart;  // noisy counts with the reference colours
 };
 

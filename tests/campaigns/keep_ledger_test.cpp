@@ -55,6 +55,12 @@ TEST(KeepLedger, HandsOverWhatWasKeptInOrderAndForgetsIt) {
 
 TEST(KeepLedger, TheCallsJsonCarriesTheSameReference) {
   const KeptBlob b{"abc", "average", "average", "application/x-colorlab-array", 16, json{{"dtype", "<f4"}}};
-  EXPECT_EQ(blob_json(b), (json{{"sha256", "abc"}, {"name", "average"}, {"kind", "average"},
-                                {"media_type", "application/x-colorlab-array"}, {"size", 16}, {"meta", {{"dtype", "<f4"}}},}));
+  EXPECT_EQ(blob_json(b), (json{
+                              {"sha256", "abc"},
+                              {"name", "average"},
+                              {"kind", "average"},
+                              {"media_type", "application/x-colorlab-array"},
+                              {"size", 16},
+                              {"meta", {{"dtype", "<f4"}}},
+                          }));
 }

@@ -28,10 +28,10 @@ TEST(SseParser, FieldsCommentsAndLineEndsAsTheSpecSays) {
       "retry: 2000\n\n"
       ": keep-alive\n\n"
       "id: 7\nevent: progress\ndata: {\"a\":1}\n\n"
-      "data:first\r\ndata: second\r\n\r\n"       // CRLF; no space after the colon; the id stays 7
-      "id: 9\revent: execution\rdata: x\r\r"      // lone CRs
-      "event: nothing\n\n"                         // no data: not dispatched
-      "id: 10\nunknown: field\ndata\n\n";          // a field without a colon: data, empty
+      "data:first\r\ndata: second\r\n\r\n"    // CRLF; no space after the colon; the id stays 7
+      "id: 9\revent: execution\rdata: x\r\r"  // lone CRs
+      "event: nothing\n\n"                    // no data: not dispatched
+      "id: 10\nunknown: field\ndata\n\n";     // a field without a colon: data, empty
   for (std::size_t piece : {std::size_t{1}, std::size_t{2}, std::size_t{5}, text.size()}) {
     auto got = parse_in_pieces(text, piece);
     ASSERT_EQ(got.size(), 4u) << "piece " << piece;

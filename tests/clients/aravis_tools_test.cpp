@@ -94,7 +94,8 @@ TEST(AravisTools, DiscoverReadAndStreamTheSimulatedCamera) {
   // Discovery: arv-tool's device list names the camera by its serial at its address.
   std::string listed = tool({"arv-tool-0.8"});
   EXPECT_TRUE(std::regex_search(listed, std::regex("-" + serial + " \\(" + std::regex_replace(address, std::regex("\\."), "\\.") + "\\)")))
-      << "arv-tool-0.8 listed:\n" << listed;
+      << "arv-tool-0.8 listed:\n"
+      << listed;
 
   // Features: identity and the sensor the simulator reports.
   std::string values = tool({"arv-tool-0.8", "-a", address, "control", "DeviceID", "SensorWidth", "SensorHeight",
@@ -107,7 +108,8 @@ TEST(AravisTools, DiscoverReadAndStreamTheSimulatedCamera) {
   std::string described = tool({"arv-tool-0.8", "-a", address, "features"});
   for (const char* format : {"BayerRG12", "BayerRG16", "Mono16", "Mono8", "BayerRG8"}) {
     EXPECT_NE(described.find("EnumEntry   : '" + std::string(format) + "'"), std::string::npos)
-        << format << " missing from PixelFormat:\n" << described;
+        << format << " missing from PixelFormat:\n"
+        << described;
   }
   for (const char* format : {"BayerRG12", "Mono16"}) {
     std::string set = tool({"arv-tool-0.8", "-a", address, "control", "PixelFormat=" + std::string(format), "PixelFormat"});

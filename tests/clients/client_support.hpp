@@ -23,11 +23,11 @@ inline bool in_ci() {
 }
 
 #define COLORLAB_REQUIRE_CLIENT(condition, reason)                                                   \
-  do {                                                                                              \
-    if (!(condition)) {                                                                             \
+  do {                                                                                               \
+    if (!(condition)) {                                                                              \
       if (::colorlab::test::in_ci()) FAIL() << (reason) << " — scripts/setup.sh installs it for CI"; \
-      GTEST_SKIP() << (reason);                                                                     \
-    }                                                                                               \
+      GTEST_SKIP() << (reason);                                                                      \
+    }                                                                                                \
   } while (0)
 
 // A tool's absolute path (colorlab::testing::Process and run_command exec without a PATH search), or "".

@@ -42,7 +42,8 @@ TEST(NodeDmxClient, StreamsUniversesThatDriveTheCabinet) {
   const std::string dir = NODE_DMX_DIR;
   auto installed = run_command({"/bin/sh", std::string(COLORLAB_SOURCE_DIR) + "/tests/clients/node-dmx/install.sh", dir},
                                std::chrono::seconds(240));
-  ASSERT_EQ(installed.exit_code, 0) << "npm ci of tests/clients/node-dmx failed:\n" << installed.out << installed.err;
+  ASSERT_EQ(installed.exit_code, 0) << "npm ci of tests/clients/node-dmx failed:\n"
+                                    << installed.out << installed.err;
 
   SimProcess sim(kLab);
   const std::string log = (sim.dir() / "node-dmx.log").string();

@@ -102,7 +102,7 @@ TEST(OlaClient, DetectsTheSimulatedWidgetAndDrivesTheCabinet) {
   fs::create_symlink(pty, devices / link_name);
   for (const char* plugin : kOtherPlugins) std::ofstream(config / ("ola-" + std::string(plugin) + ".conf")) << "enabled = false\n";
   std::ofstream(config / "ola-usbserial.conf") << "enabled = true\ndevice_dir = " << devices.string()
-                                                << "\ndevice_prefix = ttyUSB\npro_fps_limit = 190\n";
+                                               << "\ndevice_prefix = ttyUSB\npro_fps_limit = 190\n";
   ASSERT_EQ(::chown(config.c_str(), olad_uid, olad_gid), 0);
   for (const auto& f : fs::directory_iterator(config)) ASSERT_EQ(::chown(f.path().c_str(), olad_uid, olad_gid), 0);
 
@@ -146,7 +146,8 @@ TEST(OlaClient, DetectsTheSimulatedWidgetAndDrivesTheCabinet) {
         return seen.find("Enttec Usb Pro Device") != std::string::npos;
       },
       std::chrono::seconds(30), devices_seen))
-      << "olad found no DMX USB Pro on " << pty << "; ola_dev_info printed:\n" << devices_seen << "\n(see " << log << ")";
+      << "olad found no DMX USB Pro on " << pty << "; ola_dev_info printed:\n"
+      << devices_seen << "\n(see " << log << ")";
   std::smatch m;
   ASSERT_TRUE(std::regex_search(devices_seen, m, std::regex(R"(Device (\d+): Enttec Usb Pro Device, Serial #: (\d+), firmware (\d+\.\d+))")))
       << devices_seen;
@@ -154,12 +155,14 @@ TEST(OlaClient, DetectsTheSimulatedWidgetAndDrivesTheCabinet) {
   EXPECT_EQ(m[2], "12345678") << "the serial the lab configured";
   EXPECT_EQ(m[3], "1.44") << "docs/simulator.md: DMX firmware 1.44 (issue 25: OLA saw 1.68)";
   EXPECT_EQ(std::regex_search(devices_seen, std::regex(R"(Device \d+: (?!Enttec Usb Pro Device))")), false)
-      << "only the widget: every other plugin is off\n" << devices_seen;
+      << "only the widget: every other plugin is off\n"
+      << devices_seen;
 
   // Parameters: a live label 3 request through OLA, then a label 4 write checked at the widget.
   std::string params = ola({"ola_usbpro", "-d", device, "-p", "0", "-g"});
   EXPECT_NE(params.find("Firmware: 1.44"), std::string::npos) << params;
-  EXPECT_NE(params.find("Break Time: 96"), std::string::npos) << "9 units of 10.67 us\n" << params;
+  EXPECT_NE(params.find("Break Time: 96"), std::string::npos) << "9 units of 10.67 us\n"
+                                                              << params;
   EXPECT_NE(params.find("Rate: 40"), std::string::npos) << params;
   ola({"ola_usbpro", "-d", device, "-p", "0", "-b", "20", "-m", "4", "-r", "30"});
   EXPECT_TRUE(wait_for(

@@ -156,7 +156,8 @@ TEST_F(AccessTest, EachScopeAndRouteClassGetsTheDocumentedAnswer) {
       if (transport == Transport::unix_socket) granted = Scope::admin;
       if (transport == Transport::loopback) granted = Scope::read;
       if (key_name != "none") {
-        Scope k = key_name == "read" ? Scope::read : key_name == "control" ? Scope::control : Scope::admin;
+        Scope k = key_name == "read" ? Scope::read : key_name == "control" ? Scope::control
+                                                                           : Scope::admin;
         if (!granted || *granted < k) granted = k;
       }
       for (const auto& route : routes()) {
@@ -268,7 +269,8 @@ Caller key_caller(const std::string& id, const std::string& name, Scope scope) {
 TEST(ControlLockTest, OneHolderOthersGet409NamingItUntilReleasedOrExpired) {
   FakeClock clock;
   std::vector<json> events;
-  ControlLock lock(std::chrono::seconds(600), [&](const json& e) { events.push_back(e); }, [&] { return clock.now; });
+  ControlLock lock(
+      std::chrono::seconds(600), [&](const json& e) { events.push_back(e); }, [&] { return clock.now; });
   auto anna = key_caller("k1", "anna", Scope::control);
   auto ben = key_caller("k2", "ben", Scope::control);
 
@@ -308,7 +310,8 @@ TEST(ControlLockTest, OneHolderOthersGet409NamingItUntilReleasedOrExpired) {
 TEST(ControlLockTest, TheUnixSocketOrAnAdminBreaksItAndItIsRecorded) {
   FakeClock clock;
   std::vector<json> events;
-  ControlLock lock(std::chrono::seconds(600), [&](const json& e) { events.push_back(e); }, [&] { return clock.now; });
+  ControlLock lock(
+      std::chrono::seconds(600), [&](const json& e) { events.push_back(e); }, [&] { return clock.now; });
   auto anna = key_caller("k1", "anna", Scope::control);
   Caller local;
   local.transport = Transport::unix_socket;

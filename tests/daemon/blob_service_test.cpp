@@ -171,8 +171,8 @@ TEST(BlobPreview, AFloatMosaicBecomesAHalfSizePng) {
     return (static_cast<unsigned char>(png[at]) << 24) | (static_cast<unsigned char>(png[at + 1]) << 16) |
            (static_cast<unsigned char>(png[at + 2]) << 8) | static_cast<unsigned char>(png[at + 3]);
   };
-  EXPECT_EQ(be32(16), w / 2);  // IHDR width
-  EXPECT_EQ(be32(20), h / 2);  // IHDR height
+  EXPECT_EQ(be32(16), w / 2);               // IHDR width
+  EXPECT_EQ(be32(20), h / 2);               // IHDR height
   EXPECT_EQ(static_cast<int>(png[25]), 2);  // colour type 2: RGB
 }
 

@@ -108,7 +108,8 @@ command = ["/usr/local/bin/page-me", "--lab", "north"]
 webhook = "https://hooks.example.invalid/T0/secret"
 timeout_s = 3
 events = ["crash-loop"]
-)", "c.toml");
+)",
+                        "c.toml");
   EXPECT_EQ(c.campaigns.crash_loop_backoff_s, 0.5);
   EXPECT_EQ(c.campaigns.crash_loop_backoff_max_s, 2);
   EXPECT_EQ(c.campaigns.crash_loop_retries, 0);

@@ -53,8 +53,8 @@ TEST(CrashLoopGuard, WhatIsLeftOfABackOffIsBoundedByIt) {
                                            std::chrono::duration<double>(s)));
   };
   EXPECT_NEAR(seconds_until(at(30), 60, now), 30, 0.01);
-  EXPECT_EQ(seconds_until(at(-5), 60, now), 0);       // over while the daemon was down
-  EXPECT_EQ(seconds_until(at(7200), 60, now), 60);    // the clock was stepped back: never longer than the back-off
+  EXPECT_EQ(seconds_until(at(-5), 60, now), 0);     // over while the daemon was down
+  EXPECT_EQ(seconds_until(at(7200), 60, now), 60);  // the clock was stepped back: never longer than the back-off
   EXPECT_EQ(seconds_until("not a time", 60, now), 60);
 }
 
@@ -62,10 +62,10 @@ TEST(CrashLoopGuard, StartsWithinAWindowCountTheRestartsAndTheRetriesThatFit) {
   // 0, then restarts at 5, 10 (max_resume_attempts 1 + the trip), then retries 5 + 10 and 5 + 20 later.
   CrashLoopPolicy p{1, 10, 20, 2};
   EXPECT_EQ(max_starts_within(p, 1, 5), 1);
-  EXPECT_EQ(max_starts_within(p, 11, 5), 3);   // 0, 5, 10
-  EXPECT_EQ(max_starts_within(p, 26, 5), 4);   // 0, 5, 10, 25
+  EXPECT_EQ(max_starts_within(p, 11, 5), 3);  // 0, 5, 10
+  EXPECT_EQ(max_starts_within(p, 26, 5), 4);  // 0, 5, 10, 25
   // The next run's crash loop follows at once: 50 (the start that gives up) shares a window with 55 and 60,
   // its restarts, and the 25 before it.
   EXPECT_EQ(max_starts_within(p, 16, 5), 3);
-  EXPECT_EQ(max_starts_within(p, 51, 5), 5);   // e.g. 10, 25, 50, 55, 60
+  EXPECT_EQ(max_starts_within(p, 51, 5), 5);  // e.g. 10, 25, 50, 55, 60
 }

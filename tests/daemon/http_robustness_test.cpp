@@ -96,7 +96,8 @@ class DaemonHttp : public ::testing::Test {
   }
 
   void expect_problem(const RawReply& r, int status, const std::string& code) {
-    EXPECT_EQ(r.status, status) << r.headers << "\n" << r.body;
+    EXPECT_EQ(r.status, status) << r.headers << "\n"
+                                << r.body;
     EXPECT_NE(r.headers.find("application/problem+json"), std::string::npos) << r.headers;
     auto j = json::parse(r.body, nullptr, false);
     ASSERT_FALSE(j.is_discarded()) << r.body;
@@ -137,8 +138,8 @@ TEST_F(DaemonHttp, APathThatIsNotUtf8IsStillA404Problem) {
 TEST_F(DaemonHttp, MalformedJsonIsA400) {
   std::string body = "{\"campaign\": \"luminance-spot\", ";
   expect_problem(send_raw_unix(socket_path, "POST /v1/executions HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\n"
-                                "Connection: close\r\nContent-Length: " +
-                                    std::to_string(body.size()) + "\r\n\r\n" + body),
+                                            "Connection: close\r\nContent-Length: " +
+                                                std::to_string(body.size()) + "\r\n\r\n" + body),
                  400, "bad-json");
   expect_still_serving();
 }
@@ -146,7 +147,7 @@ TEST_F(DaemonHttp, MalformedJsonIsA400) {
 TEST_F(DaemonHttp, WrongShapesAndMediaTypesAreRefused) {
   auto post = [&](const std::string& ct, const std::string& body) {
     return send_raw_unix(socket_path, "POST /v1/executions HTTP/1.1\r\nHost: x\r\nContent-Type: " + ct +
-                              "\r\nConnection: close\r\nContent-Length: " + std::to_string(body.size()) + "\r\n\r\n" + body);
+                                          "\r\nConnection: close\r\nContent-Length: " + std::to_string(body.size()) + "\r\n\r\n" + body);
   };
   expect_problem(post("text/plain", "{}"), 415, "unsupported-media-type");
   expect_problem(post("application/json", "[1,2]"), 400, "bad-request");
@@ -192,7 +193,8 @@ TEST_F(DaemonHttp, EveryWrongMethodIs405WithTheRoutesMethodsInAllow) {
   for (const auto& [method, path, allow] : cases) {
     auto r = send_raw_unix(socket_path, method + " " + path + " HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n");
     expect_problem(r, 405, "method-not-allowed");
-    EXPECT_NE(r.headers.find("\r\nAllow: " + allow + "\r\n"), std::string::npos) << method << " " << path << "\n" << r.headers;
+    EXPECT_NE(r.headers.find("\r\nAllow: " + allow + "\r\n"), std::string::npos) << method << " " << path << "\n"
+                                                                                 << r.headers;
   }
   expect_still_serving();
 }
@@ -201,7 +203,8 @@ TEST_F(DaemonHttp, EveryWrongMethodIs405WithTheRoutesMethodsInAllow) {
 // check — they are public and a browser loads them before it has a key — and every /v1 request after it.
 TEST_F(DaemonHttp, ConsoleFilesAreServedBeforeTheAccessCheckAndTheApiAfterIt) {
   auto page = send_raw(port, "GET / HTTP/1.1\r\nHost: x\r\nAuthorization: Bearer clk_not-a-key\r\nConnection: close\r\n\r\n");
-  EXPECT_EQ(page.status, 200) << page.headers << "\n" << page.body;
+  EXPECT_EQ(page.status, 200) << page.headers << "\n"
+                              << page.body;
   EXPECT_NE(page.body.find("<title>console</title>"), std::string::npos) << page.body;
   // Loopback without a key only reads; a write to a console file is the console's 405, not a 401.
   auto write = send_raw(port, "POST /index.html HTTP/1.1\r\nHost: x\r\nContent-Length: 0\r\nConnection: close\r\n\r\n");

@@ -191,14 +191,17 @@ TEST(queue_store, TheSchemaRefusesStatesAndPoliciesItDoesNotKnow) {
   ASSERT_EQ(sqlite3_open(path.c_str(), &h), SQLITE_OK);
   auto insert = [&](const char* on_failure, const char* state) {
     std::string sql = std::string("INSERT INTO queue_items (id, campaign, params, on_failure, state, created_at, updated_at) "
-                                  "VALUES (hex(randomblob(16)), 'x', '{}', '") + on_failure + "', '" + state + "', 'now', 'now')";
+                                  "VALUES (hex(randomblob(16)), 'x', '{}', '") +
+                      on_failure + "', '" + state + "', 'now', 'now')";
     return sqlite3_exec(h, sql.c_str(), nullptr, nullptr, nullptr);
   };
   EXPECT_EQ(insert("stop", "queued"), SQLITE_OK);
   EXPECT_NE(insert("retry", "queued"), SQLITE_OK);
   EXPECT_NE(insert("stop", "paused"), SQLITE_OK);
   EXPECT_NE(sqlite3_exec(h, "INSERT INTO queue_state (id, started, halted, reason, updated_at) VALUES (2, 0, 0, '', 'now')",
-                         nullptr, nullptr, nullptr), SQLITE_OK) << "the queue's state is one row";
+                         nullptr, nullptr, nullptr),
+            SQLITE_OK)
+      << "the queue's state is one row";
   sqlite3_close(h);
 }
 

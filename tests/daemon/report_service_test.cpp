@@ -21,7 +21,8 @@ namespace {
 // A shell script standing in for python3: it gets `-m colorlab.report RUN -o FILE --socket SOCK`.
 std::string stand_in(const TempDir& dir, const std::string& name, const std::string& body) {
   const auto path = dir / name;
-  std::ofstream(path) << "#!/bin/sh\n" << body << "\n";
+  std::ofstream(path) << "#!/bin/sh\n"
+                      << body << "\n";
   ::chmod(path.c_str(), 0755);
   return path.string();
 }
@@ -42,7 +43,7 @@ TEST(ReportService, MadeOnceThenServedFromTheFile) {
   // Counts its runs, writes the HTML where -o says.
   const auto python = stand_in(dir, "python",
                                "echo run >> \"" + (dir / "count").string() +
-                                                   "\"\nwhile [ \"$1\" != -o ]; do shift; done\necho '<html>' $2 > \"$2\"");
+                                   "\"\nwhile [ \"$1\" != -o ]; do shift; done\necho '<html>' $2 > \"$2\"");
   ReportService reports({dir / "reports", dir / "sock", python, "v1"});
   EXPECT_EQ(reports.request("run-a").kind, Kind::generating);
   auto s = wait_until_not_generating(reports, "run-a");

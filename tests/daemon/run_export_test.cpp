@@ -38,8 +38,15 @@ MeasurementRecord patch(std::int64_t seq, const std::string& id, int index, std:
   const auto lab = ca::xyz_to_lab({xyz[0], xyz[1], xyz[2]}, ca::kIccD50White);
   m.value = lab.L;
   // A flat reflectance of Y/100 on 380–730 nm at 10 nm.
-  m.data = {{"id", id}, {"index", index}, {"XYZ", xyz}, {"Lab", {lab.L, lab.a, lab.b}}, {"first_nm", 380}, {"step_nm", 10},
-            {"values", std::vector<double>(36, xyz[1] / 100)},};
+  m.data = {
+      {"id", id},
+      {"index", index},
+      {"XYZ", xyz},
+      {"Lab", {lab.L, lab.a, lab.b}},
+      {"first_nm", 380},
+      {"step_nm", 10},
+      {"values", std::vector<double>(36, xyz[1] / 100)},
+  };
   return m;
 }
 

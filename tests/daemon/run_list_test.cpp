@@ -127,7 +127,9 @@ TEST(RunList, MigrationFillsTheListSummaryOfRunsKeptBefore) {
   sqlite3* h = nullptr;
   ASSERT_EQ(sqlite3_open(path.c_str(), &h), SQLITE_OK);
   ASSERT_EQ(sqlite3_exec(h, "DROP INDEX runs_by_campaign; DROP INDEX runs_by_status; ALTER TABLE runs DROP COLUMN list_summary; "
-                            "PRAGMA user_version = 7;", nullptr, nullptr, nullptr), SQLITE_OK);
+                            "PRAGMA user_version = 7;",
+                         nullptr, nullptr, nullptr),
+            SQLITE_OK);
   sqlite3_close(h);
   Store migrated(path);
   const auto page = migrated.runs(10, std::nullopt);

@@ -19,7 +19,6 @@
 using colorlab::testing::Process;
 using colorlab::testing::TempDir;
 
-
 TEST(Systemd, ReadyAfterStartupThenWatchdogPings) {
   TempDir dir;
   colorlab::testing::NotifySocket systemd(dir / "notify.sock");

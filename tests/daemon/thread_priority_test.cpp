@@ -67,10 +67,10 @@ TEST(ThreadPriority, WorkerPoolThreadsRunAtTheConfiguredNiceAndTheCommitterAsThe
         "a probe", [&] {
           seen = core::thread_nice();
           seen_name = thread_name();
-          return json();
-        },
+          return json(); },
         [&](std::exception_ptr, json) { done = true; });
-    run_until(io, [&] { return done; }, "the job");
+    run_until(
+        io, [&] { return done; }, "the job");
     EXPECT_EQ(seen, expected) << name;
     EXPECT_EQ(seen_name, name);
   }

@@ -151,10 +151,12 @@ TEST(ThreadServices, TwoWritersCommitWhileTheHubWakesStreamsOnPoolThreadsAndEach
     EXPECT_EQ(seen[b.id], in_order);
   }
   // Read back on the io thread, the first writer's own.
-  auto counts = asio::co_spawn(io, [&]() -> asio::awaitable<std::pair<std::size_t, std::int64_t>> {
-    co_return std::make_pair(writer.measurements(a.run_id).size() + writer.measurements(b.run_id).size(),
-                             writer.last_event_seq());
-  }, asio::use_future);
+  auto counts = asio::co_spawn(
+      io, [&]() -> asio::awaitable<std::pair<std::size_t, std::int64_t>> {
+        co_return std::make_pair(writer.measurements(a.run_id).size() + writer.measurements(b.run_id).size(),
+                                 writer.last_event_seq());
+      },
+      asio::use_future);
   ASSERT_EQ(counts.wait_for(60s), std::future_status::ready);
   const auto [measurements, last] = counts.get();
   EXPECT_EQ(measurements, 2u * kSteps);
@@ -257,10 +259,12 @@ TEST(ThreadServices, TheBlobCheckRunsOnItsThreadWhileFramesAreKeptFromTwoOthers)
 
   // The check starts on the io thread (it reads the rows through the writer there); two campaign threads keep frames
   // meanwhile, as the frame keeper's worker does during a night.
-  auto started = asio::co_spawn(main.io, [&blobs]() -> asio::awaitable<void> {
-    blobs.start_check();
-    co_return;
-  }, asio::use_future);
+  auto started = asio::co_spawn(
+      main.io, [&blobs]() -> asio::awaitable<void> {
+        blobs.start_check();
+        co_return;
+      },
+      asio::use_future);
   ASSERT_EQ(started.wait_for(60s), std::future_status::ready) << "the io thread did not start the check within 60 s";
   started.get();
   std::vector<std::future<std::vector<records::BlobRef>>> keepers;
@@ -293,9 +297,11 @@ TEST(ThreadServices, TheBlobCheckRunsOnItsThreadWhileFramesAreKeptFromTwoOthers)
     }
   }
   // The check's event was appended on the io thread, the writer's (before the report said done).
-  auto events = asio::co_spawn(main.io, [&writer]() -> asio::awaitable<std::size_t> {
-    co_return writer.events(0, 100, std::string("blobs")).size();
-  }, asio::use_future);
+  auto events = asio::co_spawn(
+      main.io, [&writer]() -> asio::awaitable<std::size_t> {
+        co_return writer.events(0, 100, std::string("blobs")).size();
+      },
+      asio::use_future);
   ASSERT_EQ(events.wait_for(60s), std::future_status::ready);
   EXPECT_EQ(events.get(), 1u);
 }

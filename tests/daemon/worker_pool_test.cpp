@@ -59,11 +59,14 @@ TEST(WorkerPool, RunsTheJobOffTheIoThreadAndPostsTheResultBack) {
   WorkerPool pool(io.get_executor(), WorkerPoolOptions{1, 4, {}});
   std::thread::id job_thread;
   Outcome out;
-  pool.submit("a fit", [&] {
-    job_thread = std::this_thread::get_id();
-    return json{{"de00", 1.5}};
-  }, into(out));
-  run_until(io, [&] { return out.arrived; }, "the job's result");
+  pool.submit(
+      "a fit", [&] {
+        job_thread = std::this_thread::get_id();
+        return json{{"de00", 1.5}};
+      },
+      into(out));
+  run_until(
+      io, [&] { return out.arrived; }, "the job's result");
   ASSERT_TRUE(out.result) << (out.error ? out.error->what() : "");
   EXPECT_EQ((*out.result)["de00"], 1.5);
   EXPECT_NE(job_thread, std::this_thread::get_id()) << "the job ran on the io thread";
@@ -77,19 +80,24 @@ TEST(WorkerPool, AFullQueueRefusesWithATypedErrorAndAlwaysAdmissionStillQueues) 
   std::promise<void> started;
   auto gate = release.get_future().share();
   Outcome first, second, third, always;
-  pool.submit("the held job", [&, gate] {
-    started.set_value();
-    gate.wait();
-    return json(1);
-  }, into(first));
+  pool.submit(
+      "the held job", [&, gate] {
+        started.set_value();
+        gate.wait();
+        return json(1);
+      },
+      into(first));
   // Once the worker holds the first job, the queue is empty: two places, then refusals.
   ASSERT_EQ(started.get_future().wait_for(std::chrono::seconds(60)), std::future_status::ready) << "the worker never started";
-  pool.submit("two", [] { return json(2); }, into(second));
-  pool.submit("three", [] { return json(3); }, into(third));
+  pool.submit(
+      "two", [] { return json(2); }, into(second));
+  pool.submit(
+      "three", [] { return json(3); }, into(third));
   EXPECT_EQ(pool.queued(), 2u);
   EXPECT_EQ(pool.running(), 1u);
   try {
-    pool.submit("a fourth", [] { return json(4); }, [](std::exception_ptr, json) {});
+    pool.submit(
+        "a fourth", [] { return json(4); }, [](std::exception_ptr, json) {});
     FAIL() << "a full queue took a job";
   } catch (const WorkerPoolFull& e) {
     EXPECT_NE(std::string(e.what()).find("a fourth"), std::string::npos) << e.what();
@@ -97,9 +105,11 @@ TEST(WorkerPool, AFullQueueRefusesWithATypedErrorAndAlwaysAdmissionStillQueues) 
     EXPECT_GT(e.retry_after_s(), 0);
   }
   EXPECT_THROW(pool.admit("a dry run"), WorkerPoolFull);
-  pool.submit("a campaign's fit", [] { return json(5); }, into(always), Admission::always);
+  pool.submit(
+      "a campaign's fit", [] { return json(5); }, into(always), Admission::always);
   release.set_value();
-  run_until(io, [&] { return first.arrived && second.arrived && third.arrived && always.arrived; }, "every result");
+  run_until(
+      io, [&] { return first.arrived && second.arrived && third.arrived && always.arrived; }, "every result");
   EXPECT_EQ(first.result, json(1));
   EXPECT_EQ(second.result, json(2));
   EXPECT_EQ(third.result, json(3));
@@ -110,12 +120,16 @@ TEST(WorkerPool, AnAdmissionHoldsAPlaceUntilItsHandleIsDropped) {
   asio::io_context io;
   WorkerPool pool(io.get_executor(), WorkerPoolOptions{1, 1, {}});
   auto place = pool.admit("a dry run");
-  EXPECT_THROW(pool.submit("a dry run's rival", [] { return json(1); }, [](std::exception_ptr, json) {}), WorkerPoolFull);
+  EXPECT_THROW(pool.submit(
+                   "a dry run's rival", [] { return json(1); }, [](std::exception_ptr, json) {}),
+               WorkerPoolFull);
   EXPECT_THROW(pool.admit("another dry run"), WorkerPoolFull);
   place.reset();
   Outcome out;
-  EXPECT_NO_THROW(pool.submit("a dry run's rival", [] { return json(1); }, into(out)));
-  run_until(io, [&] { return out.arrived; }, "the result");
+  EXPECT_NO_THROW(pool.submit(
+      "a dry run's rival", [] { return json(1); }, into(out)));
+  run_until(
+      io, [&] { return out.arrived; }, "the result");
   EXPECT_EQ(out.result, json(1));
 }
 
@@ -123,9 +137,12 @@ TEST(WorkerPool, ExceptionsArriveAsTypedErrors) {
   asio::io_context io;
   WorkerPool pool(io.get_executor(), WorkerPoolOptions{2, 4, {}});
   Outcome typed, foreign;
-  pool.submit("a fit", [] () -> json { throw Error(ErrorClass::bad_data, "too few patches"); }, into(typed));
-  pool.submit("a fit", [] () -> json { throw std::runtime_error("Eigen gave up"); }, into(foreign));
-  run_until(io, [&] { return typed.arrived && foreign.arrived; }, "both errors");
+  pool.submit(
+      "a fit", []() -> json { throw Error(ErrorClass::bad_data, "too few patches"); }, into(typed));
+  pool.submit(
+      "a fit", []() -> json { throw std::runtime_error("Eigen gave up"); }, into(foreign));
+  run_until(
+      io, [&] { return typed.arrived && foreign.arrived; }, "both errors");
   ASSERT_TRUE(typed.error);
   EXPECT_EQ(typed.error->cls(), ErrorClass::bad_data);
   EXPECT_EQ(typed.error->info().message, "too few patches");
@@ -140,10 +157,12 @@ TEST(WorkerPool, RunAsACoroutineReturnsTheResultOrRethrows) {
   auto ok = asio::co_spawn(io, pool.run("a fit", [] { return json("fitted"); }), asio::use_future);
   auto bad = asio::co_spawn(
       io, pool.run("a fit", []() -> json { throw Error(ErrorClass::bad_parameter, "unknown prior"); }), asio::use_future);
-  run_until(io, [&] {
-    return ok.wait_for(std::chrono::seconds(0)) == std::future_status::ready &&
-           bad.wait_for(std::chrono::seconds(0)) == std::future_status::ready;
-  }, "both coroutines");
+  run_until(
+      io, [&] {
+        return ok.wait_for(std::chrono::seconds(0)) == std::future_status::ready &&
+               bad.wait_for(std::chrono::seconds(0)) == std::future_status::ready;
+      },
+      "both coroutines");
   EXPECT_EQ(ok.get(), json("fitted"));
   try {
     bad.get();
@@ -160,23 +179,30 @@ TEST(WorkerPool, ShutdownCancelsWhatWaitsAndLetsTheRunningJobFinish) {
   std::promise<void> started;
   auto gate = release.get_future().share();
   Outcome running, waiting;
-  pool->submit("the running fit", [&, gate] {
-    started.set_value();
-    gate.wait();
-    return json("finished");
-  }, into(running));
+  pool->submit(
+      "the running fit", [&, gate] {
+        started.set_value();
+        gate.wait();
+        return json("finished");
+      },
+      into(running));
   ASSERT_EQ(started.get_future().wait_for(std::chrono::seconds(60)), std::future_status::ready) << "the worker never started";
-  pool->submit("the waiting fit", [] { return json("never"); }, into(waiting));
+  pool->submit(
+      "the waiting fit", [] { return json("never"); }, into(waiting));
   // shutdown() joins the worker, so it runs beside the test, which releases the job once the
   // waiting one has been cancelled.
   std::thread stopper([&] { pool->shutdown(); });
-  run_until(io, [&] { return waiting.arrived; }, "the waiting job's cancellation");
+  run_until(
+      io, [&] { return waiting.arrived; }, "the waiting job's cancellation");
   ASSERT_TRUE(waiting.error);
   EXPECT_EQ(waiting.error->cls(), ErrorClass::aborted);
-  EXPECT_THROW(pool->submit("a late fit", [] { return json(0); }, [](std::exception_ptr, json) {}), Error);
+  EXPECT_THROW(pool->submit(
+                   "a late fit", [] { return json(0); }, [](std::exception_ptr, json) {}),
+               Error);
   release.set_value();
   stopper.join();
-  run_until(io, [&] { return running.arrived; }, "the running job's result");
+  run_until(
+      io, [&] { return running.arrived; }, "the running job's result");
   EXPECT_EQ(running.result, json("finished"));
   pool.reset();  // a second shutdown (the destructor's) is harmless
 }

@@ -192,7 +192,8 @@ TEST_F(Backup, SnapshotUnderLoadRestoresIntoADaemonServingTheSameRuns) {
     try {
       started = std::make_unique<ct::DaemonProcess>(restored, daemon_config, dir_ / "restored-colorlabd.log");
     } catch (const std::exception& e) {
-      FAIL() << e.what() << "\n" << ct::shell_output("tail -30 " + (dir_ / "restored-colorlabd.log").string());
+      FAIL() << e.what() << "\n"
+             << ct::shell_output("tail -30 " + (dir_ / "restored-colorlabd.log").string());
     }
     auto& daemon = *started;
     auto api = ct::api_for(daemon);
@@ -213,7 +214,8 @@ TEST_F(Backup, SnapshotUnderLoadRestoresIntoADaemonServingTheSameRuns) {
       }
       const json m = api.get("/v1/runs/" + id + "/measurements?limit=100");
       EXPECT_EQ(static_cast<std::int64_t>(m["items"].size()), store::Store(restored / "colorlab.db", store::Store::ReadOnly{})
-                                                                   .measurement_count(id)) << id;
+                                                                  .measurement_count(id))
+          << id;
     }
     daemon.terminate();
   }

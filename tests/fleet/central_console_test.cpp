@@ -28,7 +28,6 @@ namespace {
 
 SharedServers& servers() { return web_tls_servers(); }
 
-
 // The response headers of one GET with curl (lower-case names), and its status.
 std::map<std::string, std::string> head_of(const std::string& url, int& status) {
   auto r = ct::run_command({"/usr/bin/curl", "-s", "-o", "/dev/null", "-D", "-", url}, std::chrono::seconds(30));

@@ -33,7 +33,6 @@ using protocol::ExecutionStatus;
 
 namespace {
 
-
 struct Reply {
   int status = 0;
   std::map<std::string, std::string> headers;  // lower-case names
@@ -535,8 +534,13 @@ TEST_F(Central, ALargeBlobIsRelayedByteForByteWholeAndInRanges) {
 
 TEST_F(Central, ControlRequestsAreRefusedAsReadOnly) {
   for (const auto& [method, path] : std::vector<std::pair<std::string, std::string>>{
-           {"POST", "/v1/executions"}, {"POST", "/v1/queue"}, {"DELETE", "/v1/keys/x"},
-           {"POST", "/v1/control/acquire"}, {"PUT", "/v1/runs/" + w().chart_run}, {"POST", "/v1/blobs/retention"},}) {
+           {"POST", "/v1/executions"},
+           {"POST", "/v1/queue"},
+           {"DELETE", "/v1/keys/x"},
+           {"POST", "/v1/control/acquire"},
+           {"PUT", "/v1/runs/" + w().chart_run},
+           {"POST", "/v1/blobs/retention"},
+       }) {
     auto r = central(path, {"-X", method, "-H", "Content-Type: application/json", "--data", "{}"});
     EXPECT_EQ(r.status, 405) << method << " " << path << ": " << r.body;
     EXPECT_EQ(r.headers["content-type"], "application/problem+json");

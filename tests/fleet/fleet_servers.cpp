@@ -128,7 +128,8 @@ void PostgresServer::start() {
     // --no-sync only skips initdb's own flush of the template files; the server runs with fsync on.
     auto r = testing::run_command({"/bin/sh", "-c",
                                    as_owner(std::string(kPgBin) + "/initdb -D " + quote(dir_ / "data") +
-                                            " -A trust -U postgres -E UTF8 --locale=C --no-sync") + " 2>&1"},
+                                            " -A trust -U postgres -E UTF8 --locale=C --no-sync") +
+                                       " 2>&1"},
                                   std::chrono::seconds(120));
     if (r.exit_code != 0) throw std::runtime_error("initdb failed: " + r.out + r.err);
     initialised_ = true;
@@ -147,8 +148,12 @@ void PostgresServer::start() {
 
 void PostgresServer::stop_immediate() {
   auto r = testing::run_command(
-      {"/bin/sh", "-c", as_owner(std::string(kPgBin) + "/pg_ctl -D " + quote(dir_ / "data") + " -m immediate -w stop") +
-                            " 2>&1",},
+      {
+          "/bin/sh",
+          "-c",
+          as_owner(std::string(kPgBin) + "/pg_ctl -D " + quote(dir_ / "data") + " -m immediate -w stop") +
+              " 2>&1",
+      },
       std::chrono::seconds(60));
   if (r.exit_code != 0) throw std::runtime_error("pg_ctl stop failed: " + r.out + r.err);
 }

@@ -53,7 +53,6 @@ int port_of(const std::string& text, const std::string& prefix) {
   return std::stoi(text.substr(at + prefix.size()));
 }
 
-
 // socat relaying 127.0.0.1:listen to 127.0.0.1:upstream, a child per connection. Started through setsid, so
 // cut() kills the whole process group: the listener and every connection it relays, as a cable pulled would.
 class Socat {
@@ -234,7 +233,8 @@ TEST_F(ShipFaults, TheBenchShowsItsLagAndTheAgentsLastError) {
     started = std::make_unique<ct::DaemonProcess>(state, daemon_config, dir_ / "colorlabd.log");
   } catch (const std::exception& e) {
     std::ifstream log(dir_ / "colorlabd.log");
-    FAIL() << e.what() << "\ncolorlabd's log:\n" << std::string(std::istreambuf_iterator<char>(log), {});
+    FAIL() << e.what() << "\ncolorlabd's log:\n"
+           << std::string(std::istreambuf_iterator<char>(log), {});
   }
   auto& daemon = *started;
   auto api = ct::api_for(daemon);
@@ -435,9 +435,9 @@ TEST_F(ShipFaults, PostgresOverTlsVerifiesTheServer) {
        " -keyout " + ca + ".key -out " + ca + ".pem 2>&1");
   }
   sh("cd " + p + " && openssl req -newkey rsa:2048 -nodes -subj /CN=127.0.0.1 -keyout server.key -out server.csr 2>&1 && "
-     "printf 'subjectAltName=IP:127.0.0.1,DNS:localhost\\n' > san.ext && "
-     "openssl x509 -req -in server.csr -CA ca.pem -CAkey ca.key -CAcreateserial -days 2 -extfile san.ext "
-     "-out server.crt 2>&1");
+                 "printf 'subjectAltName=IP:127.0.0.1,DNS:localhost\\n' > san.ext && "
+                 "openssl x509 -req -in server.csr -CA ca.pem -CAkey ca.key -CAcreateserial -days 2 -extfile san.ext "
+                 "-out server.crt 2>&1");
   auto& s = servers();
   const std::string data = s.pg->psql("postgres", "SHOW data_directory");
   // The server's key belongs to the server's user, mode 0600 (PostgreSQL refuses anything looser).

@@ -33,12 +33,10 @@ namespace {
 
 SharedServers& servers() { return web_tls_servers(); }
 
-
 void sh(const std::string& cmd) {
   auto r = ct::run_command({"/bin/sh", "-c", cmd}, std::chrono::seconds(60));
   if (r.exit_code != 0) throw std::runtime_error(cmd + ": " + r.out + r.err);
 }
-
 
 // The lab's CA and a server certificate for 127.0.0.1 it signed; an unrelated CA and a certificate for the same
 // address that one signed (what a wrong or intercepted store would present).
@@ -214,7 +212,8 @@ TEST(ShipHttps, ShipsAndReadsBackThroughATlsFrontWithTheLabsCa) {
   ASSERT_EQ(sha.size(), 64u);
   const fs::path got = dir / "blob.out";
   auto fetched = ct::run_command({"/usr/bin/curl", "-s", "-w", "%{http_code}", "-o", got.string(),
-                                  url + "/v1/blobs/" + sha}, std::chrono::seconds(60));
+                                  url + "/v1/blobs/" + sha},
+                                 std::chrono::seconds(60));
   EXPECT_EQ(trimmed(fetched.out), "200") << read_all(got).substr(0, 400);
   EXPECT_EQ(fleet::sha256_hex(read_all(got)), sha);
   EXPECT_NE(front.store_log_with("\"GET /" + name + "/sha256/" + sha).find("\"GET /" + name + "/sha256/" + sha),

@@ -55,7 +55,6 @@ SharedServers& servers() {
   return shared_servers(fs::path(COLORLAB_BIN_DIR).parent_path() / "tests" / "fleet-three-scratch", "colorlab-3b-pg");
 }
 
-
 struct Bench {
   std::string id, address, serial;
   fs::path dir;
@@ -179,7 +178,8 @@ TEST(ThreeBenches, CampaignsAtOnceShipIntoOneCatalog) {
     b.address = kAddresses[static_cast<std::size_t>(i)];
     b.serial = "CLGVBENCH" + std::to_string(i + 1);
     b.dir = scratch.path / b.id;
-    ASSERT_NO_THROW(start_bench(b, 40 + i, target)) << b.id << "'s colorlabd.log:\n" << read_all(b.dir / "colorlabd.log");
+    ASSERT_NO_THROW(start_bench(b, 40 + i, target)) << b.id << "'s colorlabd.log:\n"
+                                                    << read_all(b.dir / "colorlabd.log");
   }
   // Each daemon has its own camera, not one absent for want of an address.
   for (auto& b : benches) {
@@ -255,7 +255,7 @@ TEST(ThreeBenches, CampaignsAtOnceShipIntoOneCatalog) {
         [&] {
           return central_count(target.postgres,
                                "SELECT count(*) FROM benches WHERE id = $1 AND shipped_position >= " +
-                                                    std::to_string(last_end[b.id]),
+                                   std::to_string(last_end[b.id]),
                                b.id) == 1;
         },
         kShipBound))
@@ -326,9 +326,14 @@ TEST(ThreeBenches, CampaignsAtOnceShipIntoOneCatalog) {
 
   // Across the catalog: every table's rows equal its distinct global ids, and the runs are the benches' six.
   const std::vector<std::pair<std::string, std::string>> keys = {
-      {"runs", "id"},         {"executions", "id"},           {"measurements", "(run_id, step)"},
-      {"blobs", "sha256"},    {"run_blobs", "(run_id, name)"}, {"events", "(bench_id, seq)"},
-      {"benches", "id"},};
+      {"runs", "id"},
+      {"executions", "id"},
+      {"measurements", "(run_id, step)"},
+      {"blobs", "sha256"},
+      {"run_blobs", "(run_id, name)"},
+      {"events", "(bench_id, seq)"},
+      {"benches", "id"},
+  };
   for (const auto& [table, key] : keys) {
     auto c = pg.query("SELECT count(*), count(DISTINCT " + key + ") FROM " + table);
     EXPECT_EQ(c.int64(0, 0), c.int64(0, 1)) << table << ": rows differ from distinct " << key;

@@ -50,10 +50,10 @@ inline std::map<std::string, Target>& targets() {
 // COLORLAB_FUZZ_TARGET("cgats", one_input): libFuzzer's entry point in the fuzz build, an entry in
 // targets() in the normal build.
 #if defined(COLORLAB_LIBFUZZER)
-#define COLORLAB_FUZZ_TARGET(name, fn)                                                  \
+#define COLORLAB_FUZZ_TARGET(name, fn)                                                \
   extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) { \
-    fn(data, size);                                                                    \
-    return 0;                                                                          \
+    fn(data, size);                                                                   \
+    return 0;                                                                         \
   }
 #else
 #define COLORLAB_FUZZ_TARGET(name, fn) \

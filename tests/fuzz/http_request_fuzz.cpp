@@ -67,7 +67,7 @@ void one_input(const std::uint8_t* data, std::size_t size) {
     // The server's answer to a target it cannot parse quotes the target back (server.cpp safe_handle).
     if (!req.parse_target()) {
       (void)colorlab::http::HttpResponse::problem(400, "bad-target", "Malformed request target",
-                                                 "cannot parse '" + req.target + "'");
+                                                  "cannot parse '" + req.target + "'");
     }
   });
 }

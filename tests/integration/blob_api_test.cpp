@@ -441,8 +441,13 @@ TEST(BlobApi, ChartPhotographKeepsTheAveragedRawAndTheCamerasOwnFiles) {
   auto api = api_for(daemon);
   json reference = run_to_end(api, "chart-read", json::object());
   json run = run_to_end(api, "characterize-camera",
-                        {{"reference_run", reference["id"]}, {"frames", 2}, {"formats", {"raw", "jpeg"}},
-                         {"keep", {"average", "raw", "jpeg", "preview"}}, {"prior_exclude", {"Canon_20D"}},},
+                        {
+                            {"reference_run", reference["id"]},
+                            {"frames", 2},
+                            {"formats", {"raw", "jpeg"}},
+                            {"keep", {"average", "raw", "jpeg", "preview"}},
+                            {"prior_exclude", {"Canon_20D"}},
+                        },
                         std::chrono::seconds(300));
   const json listed = api.get("/v1/runs/" + run["id"].get<std::string>() + "/blobs");
   std::map<std::string, json> by_kind;

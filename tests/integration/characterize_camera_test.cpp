@@ -199,7 +199,8 @@ TEST(CharacterizeCamera, FitsEveryFormatWithinTheNoiseTheSimulatorInjects) {
   const double dissertation_mean_pct[3] = {1.60, 1.56, 1.29};
   for (int c = 0; c < 3; ++c) {
     const json& r = black_box["residuals"]["cv"][std::string(1, "RGB"[c])];
-    std::cout << "[characterize] raw black box " << "RGB"[c] << ": cv residual mean " << r["mean"] << " counts ("
+    std::cout << "[characterize] raw black box "
+              << "RGB"[c] << ": cv residual mean " << r["mean"] << " counts ("
               << r["mean_pct"] << " % FS), max " << r["max"] << " (" << r["max_pct"] << " %)\n";
     EXPECT_LE(r["mean_pct"].get<double>(), dissertation_mean_pct[c]) << "RGB"[c];
   }

@@ -226,7 +226,8 @@ class WebhookReceiver {
 // one a line: once a document is in `file`, its event is in the other.
 std::string notify_toml(const std::filesystem::path& file, const std::string& webhook) {
   return "[notify]\ncommand = [\"/bin/sh\", \"-c\", \"echo \\\"$COLORLAB_EVENT\\\" >> \\\"$1.events\\\"; { cat; echo; } >> \\\"$1\\\"\", "
-         "\"notify\", \"" + file.string() + "\"]\nwebhook = \"" + webhook + "\"\ntimeout_s = 10\n";
+         "\"notify\", \"" +
+         file.string() + "\"]\nwebhook = \"" + webhook + "\"\ntimeout_s = 10\n";
 }
 
 std::vector<json> notifications(const std::filesystem::path& file) {
@@ -270,8 +271,12 @@ TEST(CrashLoopGuard, SuspendsBacksOffRetriesByItselfAndTheRunCompletes) {
   for (const auto& ev : execution_events(lab.api(), id)) {
     const auto& p = ev["payload"];
     if (p.value("status", "") == "suspended" && p.contains("suspension") && p["suspension"]["category"] == "crash-loop") {
-      steps.push_back({{"suspended", p["suspension"]["retry"]}, {"backoff_s", p["suspension"]["backoff_s"]},
-                       {"retry_at", p["suspension"]["retry_at"]}, {"reason", p["reason"]},});
+      steps.push_back({
+          {"suspended", p["suspension"]["retry"]},
+          {"backoff_s", p["suspension"]["backoff_s"]},
+          {"retry_at", p["suspension"]["retry_at"]},
+          {"reason", p["reason"]},
+      });
     } else if (p.contains("resumed_by")) {
       steps.push_back({{"retried_by", p["resumed_by"]["by"]}, {"retry", p["resumed_by"]["retry"]}});
     } else if (p.value("status", "") == "finished_error" || p.value("status", "") == "aborted") {
@@ -452,7 +457,9 @@ TEST(CrashLoopGuard, WhenTheRetriesAreSpentTheQueueGoesOnWithTheNextItem) {
   ASSERT_TRUE(eventually([&] {
     q = api.get("/v1/queue?history=10");
     return q["items"].empty();
-  }, std::chrono::seconds(120))) << q.dump(1);
+  },
+                         std::chrono::seconds(120)))
+      << q.dump(1);
   EXPECT_FALSE(q["halted"].get<bool>()) << q.dump(1);
   std::map<std::string, json> history;
   for (const auto& item : q["history"]) history[item["id"]] = item;

@@ -35,8 +35,13 @@ double timed_run(const client::ApiClient& api, const std::string& campaign, cons
 json lab_truth(const DaemonProcess& daemon) {
   json endpoint = json::parse(std::ifstream(daemon.state_dir() / "colorlabd.endpoint"));
   json t = sim::send_control_command(endpoint.at("simulator_control").get<std::string>(), {{"cmd", "truth"}});
-  return json{{"lamps_on", t["lamps_on"]}, {"dimmer", t["dimmer"]}, {"ls110_readings", t["ls110"]["readings_served"]},
-              {"head_mm", t["spectrolino"]["head_mm"]}, {"spectra", t["spectrolino"]["measurements"]},};
+  return json{
+      {"lamps_on", t["lamps_on"]},
+      {"dimmer", t["dimmer"]},
+      {"ls110_readings", t["ls110"]["readings_served"]},
+      {"head_mm", t["spectrolino"]["head_mm"]},
+      {"spectra", t["spectrolino"]["measurements"]},
+  };
 }
 
 const json* problem_mentioning(const json& report, const std::string& text) {
@@ -59,15 +64,25 @@ TEST(DryRun, EstimateFromTimingsLearnedOnOtherRunsIsWithinTwentyPercentOfTheRun)
   EXPECT_EQ(fresh["estimate"]["measured_share"].get<double>(), 0.0);
 
   // What the lab learns from: a lamp-major grid of one row and a ColorChecker 24.
-  const json learn_grid = {{"rows", 1}, {"cols", 2}, {"lamps", {"TL84", "D65"}}, {"dimmer_levels", {100, 50}},
-                           {"order", "lamp-major"},};
+  const json learn_grid = {
+      {"rows", 1},
+      {"cols", 2},
+      {"lamps", {"TL84", "D65"}},
+      {"dimmer_levels", {100, 50}},
+      {"order", "lamp-major"},
+  };
   timed_run(api, "cabinet-grid", learn_grid);
   timed_run(api, "chart-read", {{"chart", "cc24"}});
 
   // What it estimates: the grid in the other order (a warm-up per spot instead of per lamp), with
   // more spots and levels, and the SG's 140 patches (three calibrations instead of one).
-  const json grid = {{"rows", 2}, {"cols", 3}, {"lamps", {"TL84", "D65"}}, {"dimmer_levels", {100, 50, 25}},
-                     {"order", "spot-major"},};
+  const json grid = {
+      {"rows", 2},
+      {"cols", 3},
+      {"lamps", {"TL84", "D65"}},
+      {"dimmer_levels", {100, 50, 25}},
+      {"order", "spot-major"},
+  };
   const json sg = {{"chart", "sg"}};
   for (const auto& [campaign, params] : {std::pair{std::string("cabinet-grid"), grid}, std::pair{std::string("chart-read"), sg}}) {
     json report = dry_run(api, campaign, params);

@@ -27,7 +27,9 @@ TEST(EmbeddedLabDslr, TheDaemonConnectsTheAnnouncedDslrAndCapturesThroughIt) {
     if (dslr.value("state", std::string()) != "ready") std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
   ASSERT_EQ(dslr.value("state", std::string()), "ready")
-      << dslr.dump() << "\n" << api.get("/v1/instruments").dump() << "\n" << shell_output("cat " + (dir / "colorlabd.log").string());
+      << dslr.dump() << "\n"
+      << api.get("/v1/instruments").dump() << "\n"
+      << shell_output("cat " + (dir / "colorlabd.log").string());
   EXPECT_EQ(dslr["kind"], "dslr");
   EXPECT_EQ(dslr["serial"], "SIM20D0001");
   EXPECT_TRUE(dslr["simulated"]);

@@ -118,7 +118,8 @@ TEST(EngineInDaemon, MisbehavingScriptsEndInTypedErrorsWhileTheDaemonKeepsServin
   };
   for (const auto& c : cases) {
     std::ofstream(dir / "state" / "campaigns" / (std::string(c.name) + ".lua"))
-        << "return {\n  limits = { memory_mib = 16 },\n  run = function(p)\n" << c.body << "\n  end,\n}\n";
+        << "return {\n  limits = { memory_mib = 16 },\n  run = function(p)\n"
+        << c.body << "\n  end,\n}\n";
   }
   ::setenv("NOTIFY_SOCKET", systemd.path().c_str(), 1);
   ::setenv("WATCHDOG_USEC", "400000", 1);

@@ -43,8 +43,12 @@ struct Lab {
     api = std::make_unique<client::ApiClient>(api_for(*daemon));
     chart_read = run_to_end(*api, "chart-read", json::object());
     characterization = run_to_end(*api, "characterize-camera",
-                                  {{"reference_run", chart_read["id"]}, {"frames", 1}, {"formats", {"raw"}},
-                                   {"prior_exclude", {"Canon_20D"}},},
+                                  {
+                                      {"reference_run", chart_read["id"]},
+                                      {"frames", 1},
+                                      {"formats", {"raw"}},
+                                      {"prior_exclude", {"Canon_20D"}},
+                                  },
                                   std::chrono::seconds(300));
     spot = run_to_end(*api, "luminance-spot", {{"readings", 3}});
   }
@@ -91,7 +95,7 @@ std::string tool(const std::string& name) {
 #define REQUIRE_TOOL_CURL() \
   if (!on_path("curl")) GTEST_SKIP() << "curl is not installed: scripts/setup.sh installs it"
 
-#define REQUIRE_ARGYLL(tool)                                                          \
+#define REQUIRE_ARGYLL(tool) \
   if (!on_path(tool)) GTEST_SKIP() << tool << " (ArgyllCMS) is not installed: scripts/setup.sh installs argyll"
 
 // spec2cie on `ti3`: its XYZ of each patch's spectrum against the XYZ the file carries. colorlab's
@@ -277,7 +281,8 @@ TEST_F(Exports, HeadAnswersAsGetWithoutTheBody) {
   for (const std::string& target : {"/v1/runs/" + id + "/export?format=csv", std::string("/v1/runs")}) {
     auto head = run_command({tool("curl"), "-sS", "-I", lab->daemon->url() + target});
     ASSERT_EQ(head.exit_code, 0) << head.err;
-    EXPECT_EQ(head.out.rfind("HTTP/1.1 200", 0), 0u) << target << "\n" << head.out;
+    EXPECT_EQ(head.out.rfind("HTTP/1.1 200", 0), 0u) << target << "\n"
+                                                     << head.out;
     // curl -I prints the headers alone: a body would follow a blank line.
     EXPECT_EQ(head.out.find("\r\n\r\n") + 4, head.out.size()) << target;
   }

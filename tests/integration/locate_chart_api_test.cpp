@@ -252,7 +252,8 @@ TEST_F(LocateChartApi, TheCliPrintsWhatAnalyzeLocateChartPrintsForTheSameMosaic)
   const auto pgm = *dir_ / "mosaic.pgm";
   {
     std::ofstream out(pgm, std::ios::binary);
-    out << "P5\n" << image.width << " " << image.height << "\n65535\n";
+    out << "P5\n"
+        << image.width << " " << image.height << "\n65535\n";
     for (std::size_t y = 0; y < image.height; ++y)
       for (auto v : image.row(y)) out.put(static_cast<char>(v >> 8)).put(static_cast<char>(v & 0xff));
   }
@@ -295,8 +296,14 @@ TEST_F(LocateChartApi, TheCliPrintsWhatAnalyzeLocateChartPrintsForTheSameMosaic)
 
 TEST_F(LocateChartApi, CharacterizeCameraRefusesADarkPhotographWithTheBlobAndCommandThenTakesTheCorners) {
   auto a = api();
-  const json params{{"reference_run", *reference_}, {"frames", 2}, {"formats", {"raw"}}, {"lamp", ""}, {"keep", json::array()},
-                    {"prior_exclude", {"Canon_20D"}},};
+  const json params{
+      {"reference_run", *reference_},
+      {"frames", 2},
+      {"formats", {"raw"}},
+      {"lamp", ""},
+      {"keep", json::array()},
+      {"prior_exclude", {"Canon_20D"}},
+  };
   // In the dark: refused. The run fails as needing a person, its hint naming the kept photograph and the commands.
   control({{"cmd", "lamp"}, {"lamp", "D65"}, {"on", false}});
   auto started = a.post("/v1/executions", {{"campaign", "characterize-camera"}, {"params", params}});

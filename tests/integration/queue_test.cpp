@@ -330,8 +330,9 @@ TEST(queue_daemon, APausedItemHoldsTheQueueAndStopLetsTheRunningItemFinish) {
   std::string execution = wait_current_measurements(api, 2);
   ASSERT_FALSE(execution.empty());
   api.post("/v1/executions/" + execution + "/pause", json::object());
-  auto q = wait_queue(api, [](const json& q) { return q["current"].value("execution_status", "") == "paused"; },
-                      std::chrono::seconds(30));
+  auto q = wait_queue(
+      api, [](const json& q) { return q["current"].value("execution_status", "") == "paused"; },
+      std::chrono::seconds(30));
   ASSERT_EQ(q["current"]["execution_status"], "paused") << q.dump(1);
   std::this_thread::sleep_for(std::chrono::seconds(1));  // several polls of the queue
   q = queue_of(api);
@@ -360,7 +361,8 @@ TEST(queue_daemon, ARunStartedByHandHoldsTheQueueUntilItEnds) {
   std::string manual_id = manual["id"];
   std::string item = enqueue(api, "luminance-spot", spot(1))["id"];
   api.post("/v1/queue/start", json::object());
-  auto q = wait_queue(api, [](const json& q) { return !q["waiting_for"].is_null(); }, std::chrono::seconds(30));
+  auto q = wait_queue(
+      api, [](const json& q) { return !q["waiting_for"].is_null(); }, std::chrono::seconds(30));
   EXPECT_EQ(q["waiting_for"], manual_id) << q.dump(1);
   std::this_thread::sleep_for(std::chrono::seconds(1));  // several polls of the queue
   EXPECT_EQ(item_in(queue_of(api), item)["state"], "queued") << "an item started beside a running execution";

@@ -43,8 +43,8 @@ struct KillNineCase {
   // Each of (at most) two kills per run comes 50..max_delay_ms after the previous start; 0 = 90 % of what the
   // uninterrupted run took (a moment anywhere in it, however fast the machine).
   int max_delay_ms = 2500;
-  int runs = 3;             // interrupted runs, each on a fresh daemon with its own random moments
-  std::string lab_toml;     // the simulated lab's configuration, when not write_daemon_config's
+  int runs = 3;          // interrupted runs, each on a fresh daemon with its own random moments
+  std::string lab_toml;  // the simulated lab's configuration, when not write_daemon_config's
   // On each fresh daemon before the campaign starts (not interrupted): parameters to add, e.g. the id of
   // a chart-read run the campaign reads.
   std::function<nlohmann::json(const client::ApiClient&)> prepare;

@@ -116,7 +116,8 @@ TEST(server_timing, EveryAnswerSaysWhereItsTimeWentWithinWhatTheClientMeasured) 
       ASSERT_EQ(a.head.rfind("HTTP/1.1 ", 0), 0u) << "no HTTP answer: '" << a.head << "'";
       const auto parts = server_timing(a.head);
       for (const char* name : {"queue", "handler", "cpu", "store", "later", "app"}) {
-        ASSERT_TRUE(parts.count(name)) << "no '" << name << "' in Server-Timing; the answer's head:\n" << a.head;
+        ASSERT_TRUE(parts.count(name)) << "no '" << name << "' in Server-Timing; the answer's head:\n"
+                                       << a.head;
         EXPECT_GE(parts.at(name), 0.0) << name;
       }
       // Nested intervals on one clock: the store's wait within the handler's run; the disjoint parts within the

@@ -21,7 +21,8 @@ class SimLabProcess {
   // `lab_toml` is written to lab.toml; the GigE Vision camera is left off (it needs the loopback lock).
   explicit SimLabProcess(const std::string& lab_toml, double time_scale = 1000, int seed = 5) {
     const auto config = dir / "lab.toml";
-    std::ofstream(config) << "[genicam]\nenabled = false\n" << lab_toml;
+    std::ofstream(config) << "[genicam]\nenabled = false\n"
+                          << lab_toml;
     process = std::make_unique<Process>(
         std::vector<std::string>{bin_path("colorlab-sim"), "--config", config.string(), "--seed", std::to_string(seed),
                                  "--time-scale", std::to_string(time_scale), "--control", (dir / "sim.sock").string()},

@@ -93,8 +93,11 @@ TEST(SimRelay, AStuckRelayAndAnUnpluggedBoardAreTypedErrors) {
   EXPECT_TRUE(scene_lamps(rig.sim).empty()) << "break before make: D65 went off, TL84 never came on";
 
   // Unplugged, found again on the second open: the driver's reconnect gets there by itself.
-  rig.sim.control({{"cmd", "fault"}, {"instrument", "relay"},
-                   {"faults", {{"stuck_mask", 0}, {"unplugged", true}, {"replug_after_opens", 2}}},});
+  rig.sim.control({
+      {"cmd", "fault"},
+      {"instrument", "relay"},
+      {"faults", {{"stuck_mask", 0}, {"unplugged", true}, {"replug_after_opens", 2}}},
+  });
   run(rig.io, rig.relay->set_lamps({"A"}));
   EXPECT_EQ(scene_lamps(rig.sim), std::vector<std::string>{"A"});
 

@@ -213,8 +213,11 @@ TEST(SuspendNotFail, ALampThatDriftsMidGridSuspendsItUntilTheLightIsStableAndThe
   // An overheating tube: −3 % of its output per lab minute for four minutes, then back at the same rate.
   // The bracket at the second spot (two minutes) sees about 6 % and suspends the run; the light is stable
   // again only once it has come back (eight minutes), and the spot is read again.
-  json drift = control(daemon, {{"cmd", "fault"}, {"instrument", "cabinet"},
-                                {"faults", {{"lamp_drift", {{"lamp", "D65"}, {"rate_pct_per_min", -3}, {"seconds", 240}, {"then", "return"}}}}},});
+  json drift = control(daemon, {
+                                   {"cmd", "fault"},
+                                   {"instrument", "cabinet"},
+                                   {"faults", {{"lamp_drift", {{"lamp", "D65"}, {"rate_pct_per_min", -3}, {"seconds", 240}, {"then", "return"}}}}},
+                               });
   EXPECT_EQ(measurements_of(api, e), 2u) << "the drift came too late: the second spot was read before it";
   std::string reason = wait_suspended(api, e, std::chrono::seconds(30));
   EXPECT_EQ(reason.rfind("lamp: ", 0), 0u) << reason;

@@ -150,4 +150,3 @@ TEST(ThinPath, KillNineMidCampaignResumesByItselfWithNothingLostOrRepeated) {
   // The summary is computed from the stored rows, so it counts the readings of both processes.
   EXPECT_EQ(after["summary"]["measurements"]["luminance"]["count"], 12);
 }
-

@@ -89,8 +89,11 @@ TEST(WatchdogWhileHeld, PingsGoOnWhileACommitIsHeldInItsSyncAndWhileAFitIsHeldOn
   std::ofstream(latch.string() + ".release") << "go\n";  // the pool's jobs pass until part 2 holds them
   std::unique_ptr<DaemonProcess> daemon;
   {
-    ScopedEnv env{{"NOTIFY_SOCKET", systemd.path().string()}, {"WATCHDOG_USEC", "400000"},
-                  {"COLORLAB_TEST_WORKER_LATCH", latch.string()},};
+    ScopedEnv env{
+        {"NOTIFY_SOCKET", systemd.path().string()},
+        {"WATCHDOG_USEC", "400000"},
+        {"COLORLAB_TEST_WORKER_LATCH", latch.string()},
+    };
     daemon = faults.start(write_daemon_config(dir.path(), 100, 3));
   }
   auto api = api_for(*daemon);

@@ -49,8 +49,8 @@ struct Lattice {
   std::map<std::pair<int, int>, int> cells;  // (i, j) → quad index
   cv::Matx33d to_image;                      // (i, j) → undistorted pixels
   int imin = 0, imax = -1, jmin = 0, jmax = -1;
-  double pitch_px = 0;                       // median distance between neighbouring centres
-  double rms_px = 0;                         // detected centres vs the fit
+  double pitch_px = 0;  // median distance between neighbouring centres
+  double rms_px = 0;    // detected centres vs the fit
   int ni() const { return imax - imin + 1; }
   int nj() const { return jmax - jmin + 1; }
 };
@@ -63,10 +63,10 @@ void refine_lattice(Lattice& lattice, const std::vector<cv::Point2d>& centres, i
 
 // ---- orientation.cpp: which way up the chart lies on the lattice ----
 struct OrientationChoice {
-  int quarter_turns = 0;      // of the chart grid on the lattice
+  int quarter_turns = 0;  // of the chart grid on the lattice
   cv::Matx33d grid_to_lattice;
   double score = 0, margin = 0;
-  bool scored = false;        // false: no expected luminances to score with
+  bool scored = false;  // false: no expected luminances to score with
 };
 // Placements of the layout on the lattice's extent (two when it fits, none when it does not).
 std::vector<OrientationChoice> placements(const ChartLayout& layout, const Lattice& lattice);

@@ -221,7 +221,7 @@ ChartLocation locate_chart(const PhotoView& photo, ChartType type, const LocateO
     if (!lat)
       throw Error(ErrorClass::not_found,
                   "no " + grid_name(L) + " found in the photo: " + std::to_string(quads.size()) +
-                                             " patch-like squares, no grid of " + std::to_string(min_cells) + " or more",
+                      " patch-like squares, no grid of " + std::to_string(min_cells) + " or more",
                   kCornersHint);
     auto choices = placements(L, *lat);
     if (choices.empty()) {
@@ -261,7 +261,7 @@ ChartLocation locate_chart(const PhotoView& photo, ChartType type, const LocateO
     const double rel = loc.reprojection_rms_px / pitch_px;
     lower(conf, clamp01(1 - (rel - 0.04) / 0.08),
           "the patches do not sit on a flat grid (rms " + std::to_string(loc.reprojection_rms_px) +
-                                                     " px); is the lens distortion uncorrected?");
+              " px); is the lens distortion uncorrected?");
   }
   for (const auto& block : undetected_blocks(L, detected)) {
     std::string names;
@@ -274,7 +274,7 @@ ChartLocation locate_chart(const PhotoView& photo, ChartType type, const LocateO
     }
     lower(conf, 0.1,
           "patches " + names + " show no edges of their own: is the chart partly covered?" +
-                         (why.empty() ? std::string() : " (" + why + ")"));
+              (why.empty() ? std::string() : " (" + why + ")"));
     break;
   }
 
@@ -302,7 +302,7 @@ ChartLocation locate_chart(const PhotoView& photo, ChartType type, const LocateO
   if (!loc.check.passed)
     lower(conf, 0.2,
           "the chart's own neutrals disagree (" + loc.check.method + ", worst at " + loc.check.worst_patch + ": " +
-                         std::to_string(loc.check.worst_disagreement * 100) + " %): the grid is misplaced or the chart is covered");
+              std::to_string(loc.check.worst_disagreement * 100) + " %): the grid is misplaced or the chart is covered");
   loc.confidence = conf.value;
   if (conf.value < 1) loc.notes.push_back("confidence limited by: " + conf.why);
   if (loc.confidence < o.min_confidence) {

@@ -75,7 +75,8 @@ SelfCheck check_repeated_neutrals(const ChartLayout& L, const std::vector<std::v
     if (grp.size() < 3) continue;
     std::vector<cv::Point2d> pos;
     for (int k : grp) pos.push_back(pos_of(k));
-    const int terms = grp.size() >= 10 ? 6 : grp.size() >= 4 ? 3 : 1;
+    const int terms = grp.size() >= 10 ? 6 : grp.size() >= 4 ? 3
+                                                             : 1;
     double group_worst = 0;
     for (int c = 0; c < channels; ++c) {
       std::vector<double> v;

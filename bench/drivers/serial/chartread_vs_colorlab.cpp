@@ -34,8 +34,8 @@
 
 #include "colorlab/drivers/spectrolino.hpp"
 #include "colorlab/testing/process.hpp"
-#include "run_support.hpp"   // tests/drivers/serial: runs a driver coroutine with a hard limit
-#include "sim_process.hpp"    // tests/sim/serial: colorlab-sim as a child process
+#include "run_support.hpp"  // tests/drivers/serial: runs a driver coroutine with a hard limit
+#include "sim_process.hpp"  // tests/sim/serial: colorlab-sim as a child process
 
 namespace {
 
@@ -45,8 +45,8 @@ using json = nlohmann::json;
 using colorlab::testing::on_path;
 using colorlab::testing::shell_output;
 
-constexpr int kColumns = 14;  // SG columns A..N: one row is one Argyll pass
-constexpr int kRows = 10;     // SG rows 1..10
+constexpr int kColumns = 14;          // SG columns A..N: one row is one Argyll pass
+constexpr int kRows = 10;             // SG rows 1..10
 const char* kArgyllPage = "160x122";  // printtarg -i SS: 14 steps per pass, 10 passes on one page
 
 struct Options {
@@ -87,26 +87,36 @@ struct Run {
   bool done = false;
   std::string why;
   std::string load_before, load_after;
-  double init = 0;     // start .. ready for the chart (chartread: its "place sheet" prompt)
-  double locate = 0;   // chartread only: sheet prompt .. the last sight answered
-  double read = 0;     // colorlab: calibrate() + read_chart(); chartread: located .. "read OK" (its calibrations inside)
+  double init = 0;    // start .. ready for the chart (chartread: its "place sheet" prompt)
+  double locate = 0;  // chartread only: sheet prompt .. the last sight answered
+  double read = 0;    // colorlab: calibrate() + read_chart(); chartread: located .. "read OK" (its calibrations inside)
   double total() const { return init + locate + read; }
   unsigned baud = 0;
   std::uint64_t sim_lines = 0, sim_measurements = 0;  // what the simulator answered (its own counters)
   // colorlab only, measured in this run:
   int calibrations = 0;
-  double device_per_patch = 0;  // mean D0 07 round trip minus its wire time
-  double wire_per_patch = 0;    // mean D0 07 request + answer bytes at the link speed
-  double host_per_patch = 0;    // median of a patch's cycle minus its D0 07 round trip (ms resolution)
-  double cycle_per_patch = 0;   // read_chart's time / patches (its recalibrations included)
+  double device_per_patch = 0;                 // mean D0 07 round trip minus its wire time
+  double wire_per_patch = 0;                   // mean D0 07 request + answer bytes at the link speed
+  double host_per_patch = 0;                   // median of a patch's cycle minus its D0 07 round trip (ms resolution)
+  double cycle_per_patch = 0;                  // read_chart's time / patches (its recalibrations included)
   std::map<int, std::vector<double>> spectra;  // chart index (row * 14 + column) → reflectance
 };
 
 json to_json(const Run& r) {
-  json j{{"client", r.client},       {"done", r.done},         {"why", r.why},
-         {"load_before", r.load_before}, {"load_after", r.load_after}, {"init_s", r.init},
-         {"locate_s", r.locate},     {"read_s", r.read},       {"total_s", r.total()},
-         {"baud", r.baud},           {"sim_lines_answered", r.sim_lines}, {"sim_measurements", r.sim_measurements},};
+  json j{
+      {"client", r.client},
+      {"done", r.done},
+      {"why", r.why},
+      {"load_before", r.load_before},
+      {"load_after", r.load_after},
+      {"init_s", r.init},
+      {"locate_s", r.locate},
+      {"read_s", r.read},
+      {"total_s", r.total()},
+      {"baud", r.baud},
+      {"sim_lines_answered", r.sim_lines},
+      {"sim_measurements", r.sim_measurements},
+  };
   if (r.client == "colorlab") {
     j["calibrations"] = r.calibrations;
     j["device_per_patch_s"] = r.device_per_patch;
@@ -225,7 +235,8 @@ std::vector<TranscriptLine> parse_transcript(const std::vector<std::string>& lin
     TranscriptLine t;
     t.ms = std::stol(l.substr(1, ms_end - 1));
     const std::string dir = l.substr(ms_end + 3, 2);
-    t.dir = dir == "->" ? '>' : dir == "<-" ? '<' : ' ';
+    t.dir = dir == "->" ? '>' : dir == "<-" ? '<'
+                                            : ' ';
     t.bytes = l.substr(ms_end + 6);
     out.push_back(std::move(t));
   }
@@ -437,8 +448,8 @@ int main(int argc, char** argv) {
                   " host %.4f s (median); read_chart / patches %.4f s (recalibrations included)\n",
                   c.calibrations, c.device_per_patch, c.wire_per_patch, c.host_per_patch, c.cycle_per_patch);
       const double steady = c.device_per_patch + c.wire_per_patch + c.host_per_patch;
-  std::printf("  colorlab's part of a patch beyond the device's own time: wire %.1f %%, host %.1f %% of %.4f s\n",
-              100.0 * c.wire_per_patch / steady, 100.0 * c.host_per_patch / steady, steady);
+      std::printf("  colorlab's part of a patch beyond the device's own time: wire %.1f %%, host %.1f %% of %.4f s\n",
+                  100.0 * c.wire_per_patch / steady, 100.0 * c.host_per_patch / steady, steady);
     } else {
       ++failures;
     }

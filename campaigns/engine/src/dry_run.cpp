@@ -141,7 +141,7 @@ class DryRun final : public LabCallSink {
     if (++calls_ > static_cast<std::int64_t>(setup_.max_calls)) {
       return stop_at(call, "script",
                      "the dry run stopped after " + std::to_string(setup_.max_calls) +
-                                         " lab calls: the script may wait for a reading the dry run cannot predict");
+                         " lab calls: the script may wait for a reading the dry run cannot predict");
     }
     const std::string role = DryLab::role_of(call);
     if (!role.empty()) roles_.insert(role);
@@ -213,8 +213,15 @@ class DryRun final : public LabCallSink {
     json& a = operator_actions_[r.action];
     if (a.is_null()) {
       action_order_.push_back(r.action);
-      a = json{{"action", r.action}, {"prompt", r.prompt}, {"count", 0}, {"options", r.options},
-               {"default", r.default_option}, {"timeout_s", r.timeout_s}, {"by", person ? "operator" : "simulated lab"},};
+      a = json{
+          {"action", r.action},
+          {"prompt", r.prompt},
+          {"count", 0},
+          {"options", r.options},
+          {"default", r.default_option},
+          {"timeout_s", r.timeout_s},
+          {"by", person ? "operator" : "simulated lab"},
+      };
     }
     a["count"] = a["count"].get<int>() + 1;
   }

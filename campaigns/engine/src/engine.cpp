@@ -401,7 +401,7 @@ class ScriptRun final : public LabCallSink {
   std::unique_ptr<LuaSandbox> sandbox_;
   lua_State* thread_ = nullptr;
   std::optional<PendingCall> requested_;  // what the script yielded with
-  HandedComputation handed_;  // a computation the script handed over, for setup_.compute to run
+  HandedComputation handed_;              // a computation the script handed over, for setup_.compute to run
 
   // The replay: where in the journal, the lab state it implies, what the calls' timing keys follow.
   bool live_;

@@ -229,9 +229,14 @@ int analysis_compare_lamps(lua_State* L) {
     }
     json out = json::array();
     for (const auto& l : analysis::compare_lamps(n, results)) {
-      out.push_back({{"name", l.name}, {"min", l.min}, {"max", l.max}, {"range", l.range},
-                     {"best", {{"row", l.best.row}, {"col", l.best.col}, {"stdev", l.best.stdev}}},
-                     {"worst_window", l.worst_window},});
+      out.push_back({
+          {"name", l.name},
+          {"min", l.min},
+          {"max", l.max},
+          {"range", l.range},
+          {"best", {{"row", l.best.row}, {"col", l.best.col}, {"stdev", l.best.stdev}}},
+          {"worst_window", l.worst_window},
+      });
     }
     lua_settop(L, 0);
     push_json(L, out);

@@ -73,9 +73,14 @@ LuaSandbox::LuaSandbox(std::string script_name, ScriptLimits limits, std::uint64
   L_ = lua_newstate(&LuaSandbox::allocate, this);
   if (!L_) throw Error(ErrorClass::internal, "cannot create a Lua state for " + name_);
   *static_cast<LuaSandbox**>(lua_getextraspace(L_)) = this;
-  const luaL_Reg libs[] = {{LUA_GNAME, luaopen_base},        {LUA_TABLIBNAME, luaopen_table},
-                           {LUA_STRLIBNAME, luaopen_string}, {LUA_MATHLIBNAME, luaopen_math},
-                           {LUA_UTF8LIBNAME, luaopen_utf8},  {LUA_COLIBNAME, luaopen_coroutine},};
+  const luaL_Reg libs[] = {
+      {LUA_GNAME, luaopen_base},
+      {LUA_TABLIBNAME, luaopen_table},
+      {LUA_STRLIBNAME, luaopen_string},
+      {LUA_MATHLIBNAME, luaopen_math},
+      {LUA_UTF8LIBNAME, luaopen_utf8},
+      {LUA_COLIBNAME, luaopen_coroutine},
+  };
   for (const auto& lib : libs) {
     luaL_requiref(L_, lib.name, lib.func, 1);
     lua_pop(L_, 1);

@@ -159,9 +159,16 @@ json CampaignScript::validate(const json& params) const {
 }
 
 json CampaignScript::to_json() const {
-  return {{"name", name},     {"kind", "campaign"},  {"description", description}, {"needs", needs},
-          {"parameters", parameters}, {"origin", origin},  {"sha256", sha256},
-          {"path", path.string()},};
+  return {
+      {"name", name},
+      {"kind", "campaign"},
+      {"description", description},
+      {"needs", needs},
+      {"parameters", parameters},
+      {"origin", origin},
+      {"sha256", sha256},
+      {"path", path.string()},
+  };
 }
 
 CampaignScript parse_campaign_script(const std::string& name, const std::string& source) {

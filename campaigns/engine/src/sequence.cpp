@@ -43,9 +43,18 @@ json SequenceStep::to_json() const {
 json CampaignSequence::to_json() const {
   json steps_json = json::array();
   for (const auto& s : steps) steps_json.push_back(s.to_json());
-  return {{"name", name},       {"kind", "sequence"},  {"description", description}, {"origin", origin},
-          {"sha256", sha256},   {"path", path.string()}, {"steps", steps_json},       {"small", small},
-          {"needs", json::array()}, {"parameters", json::object()},};
+  return {
+      {"name", name},
+      {"kind", "sequence"},
+      {"description", description},
+      {"origin", origin},
+      {"sha256", sha256},
+      {"path", path.string()},
+      {"steps", steps_json},
+      {"small", small},
+      {"needs", json::array()},
+      {"parameters", json::object()},
+  };
 }
 
 std::vector<SequenceStep> CampaignSequence::expand(bool use_small, const json& overrides) const {

@@ -103,13 +103,23 @@ json DryLab::answer(const std::string& call, const json& args, double lab_now_s,
 }
 
 json DryLab::call_meter_measure(const json&, DryContext&) {
-  return json{{"luminance", state_.dimmer_percent.value_or(100.0)}, {"unit", "cd/m2"}, {"instrument", id_for("luminance_meter")},
-              {"raw", "dry run"},};
+  return json{
+      {"luminance", state_.dimmer_percent.value_or(100.0)},
+      {"unit", "cd/m2"},
+      {"instrument", id_for("luminance_meter")},
+      {"raw", "dry run"},
+  };
 }
 
 json DryLab::call_wait_stable(const json&, DryContext&) {
-  return json{{"luminance", state_.dimmer_percent.value_or(100.0)}, {"unit", "cd/m2"}, {"instrument", id_for("luminance_meter")},
-              {"drift_pct", 0.0}, {"readings", 0}, {"waited_s", 0.0},};
+  return json{
+      {"luminance", state_.dimmer_percent.value_or(100.0)},
+      {"unit", "cd/m2"},
+      {"instrument", id_for("luminance_meter")},
+      {"drift_pct", 0.0},
+      {"readings", 0},
+      {"waited_s", 0.0},
+  };
 }
 
 json DryLab::lamps_lit(std::vector<std::string> on, DryContext& context) const {
@@ -190,8 +200,13 @@ json DryLab::call_camera_capture(const json& args, DryContext&) {
     if (n > frames) break;
     for (const char* c : {"R", "G", "B"}) rows.push_back({{"frames", n}, {"channel", c}, {"stdev", 8.0 / std::sqrt(n)}});
   }
-  return json{{"frames", frames}, {"region", {0, 0, 32, 32}}, {"rows", rows}, {"instrument", id_for("camera")},
-              {"unit", "DN above black"},};
+  return json{
+      {"frames", frames},
+      {"region", {0, 0, 32, 32}},
+      {"rows", rows},
+      {"instrument", id_for("camera")},
+      {"unit", "DN above black"},
+  };
 }
 
 json DryLab::call_camera_photograph_chart(const json& args, DryContext&) {
@@ -209,8 +224,12 @@ json DryLab::call_camera_photograph_chart(const json& args, DryContext&) {
       xyz.push_back({0.9642 * y, y, 0.8249 * y});
     }
   }
-  json out = json{{"instrument", id_for("camera")}, {"chart", o.value("chart", std::string("sg"))}, {"frames", frames},
-                  {"formats", json::object()},};
+  json out = json{
+      {"instrument", id_for("camera")},
+      {"chart", o.value("chart", std::string("sg"))},
+      {"frames", frames},
+      {"formats", json::object()},
+  };
   for (const auto& f : formats) {
     const std::string format = f.get<std::string>();
     json values = json::array();
@@ -218,13 +237,24 @@ json DryLab::call_camera_photograph_chart(const json& args, DryContext&) {
       auto v = camera_values(x, format);
       values.push_back({v[0], v[1], v[2]});
     }
-    out["formats"][format] = json{{"format", format}, {"bits", format == "raw" ? 16 : (format == "tiff16" ? 16 : 8)},
-                                  {"confidence", 1.0}, {"rotation_deg", 0}, {"corners", json::array()},
-                                  {"patches_detected", ids.size()}, {"reprojection_rms_px", 0.0},
-                                  {"check", json::object()}, {"frames", frames}, {"files", json::array()},
-                                  {"width", 0}, {"height", 0}, {"notes", {"dry run: values from the reference"}},
-                                  {"ids", ids}, {"values", values},
-                                  {"detected", std::vector<bool>(ids.size(), true)},};
+    out["formats"][format] = json{
+        {"format", format},
+        {"bits", format == "raw" ? 16 : (format == "tiff16" ? 16 : 8)},
+        {"confidence", 1.0},
+        {"rotation_deg", 0},
+        {"corners", json::array()},
+        {"patches_detected", ids.size()},
+        {"reprojection_rms_px", 0.0},
+        {"check", json::object()},
+        {"frames", frames},
+        {"files", json::array()},
+        {"width", 0},
+        {"height", 0},
+        {"notes", {"dry run: values from the reference"}},
+        {"ids", ids},
+        {"values", values},
+        {"detected", std::vector<bool>(ids.size(), true)},
+    };
   }
   return out;
 }

@@ -240,8 +240,14 @@ asio::awaitable<json> Lab::wait_stable(const StabilityCriterion& c, const Execut
       log::debug("lab", "wait_stable: " + std::to_string(r.luminance) + " " + r.unit + ", drift " +
                             std::to_string(drift_pct) + " % over " + std::to_string(c.window_s) + " s");
       if (drift_pct <= c.tolerance_pct) {
-        co_return json{{"luminance", r.luminance}, {"unit", r.unit},          {"instrument", meter->id()},
-                       {"drift_pct", drift_pct},   {"readings", readings},    {"waited_s", t},};
+        co_return json{
+            {"luminance", r.luminance},
+            {"unit", r.unit},
+            {"instrument", meter->id()},
+            {"drift_pct", drift_pct},
+            {"readings", readings},
+            {"waited_s", t},
+        };
       }
     }
     if (t >= c.timeout_s) {

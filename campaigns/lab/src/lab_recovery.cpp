@@ -163,9 +163,15 @@ asio::awaitable<json> Lab::await_recovery(const std::string& call, const Error& 
         check_drift(now, unit);
         stable_light_ = light_now(now);
         light_.settle_at(stable_light_->lamps, dimmer_percent_, now);
-        json how{{"condition", "lamp"},      {"cause", cause.info().device_code}, {"checks", checks},
-                 {"luminance", now},         {"stable_level", now},               {"lamps", stable_light_->lamps},
-                 {"dimmer_percent", dimmer_percent_},};
+        json how{
+            {"condition", "lamp"},
+            {"cause", cause.info().device_code},
+            {"checks", checks},
+            {"luminance", now},
+            {"stable_level", now},
+            {"lamps", stable_light_->lamps},
+            {"dimmer_percent", dimmer_percent_},
+        };
         if (expected_before && *expected_before > 0 && stable_light_->lamps == lamps_before) {
           how["level_before"] = *expected_before;
           how["change_pct"] = (now / *expected_before - 1) * 100;

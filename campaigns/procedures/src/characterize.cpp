@@ -95,8 +95,14 @@ double quantile(std::vector<double> v, double q) {
 }
 
 json stats_json(const ca::ErrorStats& e) {
-  return json{{"mean", e.s00.mean}, {"median", e.s00.median}, {"p95", quantile(e.de00, 0.95)},
-              {"max", e.s00.max},   {"mean_de76", e.s76.mean}, {"max_de76", e.s76.max},};
+  return json{
+      {"mean", e.s00.mean},
+      {"median", e.s00.median},
+      {"p95", quantile(e.de00, 0.95)},
+      {"max", e.s00.max},
+      {"mean_de76", e.s76.mean},
+      {"max_de76", e.s76.max},
+  };
 }
 
 Eigen::MatrixXd lab_rows(const std::vector<ca::Lab>& lab) {
@@ -115,8 +121,12 @@ json camera_colour_space(const ca::ChartData& d, double full_scale, ca::RgbSpace
   for (Eigen::Index r = 0; r < d.rgb.rows(); ++r) rgb.push_back({d.rgb(r, 0) / full_scale, d.rgb(r, 1) / full_scale, d.rgb(r, 2) / full_scale});
   auto e = ca::evaluate(lab_rows(ca::rgb_to_lab_d50(space, rgb)), d.lab);
   json s = stats_json(e);
-  return json{{"training", s}, {"cv", s}, {"fitted", false},
-              {"colour_space", space == ca::RgbSpace::srgb ? "srgb" : "adobe_rgb"},};
+  return json{
+      {"training", s},
+      {"cv", s},
+      {"fitted", false},
+      {"colour_space", space == ca::RgbSpace::srgb ? "srgb" : "adobe_rgb"},
+  };
 }
 
 // Which patches each fold holds out: every patch alone (LOO) or every k-th (k-fold, interleaved so
@@ -147,8 +157,13 @@ json icc_profile(const ca::ChartData& d, double gamma, const ca::CvSpec& cv) {
     for (std::size_t j = 0; j < held.size(); ++j) predicted.row(static_cast<Eigen::Index>(held[j])) = out.row(static_cast<Eigen::Index>(j));
   }
   auto cross = ca::evaluate(predicted, d.lab);
-  return json{{"training", stats_json(training)}, {"cv", stats_json(cross)}, {"fitted", true}, {"gamma", gamma},
-              {"kind", "matrix/shaper"},};
+  return json{
+      {"training", stats_json(training)},
+      {"cv", stats_json(cross)},
+      {"fitted", true},
+      {"gamma", gamma},
+      {"kind", "matrix/shaper"},
+  };
 }
 
 json matrix_json(const Eigen::MatrixXd& m) {
@@ -169,8 +184,13 @@ json adapted_mapping(const ca::ChartData& d, const ca::CvSpec& cv, double tolera
   json candidates = json::array();
   for (const auto& c : s.candidates) {
     if (c.rank_deficient) continue;
-    candidates.push_back({{"method", c.method}, {"target", ca::to_string(c.target)}, {"parameters", c.parameters},
-                          {"training_mean", c.training.s00.mean}, {"cv_mean", c.cv.s00.mean},});
+    candidates.push_back({
+        {"method", c.method},
+        {"target", ca::to_string(c.target)},
+        {"parameters", c.parameters},
+        {"training_mean", c.training.s00.mean},
+        {"cv_mean", c.cv.s00.mean},
+    });
   }
   ca::FitOptions fo;
   fo.target = chosen.target;
@@ -204,7 +224,6 @@ json adapted_mapping(const ca::ChartData& d, const ca::CvSpec& cv, double tolera
               {"tolerance_de00", s.tolerance},
               {"candidates", candidates}};
 }
-
 
 // (d) §7.4: the camera as a black box. Spectral sensitivities s_c ≥ 0 are fitted so that
 // RAW_c = Σ s_c(λ) · reflectance(λ) · lamp(λ) reproduces the raw counts (analysis/blackbox.hpp: NNLS
@@ -337,9 +356,16 @@ json residual_table(const Eigen::MatrixXd& residuals, double full_scale) {
     std::vector<double> a;
     for (Eigen::Index i = 0; i < residuals.rows(); ++i) a.push_back(std::abs(residuals(i, c)));
     const ca::Summary sum = ca::summarize(a);
-    out[std::string(1, "RGB"[c])] = {{"min", sum.min}, {"mean", sum.mean}, {"median", sum.median}, {"max", sum.max},
-                                     {"stdev", sum.stdev}, {"min_pct", 100 * sum.min / full_scale},
-                                     {"mean_pct", 100 * sum.mean / full_scale}, {"max_pct", 100 * sum.max / full_scale},};
+    out[std::string(1, "RGB"[c])] = {
+        {"min", sum.min},
+        {"mean", sum.mean},
+        {"median", sum.median},
+        {"max", sum.max},
+        {"stdev", sum.stdev},
+        {"min_pct", 100 * sum.min / full_scale},
+        {"mean_pct", 100 * sum.mean / full_scale},
+        {"max_pct", 100 * sum.max / full_scale},
+    };
   }
   return out;
 }
@@ -420,8 +446,13 @@ json black_box(const ca::ChartData& d, const BlackBoxSetup& s, const std::string
     }
   }
   json regularisation = model.with_prior
-                            ? json{{"kind", "prior from other cameras' measured curves"}, {"source", s.prior_source},
-                                   {"cameras", s.prior->cameras}, {"excluded", s.prior_excluded}, {"lambda", model.lambda},}
+                            ? json{
+                                  {"kind", "prior from other cameras' measured curves"},
+                                  {"source", s.prior_source},
+                                  {"cameras", s.prior->cameras},
+                                  {"excluded", s.prior_excluded},
+                                  {"lambda", model.lambda},
+                              }
                             : json{{"kind", "second-difference smoothness, weight by GCV"}, {"lambda", model.lambda}};
   return json{{"training", stats_json(training)},
               {"cv", stats_json(cross)},
@@ -433,10 +464,15 @@ json black_box(const ca::ChartData& d, const BlackBoxSetup& s, const std::string
               {"spd_note", "the lamp's spectrum is assumed to be the standard illuminant's, not measured"},
               {"mapping", {{"method", method}, {"target", ca::to_string(target)}}},
               {"full_scale", full_scale},
-              {"residuals", {{"unit", "counts"}, {"training", residual_table(predicted - d.rgb, full_scale)},
-                             {"cv", residual_table(held_counts - d.rgb, full_scale)},
-                             {"patches", {{"training", residual_patches(d.ids, predicted - d.rgb)},
-                                          {"cv", residual_patches(d.ids, held_counts - d.rgb)},}},}},
+              {"residuals", {
+                                {"unit", "counts"},
+                                {"training", residual_table(predicted - d.rgb, full_scale)},
+                                {"cv", residual_table(held_counts - d.rgb, full_scale)},
+                                {"patches", {
+                                                {"training", residual_patches(d.ids, predicted - d.rgb)},
+                                                {"cv", residual_patches(d.ids, held_counts - d.rgb)},
+                                            }},
+                            }},
               {"regularisation", regularisation},
               {"sensitivities", curves}};
 }
@@ -473,7 +509,7 @@ json characterize(const json& camera, const json& reference, const json& options
   json approaches = json::object();
   if (!raw) {
     approaches["camera_colour_space"] = camera_colour_space(d, std::ldexp(1.0, bits) - 1,
-                                                           space_name == "srgb" ? ca::RgbSpace::srgb : ca::RgbSpace::adobe_rgb_1998);
+                                                            space_name == "srgb" ? ca::RgbSpace::srgb : ca::RgbSpace::adobe_rgb_1998);
   }
   approaches["icc_profile"] = icc_profile(d, gamma, cv);
   json selected;
@@ -496,9 +532,17 @@ json characterize(const json& camera, const json& reference, const json& options
       best = name;
     }
   }
-  return json{{"format", format},     {"patches", d.size()},   {"cv", cv.name()},
-              {"approaches", approaches}, {"best_approach", best}, {"selected", selected},
-              {"not_fitted", not_fitted}, {"unit", "ΔE00"}, {"across_lamps", across_lamps},};
+  return json{
+      {"format", format},
+      {"patches", d.size()},
+      {"cv", cv.name()},
+      {"approaches", approaches},
+      {"best_approach", best},
+      {"selected", selected},
+      {"not_fitted", not_fitted},
+      {"unit", "ΔE00"},
+      {"across_lamps", across_lamps},
+  };
 }
 
 json characterize_black_box(const json& camera, const json& reference, const json& options) {

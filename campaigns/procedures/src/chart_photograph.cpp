@@ -250,7 +250,8 @@ asio::awaitable<json> photograph_chart(cam::CameraInstrument& instrument, const 
   auto& camera = instrument.camera();
   const bool tiff = wants(p, "tiff8") || wants(p, "tiff16");
   const bool processed = tiff || wants(p, "jpeg");
-  const auto want = tiff ? cam::ImageFormat::raw_jpeg_tiff : processed ? cam::ImageFormat::raw_and_jpeg : cam::ImageFormat::raw;
+  const auto want = tiff ? cam::ImageFormat::raw_jpeg_tiff : processed ? cam::ImageFormat::raw_and_jpeg
+                                                                       : cam::ImageFormat::raw;
   const auto offered = camera.limits().image_formats;
   const auto before = camera.settings().image_format;
   if (processed && std::find(offered.begin(), offered.end(), want) == offered.end()) {

@@ -25,8 +25,8 @@ class Summer {
     } else if (p.width != first_.width || p.height != first_.height || p.channels != first_.channels || p.type != first_.type) {
       throw Error(ErrorClass::bad_data,
                   path.filename().string() + " is not the same kind of image as " +
-                                            std::filesystem::path(out_.files.front()).filename().string() +
-                                            " (size, channels or bit depth differ within one series)",
+                      std::filesystem::path(out_.files.front()).filename().string() +
+                      " (size, channels or bit depth differ within one series)",
                   "the camera's settings changed during the series: photograph the chart again");
     }
     if (p.type == ca::SampleType::u8) {
@@ -85,8 +85,14 @@ namespace {
 
 // What every answer about one format's photograph starts with, located or refused.
 json photograph_fields(const AveragedPhoto& a) {
-  return json{{"format", a.format}, {"frames", a.frames}, {"files", a.files},
-              {"width", a.photo.width}, {"height", a.photo.height}, {"bits", a.bits},};
+  return json{
+      {"format", a.format},
+      {"frames", a.frames},
+      {"files", a.files},
+      {"width", a.photo.width},
+      {"height", a.photo.height},
+      {"bits", a.bits},
+  };
 }
 
 }  // namespace
@@ -143,12 +149,14 @@ json locate_and_sample(const AveragedPhoto& a, const SamplingOptions& options) {
                       {"corners", corners},
                       {"patches_detected", loc.patches_detected},
                       {"reprojection_rms_px", loc.reprojection_rms_px},
-                      {"check", {{"passed", loc.check.passed},
-                                 {"method", loc.check.method},
-                                 {"worst_disagreement", loc.check.worst_disagreement},
-                                 {"worst_patch", loc.check.worst_patch},
-                                 {"gradient_x", loc.check.gradient_x},
-                                 {"gradient_y", loc.check.gradient_y},}},
+                      {"check", {
+                                    {"passed", loc.check.passed},
+                                    {"method", loc.check.method},
+                                    {"worst_disagreement", loc.check.worst_disagreement},
+                                    {"worst_patch", loc.check.worst_patch},
+                                    {"gradient_x", loc.check.gradient_x},
+                                    {"gradient_y", loc.check.gradient_y},
+                                }},
                       {"ids", ids},
                       {"values", values},
                       {"detected", detected},

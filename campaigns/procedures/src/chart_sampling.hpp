@@ -25,10 +25,10 @@ struct AveragedPhoto {
   int frames = 0;
   analysis::Photo photo;
   double scale = 1;
-  int bits = 16;                              // significant bits before scaling
-  double black_level = 0;                     // raw only, unscaled counts
-  std::optional<analysis::CfaPattern> cfa;    // raw only
-  std::vector<std::string> files;             // the frames' files, for the record
+  int bits = 16;                            // significant bits before scaling
+  double black_level = 0;                   // raw only, unscaled counts
+  std::optional<analysis::CfaPattern> cfa;  // raw only
+  std::vector<std::string> files;           // the frames' files, for the record
 };
 
 struct SamplingOptions {

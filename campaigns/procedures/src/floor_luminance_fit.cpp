@@ -44,17 +44,33 @@ json floor_luminance(const json& photo, const json& calibration, const json& opt
   }
   const auto fit = analysis::fit_flat_field(cal, photo["width"].get<int>(), photo["height"].get<int>(), degree);
   for (std::size_t i = 0; i < cal.size(); ++i) {
-    used.push_back({{"row", calibration[i]["row"]}, {"col", calibration[i]["col"]}, {"luminance", cal[i].luminance},
-                    {"fitted", fit.luminance(cal[i].x_px, cal[i].y_px, cal[i].signal)}, {"residual_pct", fit.residual_pct[i]},});
+    used.push_back({
+        {"row", calibration[i]["row"]},
+        {"col", calibration[i]["col"]},
+        {"luminance", cal[i].luminance},
+        {"fitted", fit.luminance(cal[i].x_px, cal[i].y_px, cal[i].signal)},
+        {"residual_pct", fit.residual_pct[i]},
+    });
   }
   json spots = json::array();
   for (const auto& s : photo["spots"]) {
     const double x = s["px"][0].get<double>(), y = s["px"][1].get<double>();
-    spots.push_back({{"row", s["row"]}, {"col", s["col"]}, {"luminance", fit.luminance(x, y, s["signal"][at].get<double>())},
-                     {"gain", fit.gain(x, y)},});
+    spots.push_back({
+        {"row", s["row"]},
+        {"col", s["col"]},
+        {"luminance", fit.luminance(x, y, s["signal"][at].get<double>())},
+        {"gain", fit.gain(x, y)},
+    });
   }
-  return json{{"degree", fit.degree}, {"frames", subsets[at]}, {"coefficients", fit.coefficients},
-              {"centre_px", {fit.centre_x, fit.centre_y}}, {"radius_px", fit.radius}, {"spots", spots}, {"calibration", used},};
+  return json{
+      {"degree", fit.degree},
+      {"frames", subsets[at]},
+      {"coefficients", fit.coefficients},
+      {"centre_px", {fit.centre_x, fit.centre_y}},
+      {"radius_px", fit.radius},
+      {"spots", spots},
+      {"calibration", used},
+  };
 }
 
 }  // namespace colorlab::campaigns

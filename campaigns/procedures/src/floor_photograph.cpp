@@ -107,7 +107,7 @@ struct FloorSeries {
   std::array<std::array<double, 2>, 4> corners{};
   std::vector<std::vector<std::size_t>> pixels;  // per spot: x + y·width of its green pixels
   std::vector<std::array<double, 2>> centre_px;
-  std::vector<std::vector<double>> sum;          // per spot, per pixel
+  std::vector<std::vector<double>> sum;                  // per spot, per pixel
   std::vector<std::vector<analysis::SpotValue>> values;  // per spot, per subset reached
   int frames = 0;
 };
@@ -151,8 +151,16 @@ void plan_spots(FloorSeries& s, const FloorOptions& p, const cam::RawImage& imag
 }
 
 json spot_json(const Spot& spot, const std::array<double, 2>& px, std::size_t pixels) {
-  return {{"row", spot.row}, {"col", spot.col}, {"x_mm", spot.x_mm}, {"y_mm", spot.y_mm}, {"px", {px[0], px[1]}},
-          {"pixels", pixels}, {"signal", json::array()}, {"stdev", json::array()},};
+  return {
+      {"row", spot.row},
+      {"col", spot.col},
+      {"x_mm", spot.x_mm},
+      {"y_mm", spot.y_mm},
+      {"px", {px[0], px[1]}},
+      {"pixels", pixels},
+      {"signal", json::array()},
+      {"stdev", json::array()},
+  };
 }
 
 }  // namespace
@@ -212,9 +220,18 @@ boost::asio::awaitable<json> photograph_floor(cam::CameraInstrument& instrument,
   }
   json corners = json::array();
   for (const auto& c : s.corners) corners.push_back({c[0], c[1]});
-  co_return json{{"instrument", instrument.id()}, {"frames", p.frames}, {"width", s.width}, {"height", s.height},
-                 {"corners_px", corners}, {"spot_mm", p.spot_mm}, {"subsets", p.subsets},
-                 {"unit", "DN above black (green)"}, {"spots", spots}, {"blobs", blobs},};
+  co_return json{
+      {"instrument", instrument.id()},
+      {"frames", p.frames},
+      {"width", s.width},
+      {"height", s.height},
+      {"corners_px", corners},
+      {"spot_mm", p.spot_mm},
+      {"subsets", p.subsets},
+      {"unit", "DN above black (green)"},
+      {"spots", spots},
+      {"blobs", blobs},
+  };
 }
 
 json dry_floor_photograph(const json& options, const std::string& instrument) {
@@ -233,9 +250,18 @@ json dry_floor_photograph(const json& options, const std::string& instrument) {
   }
   json corners = json::array();
   for (const auto& q : c) corners.push_back({q[0], q[1]});
-  return json{{"instrument", instrument}, {"frames", p.frames}, {"width", kWidth}, {"height", kHeight},
-              {"corners_px", corners}, {"spot_mm", p.spot_mm}, {"subsets", p.subsets},
-              {"unit", "DN above black (green)"}, {"spots", spots}, {"blobs", json::array()},};
+  return json{
+      {"instrument", instrument},
+      {"frames", p.frames},
+      {"width", kWidth},
+      {"height", kHeight},
+      {"corners_px", corners},
+      {"spot_mm", p.spot_mm},
+      {"subsets", p.subsets},
+      {"unit", "DN above black (green)"},
+      {"spots", spots},
+      {"blobs", json::array()},
+  };
 }
 
 }  // namespace colorlab::campaigns

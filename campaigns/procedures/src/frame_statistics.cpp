@@ -123,7 +123,8 @@ boost::asio::awaitable<json> capture_noise_table(cam::CameraInstrument& instrume
         if (g.mosaic) {
           auto c = image.cfa.at(y, x);
           if (c == cam::CfaColor::green && ((y & 1U) != (g.y & 1U))) continue;  // second green: skip
-          channel = c == cam::CfaColor::red ? 0 : c == cam::CfaColor::blue ? 2 : 1;
+          channel = c == cam::CfaColor::red ? 0 : c == cam::CfaColor::blue ? 2
+                                                                           : 1;
         } else if (((xx | yy) & 1U) != 0) {
           continue;  // monochrome: one sample per 2×2 cell keeps the planes the same size
         }

@@ -181,8 +181,20 @@ void run_fit(const FitCliOptions& o) {
   fo.input_scale = o.input_scale;
   fo.target = parse_target(o.target);
   const ca::CvSpec cv = ca::CvSpec::parse(o.cv);
-  Table fits{"fits", {"method", "terms", "target", "train_dE76_mean", "train_dE00_mean", "train_dE00_max", "cv_dE76_mean",
-                      "cv_dE00_mean", "cv_dE00_max", "cv", "parameters",}, {}};
+  Table fits{"fits", {
+                         "method",
+                         "terms",
+                         "target",
+                         "train_dE76_mean",
+                         "train_dE00_mean",
+                         "train_dE00_max",
+                         "cv_dE76_mean",
+                         "cv_dE00_mean",
+                         "cv_dE00_max",
+                         "cv",
+                         "parameters",
+                     },
+             {}};
   // Splines (rbf:<term set>) are candidates of `auto` beside every polynomial; selection compares effective parameters.
   std::string chosen = o.method;
   if (o.method == "auto") {
@@ -196,8 +208,11 @@ void run_fit(const FitCliOptions& o) {
   }
   const auto model = ca::fit_method(chosen, train, fo);
   const double terms = model.spline() ? double(model.spline()->base_terms()) : double(ca::term_set_by_name(chosen).size());
-  Table model_t{"model", {"method", "terms", "target", "input_scale", "description"},
-                {{chosen, terms, ca::to_string(fo.target), model.input_scale(), model.describe()}},};
+  Table model_t{
+      "model",
+      {"method", "terms", "target", "input_scale", "description"},
+      {{chosen, terms, ca::to_string(fo.target), model.input_scale(), model.describe()}},
+  };
   std::vector<Table> out{fits, model_t};
   if (!o.test.empty()) {
     ca::ChartData test = ca::read_chart(o.test);
@@ -244,8 +259,11 @@ void run_uniformity(const UniformityCliOptions& o) {
     for (Eigen::Index j = 0; j < res.window_stdev.cols(); ++j) r.push_back(res.window_stdev(i, j));
     windows.rows.push_back(std::move(r));
   }
-  Table best{"placement", {"min", "max", "range", "best_row", "best_col", "best_stdev"},
-             {{res.min, res.max, res.max - res.min, double(res.best.row), double(res.best.col), res.best.stdev}},};
+  Table best{
+      "placement",
+      {"min", "max", "range", "best_row", "best_col", "best_stdev"},
+      {{res.min, res.max, res.max - res.min, double(res.best.row), double(res.best.col), res.best.stdev}},
+  };
   std::vector<Table> out{windows, best};
   if (!o.full.empty()) {
     if (!(o.setting > 0)) throw Error(ErrorClass::bad_parameter, "--full needs --setting (e.g. 0.5 for 50 %)");

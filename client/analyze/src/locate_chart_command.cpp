@@ -79,9 +79,24 @@ void run_locate(const LocateCliOptions& o) {
 
   std::string notes;
   for (const auto& n : loc.notes) notes += (notes.empty() ? "" : "; ") + n;
-  Table chart{"chart", {"chart", "confidence", "rotation_deg", "from_corners", "patches_detected", "reprojection_rms_px",
-                        "orientation_margin", "check", "check_passed", "check_worst_pct", "check_worst_patch", "gradient_x_pct",
-                        "gradient_y_pct", "check_detail", "notes",}, {}};
+  Table chart{"chart", {
+                           "chart",
+                           "confidence",
+                           "rotation_deg",
+                           "from_corners",
+                           "patches_detected",
+                           "reprojection_rms_px",
+                           "orientation_margin",
+                           "check",
+                           "check_passed",
+                           "check_worst_pct",
+                           "check_worst_patch",
+                           "gradient_x_pct",
+                           "gradient_y_pct",
+                           "check_detail",
+                           "notes",
+                       },
+              {}};
   chart.rows.push_back({std::string(ca::to_string(type)), loc.confidence, double(loc.rotation_deg), loc.from_corners ? "yes" : "no",
                         double(loc.patches_detected), loc.reprojection_rms_px, loc.orientation_margin, loc.check.method,
                         loc.check.passed ? "yes" : "no", loc.check.worst_disagreement * 100, loc.check.worst_patch,

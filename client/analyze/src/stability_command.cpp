@@ -35,13 +35,27 @@ void run_stability(StabilityCliOptions o) {
     others.emplace_back(spec.substr(0, eq), ca::read_chart(spec.substr(eq + 1)));
   }
   o.suite.cv = ca::CvSpec::parse(o.cv);
-  o.suite.fit.target = o.target == "lab" ? ca::FitTarget::lab_direct
+  o.suite.fit.target = o.target == "lab"    ? ca::FitTarget::lab_direct
                        : o.target == "xyzw" ? ca::FitTarget::xyz_lightness_weighted
                                             : ca::FitTarget::xyz_then_lab;
   const auto r = ca::run_stability(train, o.suite, test ? &*test : nullptr, others);
 
-  Table cases{"cases", {"method", "case", "level", "label", "evaluated", "fitted", "min", "max", "median", "mean", "stdev",
-                        "fails", "why",}, {}};
+  Table cases{"cases", {
+                           "method",
+                           "case",
+                           "level",
+                           "label",
+                           "evaluated",
+                           "fitted",
+                           "min",
+                           "max",
+                           "median",
+                           "mean",
+                           "stdev",
+                           "fails",
+                           "why",
+                       },
+              {}};
   Table patches{"patches", {"method", "case", "level", "label", "id", "dE00"}, {}};
   for (const auto& c : r.cases) {
     cases.rows.push_back({c.method, c.kind, c.level, c.label, double(c.evaluated), c.fitted ? 1.0 : 0.0, c.de00.min,
@@ -54,11 +68,37 @@ void run_stability(StabilityCliOptions o) {
   for (const auto& v : r.verdicts)
     verdicts.rows.push_back({v.method, v.fails ? 1.0 : 0.0, v.first_kind, v.fails ? v.first_level : 0.0, v.first_label});
   const auto& s = r.options;
-  Table settings{"settings", {"tolerance_mean", "tolerance_max", "target", "input_scale", "cv", "gamut_fraction",
-                              "gamut_held_out", "saturation", "draws", "seed", "training_patches", "test_patches",},
-                 {{s.tolerance_mean, s.tolerance_max, ca::to_string(s.fit.target), s.fit.input_scale, s.cv.name(),
-                   s.gamut_fraction, double(r.gamut_held_out), s.saturation, double(s.draws), double(s.seed),
-                   double(train.size()), test ? double(test->size()) : 0.0,}},};
+  Table settings{
+      "settings",
+      {
+          "tolerance_mean",
+          "tolerance_max",
+          "target",
+          "input_scale",
+          "cv",
+          "gamut_fraction",
+          "gamut_held_out",
+          "saturation",
+          "draws",
+          "seed",
+          "training_patches",
+          "test_patches",
+      },
+      {{
+          s.tolerance_mean,
+          s.tolerance_max,
+          ca::to_string(s.fit.target),
+          s.fit.input_scale,
+          s.cv.name(),
+          s.gamut_fraction,
+          double(r.gamut_held_out),
+          s.saturation,
+          double(s.draws),
+          double(s.seed),
+          double(train.size()),
+          test ? double(test->size()) : 0.0,
+      }},
+  };
   std::vector<Table> out{cases, verdicts, settings};
   if (o.per_patch) out.push_back(patches);
   print_tables(std::cout, out, o.json);

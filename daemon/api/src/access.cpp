@@ -48,12 +48,12 @@ void check_listener(const std::string& host, bool tls, bool allow_plaintext) {
   if (!allow_plaintext) {
     throw Error(ErrorClass::bad_parameter,
                 "listening on " + host + " (beyond loopback) needs TLS: API keys and data would cross the network in "
-                "the clear",
+                                         "the clear",
                 "set [tls] certificate and private_key (docs/configuration.md), or listen on 127.0.0.1 behind a "
                 "reverse proxy; [access] allow_plaintext = true accepts the risk explicitly");
   }
   log::warning("access", "listening on " + host + " without TLS (allow_plaintext = true): API keys and data cross "
-                         "the network in the clear");
+                                                  "the network in the clear");
 }
 
 Access::Access(store::Store& writer, boost::asio::any_io_executor writer_thread, AccessOptions options,

@@ -26,11 +26,16 @@ namespace {
 
 std::string content_type_of(const fs::path& file) {
   static const std::map<std::string, std::string> types{
-      {".html", "text/html; charset=utf-8"},  {".js", "text/javascript; charset=utf-8"},
-      {".css", "text/css; charset=utf-8"},    {".svg", "image/svg+xml"},
-      {".png", "image/png"},                  {".ico", "image/x-icon"},
-      {".json", "application/json"},          {".webmanifest", "application/manifest+json"},
-      {".txt", "text/plain; charset=utf-8"},};
+      {".html", "text/html; charset=utf-8"},
+      {".js", "text/javascript; charset=utf-8"},
+      {".css", "text/css; charset=utf-8"},
+      {".svg", "image/svg+xml"},
+      {".png", "image/png"},
+      {".ico", "image/x-icon"},
+      {".json", "application/json"},
+      {".webmanifest", "application/manifest+json"},
+      {".txt", "text/plain; charset=utf-8"},
+  };
   auto it = types.find(file.extension().string());
   return it == types.end() ? "application/octet-stream" : it->second;
 }
@@ -64,11 +69,11 @@ std::optional<http::HttpResponse> serve_console(const http::HttpRequest& req, co
   auto file = resolve(p, dir);
   if (!file) {
     return problem_response(404, "not_found", "Not found", "no route or console file for " + p,
-                                       "the API is under " + prefix + "; the console at /");
+                            "the API is under " + prefix + "; the console at /");
   }
   if (req.method != "GET" && req.method != "HEAD") {
     auto r = problem_response(405, "method-not-allowed", "Method not allowed",
-                                         req.method + " is not allowed on " + p, "allowed: GET, HEAD");
+                              req.method + " is not allowed on " + p, "allowed: GET, HEAD");
     r.headers["Allow"] = "GET, HEAD";
     return r;
   }

@@ -67,7 +67,7 @@ json ControlLock::status() {
 http::HttpResponse ControlLock::locked_by(const Holder& h, const std::string& detail) const {
   return problem_response(409, "control-locked", "Control lock held",
                           detail + ": the control lock is held by '" +
-                                                                          h.name + "' since " + h.since,
+                              h.name + "' since " + h.since,
                           "wait until it is released (GET /v1/control), or break it with force over the Unix socket "
                           "or with an admin key",
                           {{"holder", h.name}, {"since", h.since}});

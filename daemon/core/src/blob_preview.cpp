@@ -46,7 +46,10 @@ Plane read_array(const fs::path& file, const json& meta) {
   p.width = meta["shape"][1].get<int>();
   p.channels = meta["shape"].size() == 3 ? meta["shape"][2].get<int>() : 1;
   if (p.height <= 0 || p.width <= 0 || (p.channels != 1 && p.channels != 3)) throw Error(ErrorClass::bad_data, "the array's shape is not an image");
-  std::size_t item = dtype == "<f4" ? 4 : dtype == "<f8" ? 8 : dtype == "<u2" ? 2 : (dtype == "|u1" || dtype == "<u1") ? 1 : 0;
+  std::size_t item = dtype == "<f4" ? 4 : dtype == "<f8"                   ? 8
+                                      : dtype == "<u2"                     ? 2
+                                      : (dtype == "|u1" || dtype == "<u1") ? 1
+                                                                           : 0;
   if (item == 0) throw Error(ErrorClass::unsupported, "no preview for arrays of dtype '" + dtype + "'", "previews show <f4, <f8, <u2 and u1 arrays");
   const std::size_t n = static_cast<std::size_t>(p.height) * p.width * p.channels;
   auto bytes = read_file(file);
@@ -102,7 +105,8 @@ Plane half_size_rgb(const Plane& m) {
   out.channels = 3;
   out.values.assign(static_cast<std::size_t>(out.height) * out.width * 3, 0.f);
   int index[4];  // channel of each cell position [row%2*2 + col%2]
-  for (int i = 0; i < 4; ++i) index[i] = m.cfa[static_cast<std::size_t>(i)] == 'R' ? 0 : m.cfa[static_cast<std::size_t>(i)] == 'B' ? 2 : 1;
+  for (int i = 0; i < 4; ++i) index[i] = m.cfa[static_cast<std::size_t>(i)] == 'R' ? 0 : m.cfa[static_cast<std::size_t>(i)] == 'B' ? 2
+                                                                                                                                   : 1;
   for (int y = 0; y < out.height; ++y) {
     for (int x = 0; x < out.width; ++x) {
       float sum[3] = {0, 0, 0};

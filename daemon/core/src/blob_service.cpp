@@ -148,7 +148,7 @@ void BlobService::check_done(json report) {
                               std::to_string(report["missing"].size()) + " row(s) whose file is missing, " +
                               std::to_string(report["mismatched"].size()) + " with the wrong size or hash, " +
                               std::to_string(report["partial"].size()) + " partial or stray file(s); nothing was deleted "
-                              "(GET /v1/blobs/check lists them)");
+                                                                         "(GET /v1/blobs/check lists them)");
   }
   json event = report;
   event["event"] = "check";

@@ -5,7 +5,7 @@
 namespace colorlab::daemon {
 
 CampaignRequest validate_campaign_params(campaigns::ScriptCatalogue& catalogue, const std::string& campaign,
-                                        const nlohmann::json& params) {
+                                         const nlohmann::json& params) {
   catalogue.refresh();
   auto script = catalogue.find(campaign);
   if (!script) {

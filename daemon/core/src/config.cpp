@@ -91,7 +91,6 @@ void parse_blobs(const toml::node& node, BlobConfig& b, const std::filesystem::p
   }
 }
 
-
 // [notify]: a command (argv) and/or a webhook, each optional (docs/configuration.md, "Notifications").
 void parse_notify(const toml::node& node, NotifyConfig& n, const std::filesystem::path& file) {
   auto t = node.as_table();

@@ -111,7 +111,7 @@ class StoreSink final : public campaigns::ExecutionSink {
   // has accepted another unit.
   store::StepRecord records_of(const campaigns::StepCommit& step) {
     return store::StepRecord{step.journal, step.measurements, step.progress, step.label,
-                             updated_snapshot(),  step.timings, time_scale_, step.blobs};
+                             updated_snapshot(), step.timings, time_scale_, step.blobs};
   }
 
   std::optional<json> updated_snapshot() {
@@ -344,8 +344,14 @@ void Executions::cancel_backoff(const std::string& id) {
 void Executions::notify(const std::string& event, const store::ExecutionRecord& record, const std::string& reason,
                         const json& problem, const json& suspension) {
   if (!options_.notifier) return;
-  json details{{"execution_id", record.id}, {"run_id", record.run_id}, {"campaign", record.campaign},
-               {"step", record.step},       {"reason", reason},        {"problem", problem},};
+  json details{
+      {"execution_id", record.id},
+      {"run_id", record.run_id},
+      {"campaign", record.campaign},
+      {"step", record.step},
+      {"reason", reason},
+      {"problem", problem},
+  };
   if (event == "failed") details["status"] = protocol::to_string(ExecutionStatus::finished_error);
   else details["status"] = protocol::to_string(ExecutionStatus::suspended);
   if (problem.is_object() && problem.contains("code")) details["category"] = problem["code"];
@@ -408,11 +414,12 @@ void Executions::launch(store::ExecutionRecord record, std::shared_ptr<const cam
             // An operator resuming a paused run has looked at the lab: accept the units as they are.
             setup.verify_serials = !accept_units;
           }
-          StoreSink sink(store_, record, instruments_, status_text_, snapshot, resumed && accept_units, active->suspension,
-                         lab_.time_scale(), [this, &record](const std::string& reason, const json& problem, const json& doc) {
-                           notify("suspended", record, reason, problem, doc);
-                         },
-                         options_.committer);
+          StoreSink sink(
+              store_, record, instruments_, status_text_, snapshot, resumed && accept_units, active->suspension,
+              lab_.time_scale(), [this, &record](const std::string& reason, const json& problem, const json& doc) {
+                notify("suspended", record, reason, problem, doc);
+              },
+              options_.committer);
           starting.reset();
           outcome = co_await campaigns::run_campaign_script(std::move(setup), lab_, sink, active->control);
         } catch (const Error& e) {
@@ -498,7 +505,8 @@ store::ExecutionRecord Executions::pause(const std::string& id) {
     if (record.status == ExecutionStatus::paused) return record;
     throw Error(ErrorClass::conflict,
                 "execution " + id + " is " + std::string(protocol::to_string(record.status)) +
-                                          ", not running", "only a running execution can be paused");
+                    ", not running",
+                "only a running execution can be paused");
   }
   it->second->control.request = Request::pause;
   it->second->control.reason = "paused by a client";
@@ -520,7 +528,8 @@ store::ExecutionRecord Executions::resume(const std::string& id) {
   if (record.status != ExecutionStatus::paused && record.status != ExecutionStatus::suspended) {
     throw Error(ErrorClass::conflict,
                 "execution " + id + " is " + std::string(protocol::to_string(record.status)) +
-                                          ", not paused", "only a paused or suspended execution can be resumed");
+                    ", not paused",
+                "only a paused or suspended execution can be resumed");
   }
   if (shutting_down_) throw Error(ErrorClass::conflict, "colorlabd is shutting down");
   const bool crash_loop = is_crash_loop(record.suspension);

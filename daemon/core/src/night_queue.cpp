@@ -260,8 +260,11 @@ store::QueueStore::EnqueuedGroup NightQueue::enqueue_sequence(const std::string&
     ids[step.name] = id;
     items.push_back(std::move(n));
   }
-  json options{{"small", small}, {"overrides", overrides.is_null() ? json::object() : overrides},
-               {"on_failure", store::to_string(on_failure)},};
+  json options{
+      {"small", small},
+      {"overrides", overrides.is_null() ? json::object() : overrides},
+      {"on_failure", store::to_string(on_failure)},
+  };
   auto enqueued = queue_.enqueue_group(new_uuid_v7(), name, options, items);
   if (enqueued.created) poke();
   return enqueued;
@@ -287,10 +290,19 @@ json NightQueue::describe_group(const store::QueueGroup& group) {
     any_running = any_running || item.state == QueueItemState::running;
     items.push_back(j);
   }
-  std::string state = all_done ? "done" : any_bad ? "failed" : any_running ? "running" : "queued";
-  json described{{"id", group.id},       {"sequence", group.sequence}, {"options", group.options},
-                 {"created_at", group.created_at}, {"state", state},  {"items", items},
-                 {"runs", runs},         {"run_ids", run_ids},};
+  std::string state = all_done ? "done" : any_bad   ? "failed"
+                                      : any_running ? "running"
+                                                    : "queued";
+  json described{
+      {"id", group.id},
+      {"sequence", group.sequence},
+      {"options", group.options},
+      {"created_at", group.created_at},
+      {"state", state},
+      {"items", items},
+      {"runs", runs},
+      {"run_ids", run_ids},
+  };
   // The study's report, of the runs it finished, once nothing of it is left to run.
   if (group_ended(group) && !run_ids.empty())
     described["links"] = {{"report", std::string(protocol::kPrefix) + "/queue/groups/" + group.id + "/report"}};
@@ -362,7 +374,8 @@ json NightQueue::describe(unsigned history_limit) {
   }
   json history = json::array();
   for (const auto& item : queue_.history(history_limit)) history.push_back(item.to_json());
-  std::string state = status.started ? "running" : current.is_null() ? "stopped" : "stopping";
+  std::string state = status.started ? "running" : current.is_null() ? "stopped"
+                                                                     : "stopping";
   return {{"state", state},
           {"reason", status.reason},
           {"halted", status.halted},

@@ -56,8 +56,9 @@ struct RunInitiation {
     // The awaitable's handler is move-only; the pool's callbacks are std::function.
     auto shared = std::make_shared<Handler>(std::move(handler));
     try {
-      pool->submit(std::move(what), std::move(job), [shared](std::exception_ptr e, json j) { (*shared)(e, std::move(j)); },
-                   admission);
+      pool->submit(
+          std::move(what), std::move(job), [shared](std::exception_ptr e, json j) { (*shared)(e, std::move(j)); },
+          admission);
     } catch (...) {
       // A refusal arrives like a job's error, and never inside the initiation.
       asio::post(results, [shared, e = std::current_exception()] { (*shared)(e, json()); });

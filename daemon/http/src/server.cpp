@@ -592,7 +592,7 @@ void Server::start() {
     if (ec) {
       throw Error(ErrorClass::io_error,
                   "cannot listen on " + o.tcp_host + ":" + std::to_string(o.tcp_port) + ": " +
-                                            ec.message(),
+                      ec.message(),
                   "another colorlabd may be running; pick another port with --listen");
     }
     impl_->tcp_acceptor = std::move(acc);

@@ -70,8 +70,9 @@ std::vector<ExpiredBlob> BlobIndex::expired(const std::string& cutoff, const std
       "AND (?3 < 0 OR NOT EXISTS (SELECT 1 FROM run_blobs u WHERE u.sha256 = b.sha256 AND NOT EXISTS ("
       "SELECT 1 FROM event_log e WHERE e.seq <= ?3 AND e.topic = 'execution' AND "
       "json_extract(e.payload, '$.run_id') = u.run_id AND "
-      "json_extract(e.payload, '$.status') IN " + std::string(kEndedStatusesSql) + "))) "
-      "ORDER BY b.sha256");
+      "json_extract(e.payload, '$.status') IN " +
+      std::string(kEndedStatusesSql) + "))) "
+                                       "ORDER BY b.sha256");
   st.bind(1, std::string_view(cutoff)).bind(2, std::string_view(kinds)).bind(3, shipped_upto.value_or(-1));
   std::vector<ExpiredBlob> out;
   while (st.step()) {

@@ -209,7 +209,7 @@ void migrate(Database& db) {
   if (app_id != 0 && app_id != kApplicationId) {
     throw Error(ErrorClass::io_error,
                 "the database file belongs to another application (application_id " +
-                                          std::to_string(app_id) + ")",
+                    std::to_string(app_id) + ")",
                 "point --state at colorlab's own state directory");
   }
   if (version > kSchemaVersion) {

@@ -14,7 +14,8 @@ ShipBacklog ShipLog::backlog(std::int64_t position) {
   if (b.runs > 0) {
     auto st = db_.prepare(
         "SELECT r.id, r.status, r.finished_at FROM event_log e JOIN runs r ON r.id = json_extract(e.payload, '$.run_id') "
-        "WHERE e.seq > ?1 AND " + kEndEventSql + " ORDER BY e.seq LIMIT 1");
+        "WHERE e.seq > ?1 AND " +
+        kEndEventSql + " ORDER BY e.seq LIMIT 1");
     st.bind(1, position);
     if (st.step()) {
       b.oldest_run_id = st.text(0);

@@ -33,9 +33,16 @@ constexpr const char* kExecutionColumns =
 }  // namespace
 
 nlohmann::json ExecutionRecord::to_json() const {
-  nlohmann::json j{{"id", id},         {"run_id", run_id},         {"campaign", campaign},
-                   {"status", protocol::to_string(status)},       {"progress", progress},
-                   {"step", step},     {"created_at", created_at}, {"updated_at", updated_at},};
+  nlohmann::json j{
+      {"id", id},
+      {"run_id", run_id},
+      {"campaign", campaign},
+      {"status", protocol::to_string(status)},
+      {"progress", progress},
+      {"step", step},
+      {"created_at", created_at},
+      {"updated_at", updated_at},
+  };
   if (!error.is_null()) j["error"] = error;
   j["reason"] = reason;
   if (!suspension.is_null()) j["suspension"] = suspension;

@@ -65,9 +65,12 @@ asio::awaitable<void> identify_dmx(asio::any_io_executor ex, Examination& x, con
 asio::awaitable<void> identify_ls110(asio::any_io_executor ex, Examination& x, const ExamineOptions& o, Recording& rec) {
   x.identity = {{"model", "Konica Minolta LS-110"},
                 {"detail", "the meter has no identification command; it answered MDS,04 in remote mode"}};
-  x.calibration = {{"applies", true}, {"state", "factory"},
-                   {"detail", "the LS-110 reports no calibration over RS-232: its accuracy is Konica Minolta's "
-                              "calibration (see the certificate's date); the calibration factor shown on its display applies"},};
+  x.calibration = {
+      {"applies", true},
+      {"state", "factory"},
+      {"detail", "the LS-110 reports no calibration over RS-232: its accuracy is Konica Minolta's "
+                 "calibration (see the certificate's date); the calibration factor shown on its display applies"},
+  };
   if (!o.measure) co_return;
   drivers::Ls110Options d;
   d.port = x.port;
@@ -126,8 +129,12 @@ asio::awaitable<void> identify_spectrolino_readonly(asio::any_io_executor ex, Ex
       rec.mark("identify: Spectrolino device data, target id");
       auto dev = sl::DeviceDataAnswer::decode(co_await protocol.transact(sl::req::device_data_request(), t.command, "device data"));
       auto tid = sl::TargetIdAnswer::decode(co_await protocol.transact(sl::req::target_id_request(), t.command, "target id"));
-      x.identity = {{"model", trim(tid.name)}, {"serial", std::to_string(dev.serial)}, {"firmware", trim(dev.software)},
-                    {"baud", heard.baud},};
+      x.identity = {
+          {"model", trim(tid.name)},
+          {"serial", std::to_string(dev.serial)},
+          {"firmware", trim(dev.software)},
+          {"baud", heard.baud},
+      };
       x.decoded["serial"] = std::to_string(dev.serial);
       x.decoded["topology"] = "standalone";
     }
@@ -140,9 +147,12 @@ asio::awaitable<void> identify_spectrolino_readonly(asio::any_io_executor ex, Ex
 asio::awaitable<void> identify_spectrolino(asio::any_io_executor ex, Examination& x, const Heard& heard, const ExamineOptions& o,
                                            Recording& rec) {
   co_await identify_spectrolino_readonly(ex, x, heard, o, rec);
-  x.calibration = {{"applies", true}, {"state", "unknown"},
-                   {"detail", "the Spectrolino keeps no white calibration colorlab can read back: the daemon calibrates on "
-                              "the white tile before its readings, and doctor --measure does it once"},};
+  x.calibration = {
+      {"applies", true},
+      {"state", "unknown"},
+      {"detail", "the Spectrolino keeps no white calibration colorlab can read back: the daemon calibrates on "
+                 "the white tile before its readings, and doctor --measure does it once"},
+  };
   if (!o.measure) co_return;
   drivers::SpectrolinoOptions d;
   d.port = x.port;
@@ -169,8 +179,12 @@ asio::awaitable<void> identify_spectrolino(asio::any_io_executor ex, Examination
     if (r.xyz) x.decoded["xyz"] = *r.xyz;
     auto cal = spectro.calibration();
     if (!cal.empty()) {
-      x.calibration = {{"applies", true}, {"state", cal.front().valid ? "valid" : "expired"}, {"type", cal.front().type},
-                       {"detail", "white calibration made by doctor on the tile just now"},};
+      x.calibration = {
+          {"applies", true},
+          {"state", cal.front().valid ? "valid" : "expired"},
+          {"type", cal.front().type},
+          {"detail", "white calibration made by doctor on the tile just now"},
+      };
       if (cal.front().readings_left) x.calibration["readings_left"] = *cal.front().readings_left;
     }
   } catch (...) {
@@ -282,9 +296,18 @@ asio::awaitable<Examination> examine_port(asio::any_io_executor executor, std::s
 json to_json(const Examination& e) {
   json confirm = json::array();
   for (const auto& c : e.confirmations) confirm.push_back({{"key", c.key}, {"question", c.question}, {"unit", c.unit}});
-  json j{{"port", e.port}, {"verdict", e.verdict}, {"message", e.message}, {"tried", e.tried},
-         {"identity", e.identity}, {"calibration", e.calibration}, {"decoded", e.decoded},
-         {"measured", e.measured}, {"confirm", confirm}, {"seconds", e.seconds},};
+  json j{
+      {"port", e.port},
+      {"verdict", e.verdict},
+      {"message", e.message},
+      {"tried", e.tried},
+      {"identity", e.identity},
+      {"calibration", e.calibration},
+      {"decoded", e.decoded},
+      {"measured", e.measured},
+      {"confirm", confirm},
+      {"seconds", e.seconds},
+  };
   j["kind"] = e.kind.empty() ? json(nullptr) : json(e.kind);
   j["expected_kind"] = e.expected_kind.empty() ? json(nullptr) : json(e.expected_kind);
   if (!e.hint.empty()) j["hint"] = e.hint;

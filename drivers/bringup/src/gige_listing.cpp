@@ -20,9 +20,14 @@ json discover_gige_cameras() {
   const unsigned n = arv_get_n_devices();
   for (unsigned i = 0; i < n; ++i) {
     std::string protocol = str(arv_get_device_protocol(i));
-    out.push_back({{"id", str(arv_get_device_id(i))}, {"vendor", str(arv_get_device_vendor(i))},
-                   {"model", str(arv_get_device_model(i))}, {"serial", str(arv_get_device_serial_nbr(i))},
-                   {"address", str(arv_get_device_address(i))}, {"protocol", protocol},});
+    out.push_back({
+        {"id", str(arv_get_device_id(i))},
+        {"vendor", str(arv_get_device_vendor(i))},
+        {"model", str(arv_get_device_model(i))},
+        {"serial", str(arv_get_device_serial_nbr(i))},
+        {"address", str(arv_get_device_address(i))},
+        {"protocol", protocol},
+    });
   }
   return out;
 }
@@ -67,9 +72,12 @@ json identify_gige_camera(const std::string& address) {
     g_free(formats);
     if (e) g_error_free(e);
     j["pixel_formats"] = f;
-    j["calibration"] = {{"applies", true}, {"state", "in the daemon"},
-                        {"detail", "a camera's characterization is a campaign's result (characterize-camera), kept by colorlabd, "
-                                   "not in the camera"},};
+    j["calibration"] = {
+        {"applies", true},
+        {"state", "in the daemon"},
+        {"detail", "a camera's characterization is a campaign's result (characterize-camera), kept by colorlabd, "
+                   "not in the camera"},
+    };
     g_object_unref(cam);
   }
   j["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -39,7 +39,9 @@ std::vector<gid_t> my_groups() {
 }
 
 std::string mode_string(mode_t m) {
-  std::string s = S_ISCHR(m) ? "c" : S_ISDIR(m) ? "d" : S_ISLNK(m) ? "l" : "-";
+  std::string s = S_ISCHR(m) ? "c" : S_ISDIR(m) ? "d"
+                                 : S_ISLNK(m)   ? "l"
+                                                : "-";
   const char* rwx = "rwxrwxrwx";
   for (int i = 0; i < 9; ++i) s += (m & (0400 >> i)) ? rwx[i] : '-';
   return s;
@@ -191,9 +193,14 @@ json usb_devices(const HostPaths& paths) {
     auto pid_s = read_attr(d, "idProduct");
     if (vid_s.empty() || pid_s.empty()) continue;
     int vid = std::stoi(vid_s, nullptr, 16), pid = std::stoi(pid_s, nullptr, 16);
-    json j{{"sysfs", d.filename().string()}, {"usb_vid", vid}, {"usb_pid", pid},
-           {"manufacturer", read_attr(d, "manufacturer")}, {"product", read_attr(d, "product")},
-           {"serial", read_attr(d, "serial")},};
+    json j{
+        {"sysfs", d.filename().string()},
+        {"usb_vid", vid},
+        {"usb_pid", pid},
+        {"manufacturer", read_attr(d, "manufacturer")},
+        {"product", read_attr(d, "product")},
+        {"serial", read_attr(d, "serial")},
+    };
     auto known = known_usb_device(vid, pid, j["product"].get<std::string>());
     if (!known.empty()) j["known_as"] = known;
     auto bus = read_attr(d, "busnum"), dev = read_attr(d, "devnum");
@@ -220,8 +227,15 @@ namespace colorlab::bringup {
 json relay_boards() {
   json out = json::array();
   for (const auto& b : drivers::enumerate_relay_boards()) {
-    out.push_back({{"path", b.path}, {"usb_vid", b.vendor_id}, {"usb_pid", b.product_id}, {"manufacturer", b.manufacturer},
-                   {"product", b.product}, {"serial", b.serial}, {"node", access_json(check_access(b.path))},});
+    out.push_back({
+        {"path", b.path},
+        {"usb_vid", b.vendor_id},
+        {"usb_pid", b.product_id},
+        {"manufacturer", b.manufacturer},
+        {"product", b.product},
+        {"serial", b.serial},
+        {"node", access_json(check_access(b.path))},
+    });
   }
   return out;
 }

@@ -42,8 +42,13 @@ json identify_relay(std::unique_ptr<drivers::HidTransport> transport, const std:
     fut.get();
     auto id = relay.identity();
     const auto info = t->info();
-    j["hid"] = {{"product", info.product}, {"manufacturer", info.manufacturer}, {"serial", info.serial},
-                {"vendor_id", info.vendor_id}, {"product_id", info.product_id},};
+    j["hid"] = {
+        {"product", info.product},
+        {"manufacturer", info.manufacturer},
+        {"serial", info.serial},
+        {"vendor_id", info.vendor_id},
+        {"product_id", info.product_id},
+    };
     j["verdict"] = "identified";
     j["model"] = id.model;
     j["board_id"] = id.serial;

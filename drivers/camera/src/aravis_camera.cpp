@@ -105,13 +105,14 @@ PixelInfo pixel_info(ArvPixelFormat f) {
     case ARV_PIXEL_FORMAT_BAYER_RG_16: return {PixelFormat::bayer_rg16, f, 65535, 16, true};
     case ARV_PIXEL_FORMAT_MONO_16: return {PixelFormat::mono16, f, 65535, 16, false};
     default:
-      throw Error(ErrorClass::unsupported,
-                  "camera delivers pixel format 0x" + [&] {
-                    char b[16];
-                    std::snprintf(b, sizeof b, "%08x", static_cast<unsigned>(f));
-                    return std::string(b);
-                  }(),
-                  "configure BayerRG12, BayerRG16 or Mono16: colorlab needs unpacked 16-bit samples");
+      throw Error(
+          ErrorClass::unsupported,
+          "camera delivers pixel format 0x" + [&] {
+            char b[16];
+            std::snprintf(b, sizeof b, "%08x", static_cast<unsigned>(f));
+            return std::string(b);
+          }(),
+          "configure BayerRG12, BayerRG16 or Mono16: colorlab needs unpacked 16-bit samples");
   }
 }
 

@@ -279,7 +279,8 @@ void Camera::configure(CameraSettings settings, OperationDone done) {
 std::future<CaptureReport> Camera::capture(std::size_t n, FrameSink sink, CaptureOptions options) {
   auto promise = std::make_shared<std::promise<CaptureReport>>();
   auto result = promise->get_future();
-  capture(n, std::move(sink), [promise](CaptureReport r) { promise->set_value(std::move(r)); }, options);
+  capture(
+      n, std::move(sink), [promise](CaptureReport r) { promise->set_value(std::move(r)); }, options);
   return result;
 }
 

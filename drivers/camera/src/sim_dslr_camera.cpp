@@ -48,28 +48,47 @@ Error answer_error(const json& answer, const std::string& camera, const std::str
   const std::string code = text_field(answer, "error", "?");
   const std::string text = camera + ": " + cmd + " refused: " + text_field(answer, "message", code);
   if (code == "busy") {
-    return Error(ErrorInfo{.cls = ErrorClass::conflict, .message = text,
-                           .hint = "the camera is still writing to its card; wait and retry",
-                           .device_code = "simdslr:busy", .retryable = true,});
+    return Error(ErrorInfo{
+        .cls = ErrorClass::conflict,
+        .message = text,
+        .hint = "the camera is still writing to its card; wait and retry",
+        .device_code = "simdslr:busy",
+        .retryable = true,
+    });
   }
   if (code == "bad_value") {
-    return Error(ErrorInfo{.cls = ErrorClass::bad_parameter, .message = text, .hint = "see the camera's limits",
-                           .device_code = "simdslr:bad_value",});
+    return Error(ErrorInfo{
+        .cls = ErrorClass::bad_parameter,
+        .message = text,
+        .hint = "see the camera's limits",
+        .device_code = "simdslr:bad_value",
+    });
   }
   if (code == "in_use") {
-    return Error(ErrorInfo{.cls = ErrorClass::conflict, .message = text,
-                           .hint = "another program holds the camera; only one connection is served at a time",
-                           .device_code = "simdslr:in_use", .retryable = true,});
+    return Error(ErrorInfo{
+        .cls = ErrorClass::conflict,
+        .message = text,
+        .hint = "another program holds the camera; only one connection is served at a time",
+        .device_code = "simdslr:in_use",
+        .retryable = true,
+    });
   }
   if (code == "failed") {
-    return Error(ErrorInfo{.cls = ErrorClass::hardware_fail, .message = text,
-                           .hint = "the camera could not write its files: check the capture directory's disk",
-                           .device_code = "simdslr:failed", .retryable = true,});
+    return Error(ErrorInfo{
+        .cls = ErrorClass::hardware_fail,
+        .message = text,
+        .hint = "the camera could not write its files: check the capture directory's disk",
+        .device_code = "simdslr:failed",
+        .retryable = true,
+    });
   }
   // bad_request, not_found or a code this driver does not know: the two sides disagree.
-  return Error(ErrorInfo{.cls = ErrorClass::protocol_error, .message = text,
-                         .hint = "driver and simulator disagree about the tethered-camera protocol (docs/simulator.md)",
-                         .device_code = "simdslr:" + code,});
+  return Error(ErrorInfo{
+      .cls = ErrorClass::protocol_error,
+      .message = text,
+      .hint = "driver and simulator disagree about the tethered-camera protocol (docs/simulator.md)",
+      .device_code = "simdslr:" + code,
+  });
 }
 
 std::vector<std::uint8_t> read_whole_file(const std::filesystem::path& path, std::uint64_t expected_bytes) {

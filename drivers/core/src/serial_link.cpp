@@ -37,8 +37,10 @@ std::string transport_code(const error_code& ec) {
 }  // namespace
 
 std::string describe(const SerialSettings& s) {
-  const char parity = s.parity == Parity::even ? 'E' : s.parity == Parity::odd ? 'O' : 'N';
-  const char* flow = s.flow == FlowControl::hardware ? "rts/cts" : s.flow == FlowControl::software ? "xon/xoff" : "none";
+  const char parity = s.parity == Parity::even ? 'E' : s.parity == Parity::odd ? 'O'
+                                                                               : 'N';
+  const char* flow = s.flow == FlowControl::hardware ? "rts/cts" : s.flow == FlowControl::software ? "xon/xoff"
+                                                                                                   : "none";
   return std::to_string(s.baud) + " " + std::to_string(s.data_bits) + parity + std::to_string(s.stop_bits) + " " + flow;
 }
 

@@ -53,7 +53,8 @@ void UnixLineClient::connect(const std::string& path) {
     throw Error(ErrorInfo{.cls = ErrorClass::no_comms,
                           .message = what_ + ": cannot connect to " + path + ": " + std::strerror(err),
                           .hint = "is the simulated lab (colorlab-sim) running, and does its announcement name this path?",
-                          .transport_code = err == ENOENT ? "ENOENT" : err == ECONNREFUSED ? "ECONNREFUSED" : "errno " + std::to_string(err),
+                          .transport_code = err == ENOENT ? "ENOENT" : err == ECONNREFUSED ? "ECONNREFUSED"
+                                                                                           : "errno " + std::to_string(err),
                           .retryable = true});
   }
   fd_ = fd;
@@ -73,16 +74,24 @@ void UnixLineClient::send_line(std::string_view line, Clock::time_point deadline
     if (n < 0 && (errno == EAGAIN || errno == EINTR)) {
       pollfd p{fd_, POLLOUT, 0};
       if (::poll(&p, 1, millis_until(deadline)) == 0) {
-        throw Error(ErrorInfo{.cls = ErrorClass::timeout, .message = what_ + ": request not accepted in time",
-                              .hint = "the peer stopped reading; reconnect", .retryable = true,});
+        throw Error(ErrorInfo{
+            .cls = ErrorClass::timeout,
+            .message = what_ + ": request not accepted in time",
+            .hint = "the peer stopped reading; reconnect",
+            .retryable = true,
+        });
       }
       continue;
     }
     const int err = errno;
     close();
-    throw Error(ErrorInfo{.cls = ErrorClass::no_comms, .message = what_ + ": connection lost while sending: " + std::strerror(err),
-                          .hint = "the device went away (simulated unplug or colorlab-sim stopped); reconnect",
-                          .transport_code = err == EPIPE ? "EPIPE" : "errno " + std::to_string(err), .retryable = true,});
+    throw Error(ErrorInfo{
+        .cls = ErrorClass::no_comms,
+        .message = what_ + ": connection lost while sending: " + std::strerror(err),
+        .hint = "the device went away (simulated unplug or colorlab-sim stopped); reconnect",
+        .transport_code = err == EPIPE ? "EPIPE" : "errno " + std::to_string(err),
+        .retryable = true,
+    });
   }
 }
 
@@ -102,8 +111,12 @@ std::string UnixLineClient::read_line(Clock::time_point deadline) {
     pollfd p{fd_, POLLIN, 0};
     const int ready = ::poll(&p, 1, millis_until(deadline));
     if (ready == 0) {
-      throw Error(ErrorInfo{.cls = ErrorClass::timeout, .message = what_ + ": no answer before the deadline",
-                            .hint = "the device is not answering; it may be hung or busy", .retryable = true,});
+      throw Error(ErrorInfo{
+          .cls = ErrorClass::timeout,
+          .message = what_ + ": no answer before the deadline",
+          .hint = "the device is not answering; it may be hung or busy",
+          .retryable = true,
+      });
     }
     if (ready < 0 && errno == EINTR) continue;
     char chunk[16 * 1024];
@@ -115,9 +128,13 @@ std::string UnixLineClient::read_line(Clock::time_point deadline) {
     if (n < 0 && (errno == EAGAIN || errno == EINTR)) continue;
     const std::string why = n == 0 ? "the peer closed the connection" : std::strerror(errno);
     close();
-    throw Error(ErrorInfo{.cls = ErrorClass::no_comms, .message = what_ + ": connection lost: " + why,
-                          .hint = "the device went away (simulated unplug or colorlab-sim stopped); reconnect",
-                          .transport_code = n == 0 ? "EOF" : "errno " + std::to_string(errno), .retryable = true,});
+    throw Error(ErrorInfo{
+        .cls = ErrorClass::no_comms,
+        .message = what_ + ": connection lost: " + why,
+        .hint = "the device went away (simulated unplug or colorlab-sim stopped); reconnect",
+        .transport_code = n == 0 ? "EOF" : "errno " + std::to_string(errno),
+        .retryable = true,
+    });
   }
 }
 

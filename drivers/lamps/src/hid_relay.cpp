@@ -18,9 +18,9 @@ Identity HidRelay::identity() const {
 
 void HidRelay::fail(const Error& e) {
   last_problem_ = std::string(e.what()) + (e.hint().empty() ? "" : " (" + e.hint() + ")");
-  state_ = e.cls() == ErrorClass::no_comms      ? InstrumentState::disconnected
+  state_ = e.cls() == ErrorClass::no_comms                                           ? InstrumentState::disconnected
            : e.cls() == ErrorClass::conflict || e.cls() == ErrorClass::bad_parameter ? state_
-                                                                                    : InstrumentState::fault;
+                                                                                     : InstrumentState::fault;
   throw e;
 }
 
@@ -78,7 +78,10 @@ void HidRelay::switch_verified(int relay, bool on) {
                             std::to_string(options_.switch_attempts) + " switch attempts (read-back mask " +
                             std::to_string(mask_) + ")",
                         "the relay contact may be welded or its coil dead: check the board before trusting this lamp",
-                        "relay:" + std::to_string(relay), {}, false, {}});
+                        "relay:" + std::to_string(relay),
+                        {},
+                        false,
+                        {}});
 }
 
 void HidRelay::apply(const std::vector<int>& relays_on) {

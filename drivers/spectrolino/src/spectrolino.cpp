@@ -319,9 +319,15 @@ asio::awaitable<void> Spectrolino::calibrate_now() {
       try {
         auto code = sl::ExecError::decode(answer).error;
         if (code == sl::exec_err::RemOverflow && topology_ == SpectrolinoTopology::standalone) {
-          throw Error(ErrorInfo{ErrorClass::needs_operator, std::string(what) + ": too much light or wrong white reference",
-                                "place the Spectrolino on its white calibration tile and calibrate again",
-                                "spectrolino:" + hex_byte(code), {}, false, {},});
+          throw Error(ErrorInfo{
+              ErrorClass::needs_operator,
+              std::string(what) + ": too much light or wrong white reference",
+              "place the Spectrolino on its white calibration tile and calibrate again",
+              "spectrolino:" + hex_byte(code),
+              {},
+              false,
+              {},
+          });
         }
         sl::throw_on_exec_error(code, what, {ok});
       } catch (const Error& e) {
@@ -385,14 +391,14 @@ SpectralReading Spectrolino::make_reading(const sl::Spectrum& spectrum) {
       // mW/(nm·m²) → W: irradiance-based XYZ with Y in lux.
       auto xyz = analysis::emission_to_xyz(set,
                                            options_.observer == sl::Observer::Deg10 ? analysis::Observer::cie1964_10deg
-                                                                                         : analysis::Observer::cie1931_2deg,
+                                                                                    : analysis::Observer::cie1931_2deg,
                                            0.683);
       r.xyz = std::array<double, 3>{xyz[0].X, xyz[0].Y, xyz[0].Z};
     } else if (!integrator_failed_) {
       if (!integrator_) {
         auto illum = analysis::load_illuminant(sl::illuminant_name(options_.illuminant));
         auto obs = analysis::load_observer(options_.observer == sl::Observer::Deg10 ? analysis::Observer::cie1964_10deg
-                                                                                   : analysis::Observer::cie1931_2deg);
+                                                                                    : analysis::Observer::cie1931_2deg);
         integrator_ = std::make_shared<analysis::ReflectanceIntegrator>(illum, obs, analysis::uniform_grid(380, 730, 10));
       }
       Eigen::RowVectorXd row = Eigen::Map<const Eigen::RowVectorXd>(r.values.data(), static_cast<Eigen::Index>(r.values.size()));

@@ -59,7 +59,10 @@ asio::awaitable<sl::Bytes> SpectrolinoLink::transact(const sl::Bytes& body, std:
                               std::string(what) + ": the Spectrolino reported COM error " + sl::to_hex(std::vector<std::uint8_t>{code}) +
                                   " (" + std::string(d.meaning) + ")",
                               "the line is noisy or the instrument lost the speed setting; the driver retries and reconnects",
-                              "spectrolino-com:" + sl::to_hex(std::vector<std::uint8_t>{code}), {}, d.cls == ErrorClass::coms_fail, {}});
+                              "spectrolino-com:" + sl::to_hex(std::vector<std::uint8_t>{code}),
+                              {},
+                              d.cls == ErrorClass::coms_fail,
+                              {}});
       }
       if (head.scan && head.code == sl::scan_ans::ComErrorAnswer) {
         auto code = sl::ScanComErrorAnswer::decode(answer).error;
@@ -68,7 +71,10 @@ asio::awaitable<sl::Bytes> SpectrolinoLink::transact(const sl::Bytes& body, std:
                               std::string(what) + ": the SpectroScan reported COM error " + sl::to_hex(std::vector<std::uint8_t>{code}) +
                                   " (" + std::string(d.meaning) + ")",
                               "the line is noisy or the table lost the speed setting; the driver retries and reconnects",
-                              "spectroscan-com:" + sl::to_hex(std::vector<std::uint8_t>{code}), {}, d.cls == ErrorClass::coms_fail, {}});
+                              "spectroscan-com:" + sl::to_hex(std::vector<std::uint8_t>{code}),
+                              {},
+                              d.cls == ErrorClass::coms_fail,
+                              {}});
       }
       co_return answer;
     } catch (const Error& e) {

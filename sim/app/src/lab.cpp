@@ -55,7 +55,7 @@ struct Lab::Impl {
   std::shared_ptr<Ls110Sim> ls110;
   std::shared_ptr<SpectrolinoSim> spectrolino;
   std::shared_ptr<DmxSim> dmx;
-  std::shared_ptr<camera::CameraModel> camera_model;       // the GenICam camera's
+  std::shared_ptr<camera::CameraModel> camera_model;  // the GenICam camera's
   std::shared_ptr<camera::CameraModel> dslr_model;
   std::unique_ptr<aravis::GvFakeCamera> genicam;
   std::string genicam_absent;  // why the GenICam camera asked for did not start, announced as "absent"
@@ -179,22 +179,42 @@ struct Lab::Impl {
         const auto [x, y] = Scene::floor_spot_position_mm(r, c);
         const double l = scene->floor_luminance(r, c);
         const auto px = m->floor_point_px(x, y);
-        spots.push_back({{"row", r}, {"col", c}, {"x_mm", x}, {"y_mm", y}, {"luminance", l},
-                         {"ls110_sigma", scene->luminance_noise_sigma(l)}, {"px", {px[0], px[1]}},
-                         {"relative_illumination", m->relative_illumination(px[0], px[1], f_number, camera::CameraModel::View::floor)},});
+        spots.push_back({
+            {"row", r},
+            {"col", c},
+            {"x_mm", x},
+            {"y_mm", y},
+            {"luminance", l},
+            {"ls110_sigma", scene->luminance_noise_sigma(l)},
+            {"px", {px[0], px[1]}},
+            {"relative_illumination", m->relative_illumination(px[0], px[1], f_number, camera::CameraModel::View::floor)},
+        });
       }
     const auto& cc = m->config();
     json lamps = json::array();
     for (auto l : scene->lamps_on()) lamps.push_back(to_string(l));
-    return {{"ok", true}, {"instrument", name},
-            {"view", m->view() == camera::CameraModel::View::floor ? "floor" : "chart"},
-            {"width", m->width()}, {"height", m->height()}, {"f_number", f_number},
-            {"floor_corners_px", corners_json(*m)}, {"lamps_on", lamps}, {"dimmer", scene->dimmer()},
-            {"noise", {{"gain_dn_per_e_iso100", cc.gain_dn_per_e_iso100}, {"read_noise_e", cc.read_noise_e},
-                       {"adc_noise_dn", cc.adc_noise_dn}, {"dark_current_e_per_s", cc.dark_current_e_per_s},
-                       {"prnu_sigma", cc.prnu_sigma}, {"dsnu_sigma_dn", cc.dsnu_sigma_dn},
-                       {"column_offset_sigma_dn", cc.column_offset_sigma_dn}, {"black_level", 256},}},
-            {"spots", spots},};
+    return {
+        {"ok", true},
+        {"instrument", name},
+        {"view", m->view() == camera::CameraModel::View::floor ? "floor" : "chart"},
+        {"width", m->width()},
+        {"height", m->height()},
+        {"f_number", f_number},
+        {"floor_corners_px", corners_json(*m)},
+        {"lamps_on", lamps},
+        {"dimmer", scene->dimmer()},
+        {"noise", {
+                      {"gain_dn_per_e_iso100", cc.gain_dn_per_e_iso100},
+                      {"read_noise_e", cc.read_noise_e},
+                      {"adc_noise_dn", cc.adc_noise_dn},
+                      {"dark_current_e_per_s", cc.dark_current_e_per_s},
+                      {"prnu_sigma", cc.prnu_sigma},
+                      {"dsnu_sigma_dn", cc.dsnu_sigma_dn},
+                      {"column_offset_sigma_dn", cc.column_offset_sigma_dn},
+                      {"black_level", 256},
+                  }},
+        {"spots", spots},
+    };
   }
 
   Ls110Truth ls110_truth() const {
@@ -220,8 +240,9 @@ Lab::Lab(boost::asio::io_context& io, LabConfig config) : impl_(std::make_unique
     d.aim_row = d.config.ls110.aim_row;
     d.aim_col = d.config.ls110.aim_col;
     d.scene->floor_luminance(d.aim_row, d.aim_col);  // validates the aim now, not at the first reading
-    d.ls110 = std::make_shared<Ls110Sim>(io.get_executor(), [impl = &d] { return impl->ls110_truth(); },
-                                         d.scene->stream_seed("ls110"), d.config.time_scale);
+    d.ls110 = std::make_shared<Ls110Sim>(
+        io.get_executor(), [impl = &d] { return impl->ls110_truth(); },
+        d.scene->stream_seed("ls110"), d.config.time_scale);
     d.ls110->set_faults(d.config.ls110.faults.get<Ls110Faults>());
     d.ls110->start();
   }
@@ -433,20 +454,28 @@ json Lab::control(const json& command) {
       t["lamps_on"] = lamps;
       json warmup = json::object();
       for (auto l : d.scene->lamps_on()) warmup[std::string(to_string(l))] = d.scene->warmup_factor(l);
-      t["warmup"] = warmup;  // 1 = fully warm
+      t["warmup"] = warmup;          // 1 = fully warm
       t["drift"] = d.drift_truth();  // per lamp a drift was started on: the command and its factor now (1 = none)
       json output = json::object();
       for (auto l : d.scene->lamps_on()) output[std::string(to_string(l))] = d.scene->output_factor(l);
       t["output"] = output;  // warm-up × drift: each lit lamp's output relative to normal
       if (d.dslr) t["dslr"] = d.dslr->truth();
       if (d.relay) {
-        t["relay"] = {{"board_id", d.relay_board->board_id()}, {"mask", d.relay_board->mask()},
-                      {"requests", d.relay->requests()}, {"socket", d.relay->socket_path().string()},};
+        t["relay"] = {
+            {"board_id", d.relay_board->board_id()},
+            {"mask", d.relay_board->mask()},
+            {"requests", d.relay->requests()},
+            {"socket", d.relay->socket_path().string()},
+        };
       }
       if (d.ls110) {
         auto lt = d.ls110_truth();
-        t["ls110"] = {{"luminance", lt.luminance}, {"noise_sigma", lt.noise_sigma},
-                      {"aim", {d.aim_row, d.aim_col}}, {"readings_served", d.ls110->readings_served()},};
+        t["ls110"] = {
+            {"luminance", lt.luminance},
+            {"noise_sigma", lt.noise_sigma},
+            {"aim", {d.aim_row, d.aim_col}},
+            {"readings_served", d.ls110->readings_served()},
+        };
       }
       if (d.spectrolino) {
         t["spectrolino"] = d.spectrolino_truth();
@@ -455,9 +484,13 @@ json Lab::control(const json& command) {
       }
       if (d.genicam) {
         // what a GigE Vision client should find and how many frames the camera has filled for it
-        t["genicam"] = {{"address", d.genicam->address()}, {"serial", d.genicam->serial()},
-                        {"plugged_in", d.genicam->plugged_in()}, {"frames_filled", d.genicam->frames_filled()},
-                        {"sensor", {d.camera_model->width(), d.camera_model->height()}},};
+        t["genicam"] = {
+            {"address", d.genicam->address()},
+            {"serial", d.genicam->serial()},
+            {"plugged_in", d.genicam->plugged_in()},
+            {"frames_filled", d.genicam->frames_filled()},
+            {"sensor", {d.camera_model->width(), d.camera_model->height()}},
+        };
       }
       if (d.dmx) {
         const auto& u = d.dmx->universe();
@@ -469,9 +502,11 @@ json Lab::control(const json& command) {
                     {"bad_frames", d.dmx->bad_frames()},
                     {"rejected_requests", d.dmx->rejected_requests()},
                     // as the last label 4 set them, so a client's parameter writes are checked at the widget
-                    {"parameters", {{"break_time", d.dmx->parameters().break_time},
-                                    {"mab_time", d.dmx->parameters().mab_time},
-                                    {"output_rate", d.dmx->parameters().output_rate},}}};
+                    {"parameters", {
+                                       {"break_time", d.dmx->parameters().break_time},
+                                       {"mab_time", d.dmx->parameters().mab_time},
+                                       {"output_rate", d.dmx->parameters().output_rate},
+                                   }}};
       }
       return t;
     }

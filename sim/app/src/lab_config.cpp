@@ -18,7 +18,6 @@ namespace {
               "see docs/simulator.md");
 }
 
-
 std::filesystem::path path_value(const std::filesystem::path& file, const toml::node& n, const std::string& key) {
   auto v = n.value<std::string>();
   if (!v || v->empty()) bad(file, n, key + " must be a path");
@@ -134,7 +133,8 @@ void load_relay(const std::filesystem::path& file, const toml::table& t, RelayLa
     if (relay > rc.relays) {
       throw Error(ErrorClass::bad_parameter,
                   file.string() + ": relay.lamps." + lamp + " is relay " + std::to_string(relay) +
-                                                 " but the board has " + std::to_string(rc.relays), "see docs/simulator.md");
+                      " but the board has " + std::to_string(rc.relays),
+                  "see docs/simulator.md");
     }
   }
 }

@@ -19,8 +19,8 @@
 namespace colorlab::sim::camera {
 namespace {
 
-constexpr int surround_material = chart_patch_count;      // the chart's dark surround between patches
-constexpr int floor_material = chart_patch_count + 1;     // cabinet floor around the chart
+constexpr int surround_material = chart_patch_count;   // the chart's dark surround between patches
+constexpr int floor_material = chart_patch_count + 1;  // cabinet floor around the chart
 constexpr int material_count = chart_patch_count + 2;
 constexpr double surround_reflectance = 0.05;
 constexpr int noise_block_rows = 16;  // rows per independently seeded noise block
@@ -64,10 +64,10 @@ struct CameraModel::Impl {
   std::uint64_t seed = 0;
   detail::Sensitivities sens;
   double px_per_mm = 0, origin_x = 0, origin_y = 0;  // chart top-left in pixels
-  std::optional<detail::PoseGeometry> pose;            // set: the chart at a pose instead
-  std::optional<detail::FloorGeometry> floor;          // the floor view's geometry
+  std::optional<detail::PoseGeometry> pose;          // set: the chart at a pose instead
+  std::optional<detail::FloorGeometry> floor;        // the floor view's geometry
   std::atomic<View> view{View::chart};
-  std::vector<Spectrum> material_reflectance;          // material_count
+  std::vector<Spectrum> material_reflectance;  // material_count
   // response[lamp][material][channel]: green-normalised exposure per cd/m² of floor luminance.
   std::array<std::vector<std::array<double, 3>>, 5> response;
   std::vector<PatchRegion> regions;
@@ -81,10 +81,10 @@ struct CameraModel::Impl {
     std::uint64_t version = 0;
     double gain = 0;  // DN per electron
     std::vector<Lamp> lamps;
-    std::vector<std::vector<float>> signal_e;                  // per lamp on, warm-up 1
-    std::vector<float> base_dn;                                // black + offsets + dark signal
-    std::vector<float> var0;                                   // DN² from dark shot noise and read noise
-    std::vector<std::vector<std::array<double, 3>>> truth_e;   // per lamp: mean smooth electrons per patch
+    std::vector<std::vector<float>> signal_e;                 // per lamp on, warm-up 1
+    std::vector<float> base_dn;                               // black + offsets + dark signal
+    std::vector<float> var0;                                  // DN² from dark shot noise and read noise
+    std::vector<std::vector<std::array<double, 3>>> truth_e;  // per lamp: mean smooth electrons per patch
     double dark_e = 0;
   };
   mutable std::mutex cache_mutex;
@@ -159,7 +159,7 @@ std::shared_ptr<const CameraModel::Impl::Precomputed> CameraModel::Impl::precomp
 }
 
 std::shared_ptr<const CameraModel::Impl::Precomputed> CameraModel::Impl::build(const CameraSettings& s,
-                                                                              std::uint64_t version) const {
+                                                                               std::uint64_t version) const {
   auto pre = std::make_shared<Precomputed>();
   pre->settings = s;
   pre->version = version;

@@ -12,7 +12,7 @@ namespace {
 
 // XYZ (D65) → linear Adobe RGB (1998), from the Adobe RGB (1998) specification's primaries and D65 white.
 const Eigen::Matrix3d kXyzToAdobe = (Eigen::Matrix3d() << 2.04159, -0.56501, -0.34473,  //
-                                     -0.96924, 1.87597, 0.04156,                          //
+                                     -0.96924, 1.87597, 0.04156,                        //
                                      0.01344, -0.11836, 1.01517)
                                         .finished();
 constexpr double kAdobeGamma = 563.0 / 256.0;

@@ -44,7 +44,8 @@ DslrBody::DslrBody(std::shared_ptr<const camera::CameraModel> model, DslrBodyCon
   if (ec) {
     throw Error(ErrorClass::io_error,
                 "simulated DSLR: cannot create capture directory " + config_.capture_dir.string() +
-                                          ": " + ec.message(), "check [dslr] capture_dir and its permissions");
+                    ": " + ec.message(),
+                "check [dslr] capture_dir and its permissions");
   }
   // XYZ -> camera under D65 does not depend on which lamps are lit: computed once.
   color_matrix_ = model_->xyz_to_camera_d65();
@@ -141,7 +142,8 @@ ShotPlan DslrBody::plan_shot() {
 }
 
 double DslrBody::shot_seconds(const ShotPlan& plan) const {
-  const int sidecars = plan.image_format == "raw" ? 0 : plan.image_format == "raw+jpeg" ? 1 : 3;
+  const int sidecars = plan.image_format == "raw" ? 0 : plan.image_format == "raw+jpeg" ? 1
+                                                                                        : 3;
   return config_.release_s + plan.exposure.shutter_s + config_.transfer_s + sidecars * config_.sidecar_transfer_s;
 }
 

@@ -37,10 +37,15 @@ void from_json(const nlohmann::json& j, LinkFaults& f) {
 }
 
 void to_json(nlohmann::json& j, const LinkFaults& f) {
-  j = {{"extra_latency_s", f.extra_latency_s},       {"jitter_s", f.jitter_s},
-       {"drop_probability", f.drop_probability},     {"garble_probability", f.garble_probability},
-       {"partial_probability", f.partial_probability}, {"silent", f.silent},
-       {"disconnect_s", f.disconnect_s},};
+  j = {
+      {"extra_latency_s", f.extra_latency_s},
+      {"jitter_s", f.jitter_s},
+      {"drop_probability", f.drop_probability},
+      {"garble_probability", f.garble_probability},
+      {"partial_probability", f.partial_probability},
+      {"silent", f.silent},
+      {"disconnect_s", f.disconnect_s},
+  };
 }
 
 std::optional<std::string> apply_link_faults(const LinkFaults& f, std::string reply, std::mt19937_64& rng,

@@ -70,8 +70,15 @@ json operation(RelaySocketServer::Impl& d, drivers::HidTransport& device, const 
     device.open();
     d.follow_board();  // a board found again powers up with every relay open
     const auto info = device.info();
-    return {{"ok", true}, {"path", info.path}, {"vendor_id", info.vendor_id}, {"product_id", info.product_id},
-            {"manufacturer", info.manufacturer}, {"product", info.product}, {"serial", info.serial},};
+    return {
+        {"ok", true},
+        {"path", info.path},
+        {"vendor_id", info.vendor_id},
+        {"product_id", info.product_id},
+        {"manufacturer", info.manufacturer},
+        {"product", info.product},
+        {"serial", info.serial},
+    };
   }
   if (op == "set_feature") {
     device.send_feature_report(bytes_of(req.at("report").get<std::string>()));

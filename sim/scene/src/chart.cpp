@@ -118,7 +118,8 @@ Chart synthetic_chart() {
     if (border || grey_ramp) {
       // The SG border alternates white, black and mid grey; its grey ramp runs across the middle.
       const int k = border ? (p.column + p.row) % 3 : 0;
-      const double level = grey_ramp ? 0.03 + 0.85 * (p.column - 2) / 9.0 : (k == 0 ? 0.88 : k == 1 ? 0.03 : 0.19);
+      const double level = grey_ramp ? 0.03 + 0.85 * (p.column - 2) / 9.0 : (k == 0 ? 0.88 : k == 1 ? 0.03
+                                                                                                    : 0.19);
       for (std::size_t i = 0; i < chart_samples; ++i) {
         const double nm = chart_start_nm + chart_step_nm * double(i);
         v[i] = level * (1.0 - 0.06 * std::exp(-(nm - 380.0) / 30.0));  // slight OBA-free blue drop

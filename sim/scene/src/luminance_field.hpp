@@ -27,12 +27,12 @@ class LuminanceField {
   struct Bump {
     double x, y, sigma, amplitude;
   };
-  double peak_ = 0;       // cd/m² at the brightest point, 100 %
-  double side_ = 0;       // fall-off towards the side walls (quadratic in x)
-  double depth_ = 0;      // fall-off towards the back (linear in y)
-  double cross_ = 0;      // extra fall-off in the back corners
-  double centre_y_ = 0;   // depth of the brightest line as a fraction of the grid depth (0 = front)
-  double flatten_ = 0;    // how much the relative shape flattens as the dimmer goes down
+  double peak_ = 0;      // cd/m² at the brightest point, 100 %
+  double side_ = 0;      // fall-off towards the side walls (quadratic in x)
+  double depth_ = 0;     // fall-off towards the back (linear in y)
+  double cross_ = 0;     // extra fall-off in the back corners
+  double centre_y_ = 0;  // depth of the brightest line as a fraction of the grid depth (0 = front)
+  double flatten_ = 0;   // how much the relative shape flattens as the dimmer goes down
   std::array<Bump, 3> bumps_{};
   bool geometric_ = false;
   std::optional<verify::CabinetEmitter> emitter_;

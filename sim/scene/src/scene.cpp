@@ -15,7 +15,7 @@ namespace colorlab::sim {
 namespace {
 
 constexpr double radiance_start_nm = 380.0, radiance_step_nm = 5.0;
-constexpr std::size_t radiance_samples = 71;  // 380..730
+constexpr std::size_t radiance_samples = 71;     // 380..730
 constexpr double max_luminous_efficacy = 683.0;  // lm/W
 
 std::uint64_t splitmix64(std::uint64_t x) {
@@ -65,9 +65,9 @@ struct Scene::Impl {
   Chart chart;
   Spectrum white_tile = white_tile_spectrum();
   Spectrum transmission = transmission_filter_spectrum();
-  std::array<Spectrum, 5> lamp_spd;       // native grids
-  std::array<Spectrum, 5> lamp_on_grid;   // 380..730/5 nm
-  std::array<double, 5> lamp_y{};         // Σ S ȳ Δλ
+  std::array<Spectrum, 5> lamp_spd;      // native grids
+  std::array<Spectrum, 5> lamp_on_grid;  // 380..730/5 nm
+  std::array<double, 5> lamp_y{};        // Σ S ȳ Δλ
   std::vector<detail::LuminanceField> fields;
 
   mutable std::mutex mutex;
@@ -247,7 +247,9 @@ double Scene::lamp_floor_luminance(Lamp lamp, double dimmer_percent, double x_mm
 
 double Scene::luminance_noise_sigma(double cd_m2) const {
   // LS-110 repeatability: ±0.2 % + 1 digit (of the 4-digit display) at 2σ.
-  const double digit = cd_m2 < 10 ? 0.001 : cd_m2 < 100 ? 0.01 : cd_m2 < 1000 ? 0.1 : 1.0;
+  const double digit = cd_m2 < 10 ? 0.001 : cd_m2 < 100 ? 0.01
+                                        : cd_m2 < 1000  ? 0.1
+                                                        : 1.0;
   return 0.5 * (0.002 * std::abs(cd_m2) + digit);
 }
 

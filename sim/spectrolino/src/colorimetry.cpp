@@ -28,7 +28,8 @@ sp::IllumTabAnswer illuminant_table(std::uint8_t illuminant, const DeviceSetting
   t.illuminant = illuminant;
   auto il = static_cast<sp::Illuminant>(illuminant);
   if (il == sp::Illuminant::User) {
-    if (settings.user_illuminant) t.table = *settings.user_illuminant; else t.remote_errors = sp::remote_err::Illuminant;
+    if (settings.user_illuminant) t.table = *settings.user_illuminant;
+    else t.remote_errors = sp::remote_err::Illuminant;
   } else if (auto name = colord_name(il, settings.dxx)) {
     auto set = analysis::resample(analysis::load_illuminant(*name), band_grid(), analysis::Interpolation::linear);
     for (std::size_t i = 0; i < sp::kSpectrumBands; ++i) t.table[i] = static_cast<float>(set.values(0, static_cast<Eigen::Index>(i)));

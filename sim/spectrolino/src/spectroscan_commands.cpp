@@ -124,7 +124,8 @@ SpectrolinoReply SpectrolinoModel::Impl::spectroscan_command(const sp::Request& 
     case sp::scan_op::SetSpecialStatus:
     case sp::scan_op::ClearSpecialStatus:
       if (!need(1)) return bad_len();
-      if (r.opcode == sp::scan_op::SetSpecialStatus) table.special |= a[0]; else table.special &= static_cast<std::uint8_t>(~a[0]);
+      if (r.opcode == sp::scan_op::SetSpecialStatus) table.special |= a[0];
+      else table.special &= static_cast<std::uint8_t>(~a[0]);
       return done(cmd);
     case sp::scan_op::OutputSpecialStatus:
       if (!need(0)) return bad_len();

@@ -59,9 +59,9 @@ struct ScanTable {
   // D0 0F: the standby position must be on the table, in transmission mode only.
   std::uint8_t check_standby_position(int sx, int sy) const;
 
-  std::uint8_t status() const;          // D0 24
-  void clear_status(std::uint8_t bits); // D0 25
-  std::uint8_t special_status() const;  // D0 28
+  std::uint8_t status() const;           // D0 24
+  void clear_status(std::uint8_t bits);  // D0 25
+  std::uint8_t special_status() const;   // D0 28
 };
 
 }  // namespace colorlab::sim::spectrolino_detail

@@ -41,7 +41,8 @@ TEST(camera_asio, co_await_connect_configure_capture_on_the_loop_thread) {
         cam::CameraSettings s;
         s.iso = 250;  // not an EOS 20D choice
         bad_setting = co_await cam::async_configure(camera, s, asio::use_awaitable);
-        report = co_await cam::async_capture(camera, 4, [](const cam::RawImage&) {}, asio::use_awaitable);
+        report = co_await cam::async_capture(
+            camera, 4, [](const cam::RawImage&) {}, asio::use_awaitable);
         EXPECT_EQ(std::this_thread::get_id(), loop_thread);
         finished = true;
       },

@@ -49,13 +49,20 @@ TEST(camera_gphoto2, unknown_model_is_not_found) {
 
 TEST(camera_gphoto2, result_codes_map_to_error_classes) {
   const std::pair<int, ErrorClass> table[] = {
-      {GP_ERROR_TIMEOUT, ErrorClass::timeout},           {GP_ERROR_CAMERA_BUSY, ErrorClass::conflict},
-      {GP_ERROR_IO_USB_CLAIM, ErrorClass::conflict},     {GP_ERROR_NOT_SUPPORTED, ErrorClass::unsupported},
-      {GP_ERROR_BAD_PARAMETERS, ErrorClass::bad_parameter}, {GP_ERROR_IO, ErrorClass::no_comms},
-      {GP_ERROR_IO_READ, ErrorClass::no_comms},          {GP_ERROR_IO_USB_FIND, ErrorClass::not_found},
-      {GP_ERROR_MODEL_NOT_FOUND, ErrorClass::not_found}, {GP_ERROR_FILE_NOT_FOUND, ErrorClass::not_found},
-      {GP_ERROR_CORRUPTED_DATA, ErrorClass::coms_fail},  {GP_ERROR_NO_SPACE, ErrorClass::needs_operator},
-      {GP_ERROR_CAMERA_ERROR, ErrorClass::device_error}, {GP_ERROR_NO_MEMORY, ErrorClass::internal},
+      {GP_ERROR_TIMEOUT, ErrorClass::timeout},
+      {GP_ERROR_CAMERA_BUSY, ErrorClass::conflict},
+      {GP_ERROR_IO_USB_CLAIM, ErrorClass::conflict},
+      {GP_ERROR_NOT_SUPPORTED, ErrorClass::unsupported},
+      {GP_ERROR_BAD_PARAMETERS, ErrorClass::bad_parameter},
+      {GP_ERROR_IO, ErrorClass::no_comms},
+      {GP_ERROR_IO_READ, ErrorClass::no_comms},
+      {GP_ERROR_IO_USB_FIND, ErrorClass::not_found},
+      {GP_ERROR_MODEL_NOT_FOUND, ErrorClass::not_found},
+      {GP_ERROR_FILE_NOT_FOUND, ErrorClass::not_found},
+      {GP_ERROR_CORRUPTED_DATA, ErrorClass::coms_fail},
+      {GP_ERROR_NO_SPACE, ErrorClass::needs_operator},
+      {GP_ERROR_CAMERA_ERROR, ErrorClass::device_error},
+      {GP_ERROR_NO_MEMORY, ErrorClass::internal},
       {GP_ERROR, ErrorClass::hardware_fail},
   };
   for (const auto& [code, cls] : table) {

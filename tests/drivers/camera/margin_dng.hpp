@@ -15,7 +15,7 @@ namespace colorlab::drivers::camera::test {
 struct MarginDng {
   std::uint32_t raw_width = 0, raw_height = 0;
   std::uint32_t top = 0, left = 0, bottom = 0, right = 0;  // active area, DNG order
-  std::vector<std::uint16_t> pixels;                        // raw_width * raw_height, RGGB from (top, left)
+  std::vector<std::uint16_t> pixels;                       // raw_width * raw_height, RGGB from (top, left)
   float black = 256;
   std::uint32_t white = 4095;
 };

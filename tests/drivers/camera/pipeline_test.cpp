@@ -13,11 +13,12 @@ namespace cam = colorlab::drivers::camera;
 TEST(camera_pipeline, delivers_every_item_in_order) {
   cam::FramePipeline<int> p(2);
   std::vector<int> got;
-  auto run = p.run(50, [](std::size_t i) { return static_cast<int>(i * 3); },
-                   [&](int&& v, std::size_t i) {
-                     EXPECT_EQ(v, static_cast<int>(i * 3));
-                     got.push_back(v);
-                   });
+  auto run = p.run(
+      50, [](std::size_t i) { return static_cast<int>(i * 3); },
+      [&](int&& v, std::size_t i) {
+        EXPECT_EQ(v, static_cast<int>(i * 3));
+        got.push_back(v);
+      });
   EXPECT_TRUE(run.complete());
   EXPECT_EQ(run.produced, 50U);
   EXPECT_EQ(run.consumed, 50U);
@@ -96,7 +97,8 @@ TEST(camera_pipeline, consumer_failure_stops_the_producer) {
 TEST(camera_pipeline, is_reusable_for_many_series) {
   cam::FramePipeline<int> p(3);
   for (int s = 0; s < 20; ++s) {
-    auto run = p.run(static_cast<std::size_t>(s), [](std::size_t) { return 1; }, [](int&&, std::size_t) {});
+    auto run = p.run(
+        static_cast<std::size_t>(s), [](std::size_t) { return 1; }, [](int&&, std::size_t) {});
     EXPECT_TRUE(run.complete());
     EXPECT_EQ(run.consumed, static_cast<std::size_t>(s));
   }

@@ -44,7 +44,7 @@ class RawWidget : public std::enable_shared_from_this<RawWidget> {
       std::uint8_t label = rx_[answered_ + 1];
       answered_ += len + 5;
       Bytes reply;
-      if (label == 10) reply = {0x7E, 0x0A, 0x04, 0x00, 0x78, 0x56, 0x34, 0x12, 0xE7};         // serial 12345678 (BCD, LE)
+      if (label == 10) reply = {0x7E, 0x0A, 0x04, 0x00, 0x78, 0x56, 0x34, 0x12, 0xE7};  // serial 12345678 (BCD, LE)
       // fw 1.44 (minor 44 = 0x2C, then major 1, as OLA's UsbProWidgetDetector reads them), break 9, MAB 1, 40/s
       if (label == 3) reply = {0x7E, 0x03, 0x05, 0x00, 0x2C, 0x01, 0x09, 0x01, 0x28, 0xE7};
       if (reply.empty()) continue;
@@ -74,8 +74,8 @@ TEST(EnttecDmxTranscript, DiscoveryAndOneLampAreTheDocumentedFrames) {
   run(io, d.set_lamps({"TL84"}));
   settle(io, std::chrono::milliseconds(20));
 
-  Bytes expected{0x7E, 0x0A, 0x00, 0x00, 0xE7,                // label 10, no payload
-                 0x7E, 0x03, 0x02, 0x00, 0x00, 0x00, 0xE7};   // label 3, user-config size 0
+  Bytes expected{0x7E, 0x0A, 0x00, 0x00, 0xE7,               // label 10, no payload
+                 0x7E, 0x03, 0x02, 0x00, 0x00, 0x00, 0xE7};  // label 3, user-config size 0
   // Label 6, length 513 (LSB 01, MSB 02): start code 00, then slots 1..512 with slot 2 full.
   Bytes dmx{0x7E, 0x06, 0x01, 0x02, 0x00, 0x00, 0xFF};
   dmx.resize(4 + 513, 0x00);  // header + payload

@@ -18,8 +18,13 @@ using drivers::InstrumentConfig;
 TEST(DriverFactory, BuildsSpectrolinoDmxAndRelay) {
   boost::asio::io_context io;
   auto spectro = drivers::make_instrument(
-      io.get_executor(), InstrumentConfig{"sp", "spectrolino", "/dev/pts/9", true,
-                                          {{"illuminant", "D65"}, {"observer", 10}, {"power_on_baud", 9600}, {"table", true}},});
+      io.get_executor(), InstrumentConfig{
+                             "sp",
+                             "spectrolino",
+                             "/dev/pts/9",
+                             true,
+                             {{"illuminant", "D65"}, {"observer", 10}, {"power_on_baud", 9600}, {"table", true}},
+                         });
   ASSERT_NE(dynamic_cast<drivers::Spectrolino*>(spectro.get()), nullptr);
   EXPECT_EQ(spectro->identity().kind, "spectrolino");
   EXPECT_TRUE(spectro->identity().simulated);

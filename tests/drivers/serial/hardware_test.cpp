@@ -25,8 +25,8 @@ std::string env(const char* name) {
   return v ? v : "";
 }
 
-#define REQUIRE_ENV(var, name)                                                                       \
-  const std::string var = env(name);                                                                 \
+#define REQUIRE_ENV(var, name)       \
+  const std::string var = env(name); \
   if (var.empty()) GTEST_SKIP() << name " is not set: no bench instrument to test (CI has none)"
 
 TEST(HardwareSpectrolino, ConnectsIdentifiesAndCalibratesOnTheTile) {

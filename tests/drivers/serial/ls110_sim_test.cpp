@@ -17,7 +17,8 @@ class Ls110SimTest : public ::testing::Test {
  protected:
   static constexpr double kTruth = 245.3;
   void SetUp() override {
-    sim_ = std::make_shared<sim::Ls110Sim>(io_.get_executor(), [] { return sim::Ls110Truth{kTruth, 0.0}; }, 5, 50.0);
+    sim_ = std::make_shared<sim::Ls110Sim>(
+        io_.get_executor(), [] { return sim::Ls110Truth{kTruth, 0.0}; }, 5, 50.0);
     sim_->start();
   }
   void TearDown() override {

@@ -82,7 +82,8 @@ TEST_F(Ls110Transcript, RefusedModeIsAnErrorNotAConnection) {
 TEST(Ls110SimulatorAgainstTheDocument, AnswersMesInTheDocumentedShape) {
   boost::asio::io_context io;
   const double truth = 312.25;
-  auto sim = std::make_shared<sim::Ls110Sim>(io.get_executor(), [&] { return sim::Ls110Truth{truth, 0.0}; }, 3, 50.0);
+  auto sim = std::make_shared<sim::Ls110Sim>(
+      io.get_executor(), [&] { return sim::Ls110Truth{truth, 0.0}; }, 3, 50.0);
   sim->start();
   std::thread served([&] { io.run_for(std::chrono::seconds(5)); });
   int fd = ::open(sim->port_path().c_str(), O_RDWR | O_NOCTTY);

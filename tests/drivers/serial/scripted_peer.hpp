@@ -17,9 +17,9 @@
 namespace colorlab::test {
 
 struct ScriptStep {
-  std::string expect;  // full request line including CR LF
-  std::string reply;   // full answer line including CR LF
-  unsigned baud = 0;   // the client must have set this speed (0 = any)
+  std::string expect;    // full request line including CR LF
+  std::string reply;     // full answer line including CR LF
+  unsigned baud = 0;     // the client must have set this speed (0 = any)
   bool rts_cts = false;  // the client must have enabled RTS/CTS
 };
 

@@ -23,7 +23,7 @@ class SpectrolinoSimTest : public ::testing::Test {
     clock_ = std::make_shared<sim::SimClock>(time_scale);
     sim::SceneConfig sc;
     sc.seed = 7;
-    sc.force_synthetic_chart = true;  // deterministic without the shared data set
+    sc.force_synthetic_chart = true;          // deterministic without the shared data set
     sc.lamps_on_at_start = {sim::Lamp::d65};  // already warm: emission truth does not drift during a test
     scene_ = std::make_unique<sim::Scene>(sc, clock_);
     sim::SpectrolinoConfig cfg;

@@ -57,8 +57,13 @@ TEST_F(SpectrolinoSimTest, ConnectsToStandaloneSpectrolino) {
 TEST_F(SpectrolinoSimTest, FactoryBuildsItFromTheSimulatorsAnnouncement) {
   start(true);
   auto inst = drivers::make_instrument(
-      io_.get_executor(), drivers::InstrumentConfig{"spectro", "spectrolino", sim_->port_path(), true,
-                                                    {{"power_on_baud", 9600}, {"table", true}, {"command_timeout_ms", 600}},});
+      io_.get_executor(), drivers::InstrumentConfig{
+                              "spectro",
+                              "spectrolino",
+                              sim_->port_path(),
+                              true,
+                              {{"power_on_baud", 9600}, {"table", true}, {"command_timeout_ms", 600}},
+                          });
   run(io_, inst->connect());
   EXPECT_EQ(inst->identity().serial, "12345/table:54321");
   auto caps = inst->capabilities();

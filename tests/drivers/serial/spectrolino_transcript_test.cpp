@@ -89,16 +89,16 @@ TEST_F(TranscriptTest, StandaloneConnectCalibrateMeasure) {
       // Baud scan: the 57600 probe goes unanswered (ignored at the wrong speed), then 9600 answers
       // with COM error 04: a stand-alone Spectrolino does not know the D0 record.
       {";D024\r\n", ":2604\r\n", 9600},
-      {";4DCF\r\n", ok1f, 9600},             // hardware handshake
-      {";4D99\r\n", ok1f, 9600},             // 57600
+      {";4DCF\r\n", ok1f, 9600},  // hardware handshake
+      {";4D99\r\n", ok1f, 9600},  // 57600
       {";00\r\n", ":0B0101030001\r\n", 57600, true},
       {";B5\r\n", device_data(), 57600},
       {";2B\r\n", target_id(), 57600},
-      {";1601010300\r\n", ok1f},             // ANSI T, absolute white, D50, 2°
-      {";4D9B\r\n", ok1f},                   // reflectance
+      {";1601010300\r\n", ok1f},  // ANSI T, absolute white, D50, 2°
+      {";4D9B\r\n", ok1f},        // reflectance
       // calibrate()
-      {";220907\r\n", ":2513\r\n"},         // white calibration with warning → 13 WhiteMeasOK
-      {";00\r\n", ":0B0101030001\r\n"},      // filter check
+      {";220907\r\n", ":2513\r\n"},      // white calibration with warning → 13 WhiteMeasOK
+      {";00\r\n", ":0B0101030001\r\n"},  // filter check
       // measure()
       {";20\r\n", ":2500\r\n"},
       {";B80900\r\n", spectrum_answer(false)},
@@ -117,20 +117,20 @@ TEST_F(TranscriptTest, StandaloneConnectCalibrateMeasure) {
 
 TEST_F(TranscriptTest, TableConnectAndMoveAndMeasure) {
   auto p = peer({
-      {";D024\r\n", ":D18310\r\n", 9600},    // status: online → a SpectroScan
-      {";D00A\r\n", scan_ok, 9600},          // InitializeDevice
-      {";D010\r\n", scan_ok, 9600},          // online
-      {";D02102\r\n", scan_ok, 9600},        // hardware handshake
-      {";D0200A\r\n", scan_ok, 9600},        // 57600
+      {";D024\r\n", ":D18310\r\n", 9600},  // status: online → a SpectroScan
+      {";D00A\r\n", scan_ok, 9600},        // InitializeDevice
+      {";D010\r\n", scan_ok, 9600},        // online
+      {";D02102\r\n", scan_ok, 9600},      // hardware handshake
+      {";D0200A\r\n", scan_ok, 9600},      // 57600
       {";D024\r\n", ":D18310\r\n", 57600, true},
-      {";D00B\r\n", scan_ok},                // find the Spectrolino
+      {";D00B\r\n", scan_ok},  // find the Spectrolino
       {";D030\r\n", table_type()},
       {";B5\r\n", device_data()},
       {";2B\r\n", target_id()},
-      {";D031\r\n", ":D19131D40000\r\n"},    // table serial 54321
+      {";D031\r\n", ":D19131D40000\r\n"},  // table serial 54321
       {";D034\r\n", answer(sl::SoftwareVersionAnswer{"V2.10"}.encode())},
       {";1601010300\r\n", ok1f},
-      {";D00D00\r\n", scan_ok},              // SpectroScan T: table mode reflectance
+      {";D00D00\r\n", scan_ok},  // SpectroScan T: table mode reflectance
       // calibrate(): tile 1, head down, white cal, head up, filter check
       {";D00600\r\n", scan_ok},
       {";D004\r\n", scan_ok},
@@ -166,7 +166,9 @@ TEST_F(TranscriptTest, ScanErrorAnswerToMoveIsTyped) {
       {";D034\r\n", answer(sl::SoftwareVersionAnswer{"V2.10"}.encode())},
       {";1601010300\r\n", ok1f},
       {";D00D00\r\n", scan_ok},
-      {";D000000001" "0A00\r\n", ":D18001\r\n"},  // move absolute: sensor, x 256 = 0100 → "0001", y 10 → "0A00"; device offline
+      {";D000000001"
+       "0A00\r\n",
+       ":D18001\r\n"},  // move absolute: sensor, x 256 = 0100 → "0001", y 10 → "0A00"; device offline
   });
   drivers::Spectrolino s(io_.get_executor(), options(p->path()));
   run(io_, s.connect());
@@ -209,8 +211,8 @@ TEST_F(TranscriptTest, EveryScanComAndRemoteErrorIsTyped) {
   const std::vector<std::uint16_t> remote_bits{0x0001, 0x0002, 0x0004, 0x0008, 0x0010, 0x0020, 0x0040, 0x0080,
                                                0x0100, 0x0200, 0x0400, 0x0800, 0x1000, 0x2000, 0x4000, 0x8000};
   auto script = table_connect_script();
-  for (auto c : scan_codes) script.push_back({";D002\r\n", ":D180" + hex2(c) + "\r\n"});            // move home
-  for (auto c : com_codes) script.push_back({";D024\r\n", ":26" + hex2(c) + "\r\n"});                // status
+  for (auto c : scan_codes) script.push_back({";D002\r\n", ":D180" + hex2(c) + "\r\n"});  // move home
+  for (auto c : com_codes) script.push_back({";D024\r\n", ":26" + hex2(c) + "\r\n"});     // status
   for (auto b : remote_bits) {
     std::string rem = hex2(static_cast<std::uint8_t>(b & 0xFF)) + hex2(static_cast<std::uint8_t>(b >> 8));
     script.push_back({";1601010201\r\n", ":1F" + rem + "\r\n"});  // D65, 10°, absolute

@@ -32,7 +32,8 @@ TEST_P(SimSpotread, ReadsTheSimulatedSpectrolino) {
 time_scale = 10.0
 [spectrolino]
 table = false
-power_on_baud = )" + std::to_string(GetParam()) + R"(
+power_on_baud = )" + std::to_string(GetParam()) +
+                                 R"(
 [ls110]
 enabled = false
 [dmx]

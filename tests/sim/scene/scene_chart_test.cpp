@@ -168,7 +168,8 @@ TEST(SimChart, PatchLabTruthIsColorimetryOfTheScenesOwnSpectra) {
     cfg.lamps_on_at_start = {lamp};
     cfg.dimmer_percent_at_start = 70;
     const Scene scene(cfg, std::make_shared<SimClock>());
-    const auto illuminant = analysis::load_illuminant(lamp == Lamp::d65 ? "D65" : lamp == Lamp::tl84 ? "F11" : "A");
+    const auto illuminant = analysis::load_illuminant(lamp == Lamp::d65 ? "D65" : lamp == Lamp::tl84 ? "F11"
+                                                                                                     : "A");
     const auto observer = analysis::load_observer(analysis::Observer::cie1931_2deg);
     analysis::IntegrationOptions opt;
     opt.step_nm = 5;

@@ -181,7 +181,7 @@ TEST(SimLampDrift, RampsForItsDurationThenHoldsOrReturns) {
   LampDrift back = hold;
   back.returns = true;
   EXPECT_NEAR(back.factor_at(190.0), 0.97, 1e-12);  // comes back at the same rate …
-  EXPECT_DOUBLE_EQ(back.factor_at(220.0), 1.0);      // … and is normal again after as long again
+  EXPECT_DOUBLE_EQ(back.factor_at(220.0), 1.0);     // … and is normal again after as long again
   EXPECT_DOUBLE_EQ(back.factor_at(5000.0), 1.0);
   EXPECT_DOUBLE_EQ((LampDrift{0.0, -0.1, 100.0, false}.factor_at(50.0)), 0.0);  // never below dark
   EXPECT_DOUBLE_EQ((LampDrift{0.0, 0.0, 100.0, false}.factor_at(50.0)), 1.0);

@@ -146,8 +146,11 @@ TEST(SimSerialPty, LampDriftThroughTheControlChannelWithItsTruth) {
   SimProcess sim(kLab);
   const double before = sim.control({{"cmd", "truth"}})["ls110"]["luminance"].get<double>();
   // −30 %/min for 10 simulated seconds (1 s real at time scale 10), then back at the same rate.
-  auto r = sim.control({{"cmd", "fault"}, {"instrument", "cabinet"},
-                        {"faults", {{"lamp_drift", {{"lamp", "D65"}, {"rate_pct_per_min", -30}, {"seconds", 10}, {"then", "return"}}}}},});
+  auto r = sim.control({
+      {"cmd", "fault"},
+      {"instrument", "cabinet"},
+      {"faults", {{"lamp_drift", {{"lamp", "D65"}, {"rate_pct_per_min", -30}, {"seconds", 10}, {"then", "return"}}}}},
+  });
   ASSERT_TRUE(r["ok"].get<bool>()) << r.dump();
   EXPECT_EQ(r["lamp_drift"]["then"], "return");
   sleep_s(1.5);  // 15 simulated seconds: 5 % down at 10 s, 2.5 % down now

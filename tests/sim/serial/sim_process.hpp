@@ -103,11 +103,16 @@ class SerialClient {
     termios t{};
     ::tcgetattr(fd_, &t);
     ::cfmakeraw(&t);
-    speed_t s = baud == 4800 ? B4800 : baud == 9600 ? B9600 : baud == 19200 ? B19200 : baud == 57600 ? B57600
-              : baud == 115200 ? B115200 : baud == 2400 ? B2400 : B38400;
+    speed_t s = baud == 4800 ? B4800 : baud == 9600 ? B9600
+                                   : baud == 19200  ? B19200
+                                   : baud == 57600  ? B57600
+                                   : baud == 115200 ? B115200
+                                   : baud == 2400   ? B2400
+                                                    : B38400;
     ::cfsetispeed(&t, s);
     ::cfsetospeed(&t, s);
-    if (rts_cts) t.c_cflag |= CRTSCTS; else t.c_cflag &= ~CRTSCTS;
+    if (rts_cts) t.c_cflag |= CRTSCTS;
+    else t.c_cflag &= ~CRTSCTS;
     ::tcsetattr(fd_, TCSANOW, &t);
   }
   void write(const std::string& bytes) {

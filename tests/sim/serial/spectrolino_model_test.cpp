@@ -105,23 +105,23 @@ TEST(SimSpectrolinoModel, CalibrateThenMeasurePatchMatchesSceneTruth) {
   auto exact = xyz_d50(spec.spectrum);
   for (int k = 0; k < 3; ++k) {
     EXPECT_NEAR(xyz.values[static_cast<std::size_t>(k)], exact[static_cast<std::size_t>(k)], 1e-3);  // same spectrum
-    EXPECT_NEAR(xyz.values[static_cast<std::size_t>(k)], want[static_cast<std::size_t>(k)], 0.6);     // within noise
+    EXPECT_NEAR(xyz.values[static_cast<std::size_t>(k)], want[static_cast<std::size_t>(k)], 0.6);    // within noise
   }
 }
 
 TEST(SimSpectrolinoModel, ErrorTables) {
   Fixture f(false);
   f.model->place_on_tile();
-  EXPECT_EQ(f.q("00"), ":2601\r\n");       // no start character
-  EXPECT_EQ(f.q(";0G"), ":2602\r\n");      // illegal character
-  EXPECT_EQ(f.q(";00FF"), ":2603\r\n");    // wrong record length
-  EXPECT_EQ(f.q(";FE"), ":2604\r\n");      // unknown message
-  EXPECT_EQ(f.q(";D000"), ":2604\r\n");    // no table on a stand-alone Spectrolino
+  EXPECT_EQ(f.q("00"), ":2601\r\n");             // no start character
+  EXPECT_EQ(f.q(";0G"), ":2602\r\n");            // illegal character
+  EXPECT_EQ(f.q(";00FF"), ":2603\r\n");          // wrong record length
+  EXPECT_EQ(f.q(";FE"), ":2604\r\n");            // unknown message
+  EXPECT_EQ(f.q(";D000"), ":2604\r\n");          // no table on a stand-alone Spectrolino
   EXPECT_EQ(f.q(";1604010300"), ":1F0100\r\n");  // bad density standard -> remote error bit 0001
   EXPECT_EQ(f.q(";1601010700"), ":1F0400\r\n");  // illuminant 07 does not exist -> 0004
-  EXPECT_EQ(f.q(";220908"), ":2535\r\n");  // emission calibration outside emission mode
+  EXPECT_EQ(f.q(";220908"), ":2535\r\n");        // emission calibration outside emission mode
   EXPECT_EQ(f.q(";4D9D"), ":1F0000\r\n");
-  EXPECT_EQ(f.q(";20"), ":2537\r\n");      // emission without its calibration
+  EXPECT_EQ(f.q(";20"), ":2537\r\n");  // emission without its calibration
   EXPECT_EQ(f.q(";220908"), ":2534\r\n");
   EXPECT_EQ(f.q(";4D9B"), ":1F0000\r\n");
   f.model->set_forced_exec_error(sp::exec_err::LampFailure, true);

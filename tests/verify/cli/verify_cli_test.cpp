@@ -140,7 +140,8 @@ std::vector<std::string> verify_args(const std::string& file) { return Lab::veri
 void the_true_floor_agrees_at_95_percent_of_the_spots() {
   ASSERT_EQ((*truth_)["dimmer"].get<double>(), 100) << truth_->dump();
   const auto r = cli(verify_args("faithful.exr"));
-  ASSERT_TRUE(r.exit_code == 0 || r.exit_code == 4) << r.exit_code << "\n" << r.err;
+  ASSERT_TRUE(r.exit_code == 0 || r.exit_code == 4) << r.exit_code << "\n"
+                                                    << r.err;
   const json result = json::parse(r.out);
   const auto k = tally(result);
   ASSERT_EQ(k.at("light_spot").compared, kRows * kCols);
@@ -148,7 +149,8 @@ void the_true_floor_agrees_at_95_percent_of_the_spots() {
   for (const auto& [kind, t] : k) {
     const double agree = 1.0 - static_cast<double>(t.differ) / t.compared;
     std::cout << kind << ": " << t.compared - t.differ << "/" << t.compared << " agree\n";
-    EXPECT_GE(agree, 0.95) << kind << "\n" << result["summary"].dump(2);
+    EXPECT_GE(agree, 0.95) << kind << "\n"
+                           << result["summary"].dump(2);
   }
   // The margin, printed for the record: the largest distance over its threshold (1 = the band's edge).
   double worst = 0;

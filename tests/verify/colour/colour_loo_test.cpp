@@ -52,7 +52,7 @@ TEST(VerifyColourLoo, SplineOneSolveEqualsRefittingWithoutEachPatch) {
     analysis::FitOptions fo;
     fo.target = target;
     analysis::SplineOptions so = analysis::spline_options("rbf:ccm", fo);
-    so.smoothing = 1e-3;  // a fixed λ, as the verification takes the one chosen on every patch
+    so.smoothing = 1e-3;                // a fixed λ, as the verification takes the one chosen on every patch
     so.input_scale = d.rgb.maxCoeff();  // LOO of the same smoother: the scale is not refitted per fold
     const auto t0 = std::chrono::steady_clock::now();
     const Eigen::MatrixXd fast = analysis::spline_loo_targets(d, so);
@@ -131,8 +131,10 @@ TEST(VerifyColourLoo, RunsThatLackWhatColourNeedsAreRefusedWithTheirCause) {
   }
   // A raw result whose black box was not fitted says why.
   const json no_bb = run("k1", "characterize-camera", {{"reference_run", "c1"}},
-                         {{"script", {{"formats", {{"raw", {{"approaches", json::object()},
-                                                             {"not_fitted", {{"black_box", "the reference has no spectra"}}},}}}}}}});
+                         {{"script", {{"formats", {{"raw", {
+                                                               {"approaches", json::object()},
+                                                               {"not_fitted", {{"black_box", "the reference has no spectra"}}},
+                                                           }}}}}}});
   try {
     verify::stored_black_box(no_bb);
     ADD_FAILURE() << "no black box";

@@ -32,7 +32,7 @@ namespace {
 constexpr std::uint64_t kSeed = 5;  // characterize_camera_test's: its seeded chart pose is located at half size
 // Half the 20D's sensor, as characterize_camera_test: the chart spans hundreds of pixels and the raw renders quickly.
 constexpr const char* kLabToml = "[genicam]\nenabled = false\n[dslr]\nsize = [1752, 1168]\n";
-constexpr const char* kDefectPatch = "F5";  // a chromatic patch inside the neutral border
+constexpr const char* kDefectPatch = "F5";            // a chromatic patch inside the neutral border
 constexpr int kPitch = 28, kSide = 22, kMargin = 40;  // the rendering's chart: pixels per grid unit, patch side
 
 // A patch's reflectance under D65, the lamp of the runs, as L*a*b* (the perfect diffuser's white).
@@ -141,8 +141,13 @@ class Lab {
     auto api = api_for(*daemon_);
     chart_read_ = run_to_end(api, "chart-read", json::object())["id"].get<std::string>();
     const json run = run_to_end(api, "characterize-camera",
-                                {{"reference_run", chart_read_}, {"frames", 2}, {"formats", {"raw"}}, {"keep", {"preview"}},
-                                 {"prior_exclude", {"Canon_20D"}},},
+                                {
+                                    {"reference_run", chart_read_},
+                                    {"frames", 2},
+                                    {"formats", {"raw"}},
+                                    {"keep", {"preview"}},
+                                    {"prior_exclude", {"Canon_20D"}},
+                                },
                                 std::chrono::seconds(240));
     if (run["status"] != "finished_ok") throw std::runtime_error("characterize-camera: " + run.dump().substr(0, 2000));
     characterize_ = run["id"].get<std::string>();
@@ -165,7 +170,8 @@ class Lab {
 
 json verify_json(const Lab& lab, const std::string& file, const std::string& expect_where = "") {
   const auto r = lab.cli({"verify", lab.file(file).string(), "--against", lab.characterize(), "--json"});
-  EXPECT_TRUE(r.exit_code == 0 || r.exit_code == 4) << r.exit_code << "\n" << r.err << expect_where;
+  EXPECT_TRUE(r.exit_code == 0 || r.exit_code == 4) << r.exit_code << "\n"
+                                                    << r.err << expect_where;
   if (r.out.empty()) return json::object();
   json j = json::parse(r.out);
   EXPECT_EQ(j["exit_status"], r.exit_code);
@@ -202,14 +208,16 @@ TEST(VerifyColour, FromStoredRunsAgainstTheSimulatedLab) {
     const json result = verify_json(*lab, "faithful.exr");
     const auto k = tally(result);
     for (const char* kind : {"colour_7_3", "colour_7_4"}) {
-      ASSERT_TRUE(k.count(kind)) << kind << " not compared\n" << result.dump().substr(0, 3000);
+      ASSERT_TRUE(k.count(kind)) << kind << " not compared\n"
+                                 << result.dump().substr(0, 3000);
       const auto& t = k.at(kind);
       EXPECT_EQ(t.compared, 140) << kind;
       const double agree = 1.0 - static_cast<double>(t.differ) / t.compared;
       std::cout << kind << ": " << t.compared - t.differ << "/" << t.compared << " agree; differ at";
       for (const auto& w : t.differ_at) std::cout << " " << w;
       std::cout << "\n";
-      EXPECT_GE(agree, 0.95) << kind << "\n" << result["summary"][kind].dump(2);
+      EXPECT_GE(agree, 0.95) << kind << "\n"
+                             << result["summary"][kind].dump(2);
     }
     std::cout << "closest verdict to flipping: " << closest_to_flipping(result) << " of its threshold\n";
     for (const auto& s : result["summary"]["scales"]) EXPECT_EQ(s["how"], "fitted") << s.dump();

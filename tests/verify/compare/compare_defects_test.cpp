@@ -15,9 +15,9 @@ namespace colorlab::verify::testing {
 namespace {
 
 constexpr int kDraws = 100;
-constexpr double kDetect = 0.90;     // flagged where it is on at least 9 draws in 10
-constexpr double kFalseFlags = 0.05; // the faithful rest agrees on >= 95 % (issue 23)
-constexpr int kPatch = 40;           // a chromatic patch (row 2, column 12 of the SG-sized chart)
+constexpr double kDetect = 0.90;      // flagged where it is on at least 9 draws in 10
+constexpr double kFalseFlags = 0.05;  // the faithful rest agrees on >= 95 % (issue 23)
+constexpr int kPatch = 40;            // a chromatic patch (row 2, column 12 of the SG-sized chart)
 
 const SyntheticLab& lab() {
   static const SyntheticLab l;

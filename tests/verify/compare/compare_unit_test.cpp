@@ -14,8 +14,8 @@ namespace {
 
 TEST(VerifyUncertainty, CoverageOfKEquals2) {
   EXPECT_NEAR(coverage_probability(2), 0.9545, 1e-4);
-  EXPECT_NEAR(chi_square_quantile(0.9545, 1), 4.0, 1e-3);              // k² in one dimension
-  EXPECT_NEAR(chi_square_quantile(0.95, 3), 7.8147, 1e-3);             // table value
+  EXPECT_NEAR(chi_square_quantile(0.9545, 1), 4.0, 1e-3);                // k² in one dimension
+  EXPECT_NEAR(chi_square_quantile(0.95, 3), 7.8147, 1e-3);               // table value
   EXPECT_NEAR(chi_square_quantile(0.95, 2), -2 * std::log(0.05), 1e-6);  // exponential in two dimensions
 }
 

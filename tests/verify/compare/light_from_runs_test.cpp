@@ -15,7 +15,9 @@ nlohmann::json grid_row(int r, int c, std::vector<double> readings, const char* 
   for (double x : readings) mean += x;
   mean /= static_cast<double>(readings.size());
   return {{"step", std::string("L/") + lamp + "/D100/r" + std::to_string(r) + "c" + std::to_string(c)},
-          {"quantity", "luminance"}, {"value", mean}, {"unit", "cd/m2"},
+          {"quantity", "luminance"},
+          {"value", mean},
+          {"unit", "cd/m2"},
           {"data", {{"row", r}, {"col", c}, {"lamp", lamp}, {"dimmer_percent", 100}, {"readings", readings}}}};
 }
 
@@ -23,8 +25,12 @@ PixelRect at_grid(int row, int col) { return {10 * col, 10 * row, 3, 3}; }
 
 TEST(VerifyLightFromRuns, CabinetGridSpotsWithPooledRepeatability) {
   // Two spots, two readings each; relative deviations ±0.5 % and ±1 %: pooled σ = √((2·0.005² + 2·0.01²)/2).
-  std::vector<nlohmann::json> rows{grid_row(0, 0, {99.5, 100.5}), grid_row(1, 2, {198, 202}), grid_row(0, 0, {5, 5}, "D65"),
-                                   {{"step", "L/CWF/D50/r0c0"}, {"value", 50.0}},};
+  std::vector<nlohmann::json> rows{
+      grid_row(0, 0, {99.5, 100.5}),
+      grid_row(1, 2, {198, 202}),
+      grid_row(0, 0, {5, 5}, "D65"),
+      {{"step", "L/CWF/D50/r0c0"}, {"value", 50.0}},
+  };
   MeasuredScene s;
   add_cabinet_grid(s, rows, {"CWF", 100}, at_grid);
   ASSERT_EQ(s.spots.size(), 2u);
@@ -40,9 +46,13 @@ TEST(VerifyLightFromRuns, CabinetGridSpotsWithPooledRepeatability) {
 
 TEST(VerifyLightFromRuns, FloorMapWithItsFlatFieldResidual) {
   std::vector<nlohmann::json> rows{
-      {{"step", "P/CWF/D100"}, {"quantity", "floor_photograph"},
-       {"data", {{"grid_rows", 8}, {"grid_cols", 10}, {"calibration", {{{"residual_pct", 1.0}}, {{"residual_pct", -2.0}}}}}},},
-      {{"step", "F/CWF/D100/r3c4"}, {"value", 150.0}}, {{"step", "F/CWF/D100/r3c4x"}, {"value", 1.0}},
+      {
+          {"step", "P/CWF/D100"},
+          {"quantity", "floor_photograph"},
+          {"data", {{"grid_rows", 8}, {"grid_cols", 10}, {"calibration", {{{"residual_pct", 1.0}}, {{"residual_pct", -2.0}}}}}},
+      },
+      {{"step", "F/CWF/D100/r3c4"}, {"value", 150.0}},
+      {{"step", "F/CWF/D100/r3c4x"}, {"value", 1.0}},
       {{"step", "C/CWF/D100/r4c4"}, {"value", 120.0}}};
   MeasuredScene s;
   add_floor_luminance(s, rows, {"CWF", 100}, at_grid);

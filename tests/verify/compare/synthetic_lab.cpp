@@ -9,11 +9,11 @@
 namespace colorlab::verify::testing {
 namespace {
 
-constexpr double kStep = 10.0;         // nm
-constexpr double kWhiteCdM2 = 200.0;   // the lamp's perfect diffuser at the chart
+constexpr double kStep = 10.0;        // nm
+constexpr double kWhiteCdM2 = 200.0;  // the lamp's perfect diffuser at the chart
 constexpr double kFloorReflectance = 0.8;
-constexpr double kDriftBound = 0.01;   // the stability campaigns accept (docs/campaigns.md: ≤ 1 % rise)
-constexpr double kLocatorPx = 0.5;     // one σ
+constexpr double kDriftBound = 0.01;  // the stability campaigns accept (docs/campaigns.md: ≤ 1 % rise)
+constexpr double kLocatorPx = 0.5;    // one σ
 constexpr double kFloorPx = 0.5;
 constexpr double kLs110Relative = 0.003;  // one reading
 constexpr int kLs110Readings = 2;
@@ -231,7 +231,8 @@ MeasuredScene SyntheticLab::measure(std::mt19937_64& rng, const Sources& s) cons
     Eigen::MatrixXd A(kPatches, kBasis);
     for (int i = 0; i < kPatches; ++i) A.row(i) = refl_.row(i).cwiseProduct(lamp_) * kStep * basis;
     const Eigen::MatrixXd G = (A.transpose() * A + 1e-6 * (A.transpose() * A).trace() / kBasis *
-                                                       Eigen::MatrixXd::Identity(kBasis, kBasis)).inverse();
+                                                       Eigen::MatrixXd::Identity(kBasis, kBasis))
+                                  .inverse();
     const Eigen::MatrixXd coef = G * A.transpose() * train;
     const Eigen::MatrixXd fitted = A * coef;
     for (int c = 0; c < 3; ++c) {

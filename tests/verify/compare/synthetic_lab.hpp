@@ -25,18 +25,18 @@ struct Sources {  // which noises the draw makes (and the engine is told of)
 };
 
 struct Defects {
-  int patch = -1;              // this patch's reflectance scaled so it is ~3 ΔE00 off under the lamp
+  int patch = -1;  // this patch's reflectance scaled so it is ~3 ΔE00 off under the lamp
   double patch_factor = 1.0;
-  double lamp_factor = 1.0;    // the whole rendering brighter
-  std::string lamp_spd;        // the rendering lit by this CIE illuminant (same luminance) instead of the lamp
-  double floor_factor = 1.0;   // the floor's reflectance in the region below
+  double lamp_factor = 1.0;            // the whole rendering brighter
+  std::string lamp_spd;                // the rendering lit by this CIE illuminant (same luminance) instead of the lamp
+  double floor_factor = 1.0;           // the floor's reflectance in the region below
   int floor_rows = 3, floor_cols = 4;  // the region: rows [0, 3) × cols [0, 4)
 };
 
 class SyntheticLab {
  public:
   SyntheticLab();
-  static constexpr int kPatches = 140;  // 14 × 10, as the SG
+  static constexpr int kPatches = 140;         // 14 × 10, as the SG
   static constexpr int kRows = 8, kCols = 10;  // the cabinet grid's left half
 
   // The spectral rendering a renderer that gets the physics right (or with the planted defects) produces, in
@@ -52,14 +52,14 @@ class SyntheticLab {
   bool floor_region(int row, int col, const Defects& d) const { return row < d.floor_rows && col < d.floor_cols; }
 
  private:
-  std::vector<double> wl_;                 // 400..700 nm, 10 nm
-  Eigen::MatrixXd refl_;                   // patches × bands
-  Eigen::RowVectorXd lamp_;                // the cabinet lamp (CIE F2 = the cabinet's CWF) × κ: radiance of the white
-  Eigen::Matrix3Xd camera_;                // true sensitivities × band width, counts per radiance
-  Eigen::Matrix3Xd cmf_;                   // 683 · CIE 1931 × band width
-  analysis::Xyz white_;                    // XYZ (cd/m²) of the perfect diffuser
+  std::vector<double> wl_;   // 400..700 nm, 10 nm
+  Eigen::MatrixXd refl_;     // patches × bands
+  Eigen::RowVectorXd lamp_;  // the cabinet lamp (CIE F2 = the cabinet's CWF) × κ: radiance of the white
+  Eigen::Matrix3Xd camera_;  // true sensitivities × band width, counts per radiance
+  Eigen::Matrix3Xd cmf_;     // 683 · CIE 1931 × band width
+  analysis::Xyz white_;      // XYZ (cd/m²) of the perfect diffuser
   std::vector<PixelRect> patch_regions_;
-  std::vector<PixelRect> spot_regions_;    // kRows × kCols
+  std::vector<PixelRect> spot_regions_;  // kRows × kCols
   int width_ = 0, height_ = 0;
 
   double floor_field(double x, double y) const;  // relative illumination of the floor at a pixel centre

@@ -206,7 +206,8 @@ TEST(BlenderDaemon, TheDaemonsExportedSceneRenderedByBlenderIsVerifiedThroughThe
       std::cout << kind << ": " << t.compared - t.differ << "/" << t.compared << " agree; differ at";
       for (const auto& w : t.at) std::cout << " " << w;
       std::cout << "\n";
-      EXPECT_GE(1.0 - static_cast<double>(t.differ) / t.compared, 0.90) << kind << "\n" << result["summary"][kind].dump(1);
+      EXPECT_GE(1.0 - static_cast<double>(t.differ) / t.compared, 0.90) << kind << "\n"
+                                                                        << result["summary"][kind].dump(1);
     }
     // The exit status is the verdict: 0 exactly when nothing differs.
     const bool any = k.at("colour_7_3").differ + k.at("colour_7_4").differ > 0;

@@ -44,7 +44,8 @@ bool on_path(const std::string& tool) { return std::system(("command -v " + tool
 void run(const std::string& what, const std::string& cmd, const fs::path& log) {
   const int rc = std::system(("timeout 300 " + cmd + " > " + log.string() + " 2>&1").c_str());
   ASSERT_EQ(rc, 0) << what << " failed (exit " << rc << (WEXITSTATUS(rc) == 124 ? ", killed after 300 s" : "")
-                   << "): " << cmd << "\n" << read_file(log).substr(0, 4000);
+                   << "): " << cmd << "\n"
+                   << read_file(log).substr(0, 4000);
 }
 
 // The first channel of an OpenEXR file, through OpenImageIO (python3-openimageio): a reader colorlab did not write.
@@ -63,7 +64,7 @@ std::vector<float> read_exr(const fs::path& exr, const fs::path& work) {
   [&] {
     run("reading " + exr.string(),
         "/usr/bin/python3 " + (work / "read_exr.py").string() + " " + exr.string() + " " +
-                                       raw.string() + " " + std::to_string(kWidth) + " " + std::to_string(kHeight),
+            raw.string() + " " + std::to_string(kWidth) + " " + std::to_string(kHeight),
         work / "read_exr.log");
   }();
   const std::string bytes = read_file(raw);
@@ -89,7 +90,7 @@ TEST(BlenderRender, TheExportedScenesFloorLuminanceIsTheSimulatorsWithinTheRende
   std::ofstream(work / "grid.json") << testing::cabinet_grid_run(*scene, {sim::Lamp::d65}, {100.0}, 22).dump();
   run("colorlab scene",
       std::string(COLORLAB_BIN_DIR) + "/colorlab scene " + (work / "chart.json").string() + " " +
-                            (work / "grid.json").string() + " --lamp D65 -o " + (work / "scene").string(),
+          (work / "grid.json").string() + " --lamp D65 -o " + (work / "scene").string(),
       work / "scene.log");
   const json exported = json::parse(read_file(work / "scene" / "scene.json"));
 

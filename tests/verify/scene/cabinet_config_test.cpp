@@ -48,8 +48,8 @@ TEST(CabinetConfig, TheDefaultCabinetIsValidAndHasTheDissertationsWidth) {
 
 TEST(CabinetConfig, ATableOverridesTheDefaultsAndItsEmittersReplaceThem) {
   const auto p = write("ok", "[cabinet]\nheight_mm = 550\nchart_center_mm = [500, 150]\n"
-                              "[[cabinet.emitter]]\nlamp = \"D65\"\ncenter_mm = [600, 120]\nsize_mm = [900, 90]\n"
-                              "luminance_cd_m2 = 15000\n");
+                             "[[cabinet.emitter]]\nlamp = \"D65\"\ncenter_mm = [600, 120]\nsize_mm = [900, 90]\n"
+                             "luminance_cd_m2 = 15000\n");
   const auto c = cabinet_from_file(p);
   std::filesystem::remove(p);
   EXPECT_EQ(c.height_mm, 550.0);

@@ -59,7 +59,8 @@ Truth truth_of(const cam::ChartPose& p, const cam::CameraConfig& cc, const sim::
   const double deg = std::numbers::pi / 180;
   const Eigen::Matrix3d R = (Eigen::AngleAxisd(p.rotation_deg * deg, Eigen::Vector3d::UnitZ()) *
                              Eigen::AngleAxisd(p.tilt_deg * deg, Eigen::Vector3d::UnitX()) *
-                             Eigen::AngleAxisd(p.swing_deg * deg, Eigen::Vector3d::UnitY())).toRotationMatrix();
+                             Eigen::AngleAxisd(p.swing_deg * deg, Eigen::Vector3d::UnitY()))
+                                .toRotationMatrix();
   const double f = cc.chart_height_fraction * cc.height * p.distance_mm / sim::chart_height_mm;
   const Eigen::Vector3d t = R * Eigen::Vector3d(-sim::chart_width_mm / 2, -sim::chart_height_mm / 2, 0) +
                             Eigen::Vector3d(p.shift_x * cc.width * p.distance_mm / f, p.shift_y * cc.height * p.distance_mm / f,
@@ -73,11 +74,24 @@ Truth truth_of(const cam::ChartPose& p, const cam::CameraConfig& cc, const sim::
 json characterize_run(const ca::ChartLocation& loc, int width, int height) {
   json corners = json::array();
   for (const auto& c : loc.corners) corners.push_back({c.x, c.y});
-  json row{{"step", "chart/raw"}, {"quantity", "chart_location"}, {"value", loc.confidence},
-           {"data", {{"format", "raw"}, {"corners", corners}, {"width", width}, {"height", height},
-                     {"reprojection_rms_px", loc.reprojection_rms_px},}},};
-  return {{"run", {{"id", "0193c0de-0000-7000-8000-0000000cc0de"}, {"campaign", "characterize-camera"},
-                   {"params", json::object()}, {"status", "finished_ok"},}},
+  json row{
+      {"step", "chart/raw"},
+      {"quantity", "chart_location"},
+      {"value", loc.confidence},
+      {"data", {
+                   {"format", "raw"},
+                   {"corners", corners},
+                   {"width", width},
+                   {"height", height},
+                   {"reprojection_rms_px", loc.reprojection_rms_px},
+               }},
+  };
+  return {{"run", {
+                      {"id", "0193c0de-0000-7000-8000-0000000cc0de"},
+                      {"campaign", "characterize-camera"},
+                      {"params", json::object()},
+                      {"status", "finished_ok"},
+                  }},
           {"measurements", json::array({row})}};
 }
 

@@ -63,13 +63,27 @@ date = "2026-11-29"
 // square-on), as a file: `colorlab scene` takes run files beside run ids.
 json characterize_run() {
   const double s = 1000.0 / 262.0;
-  json corners = json::array({{876 - 131 * s, 584 - 93 * s}, {876 + 131 * s, 584 - 93 * s}, {876 + 131 * s, 584 + 93 * s},
-                              {876 - 131 * s, 584 + 93 * s},});
-  json row{{"step", "chart/raw"}, {"quantity", "chart_location"}, {"value", 1.0},
-           {"data", {{"format", "raw"}, {"corners", corners}, {"width", 1752}, {"height", 1168}, {"reprojection_rms_px", 0.2}}},};
-  return {{"run", {{"id", "0193c0de-0000-7000-8000-0000000cc0de"}, {"campaign", "characterize-camera"},
-                   {"params", json::object()}, {"status", "finished_ok"},}},
-          {"measurements", json::array({row})},};
+  json corners = json::array({
+      {876 - 131 * s, 584 - 93 * s},
+      {876 + 131 * s, 584 - 93 * s},
+      {876 + 131 * s, 584 + 93 * s},
+      {876 - 131 * s, 584 + 93 * s},
+  });
+  json row{
+      {"step", "chart/raw"},
+      {"quantity", "chart_location"},
+      {"value", 1.0},
+      {"data", {{"format", "raw"}, {"corners", corners}, {"width", 1752}, {"height", 1168}, {"reprojection_rms_px", 0.2}}},
+  };
+  return {
+      {"run", {
+                  {"id", "0193c0de-0000-7000-8000-0000000cc0de"},
+                  {"campaign", "characterize-camera"},
+                  {"params", json::object()},
+                  {"status", "finished_ok"},
+              }},
+      {"measurements", json::array({row})},
+  };
 }
 
 std::string read_file(const std::filesystem::path& p) {
@@ -122,7 +136,8 @@ TEST(DaemonCabinet, BadGeometryIsATypedErrorNamingTheLine) {
                         Case{"lens = 3\n", 1, "[[lens]] tables"}}) {
     try {
       colorlab::daemon::parse_config(c.toml, dir / "colorlabd.toml");
-      ADD_FAILURE() << "accepted:\n" << c.toml;
+      ADD_FAILURE() << "accepted:\n"
+                    << c.toml;
     } catch (const Error& e) {
       const std::string what = e.what();
       EXPECT_EQ(e.cls(), colorlab::ErrorClass::bad_parameter) << what;

@@ -83,7 +83,8 @@ std::string read_text(const std::filesystem::path& p) {
 // Written as a 16-bit PGM (the raw mosaic's counts as they are), for `colorlab lens calibrate`.
 void write_pgm(const cam::RawFrame& f, const std::filesystem::path& path) {
   std::ofstream o(path, std::ios::binary);
-  o << "P5\n" << f.width << " " << f.height << "\n65535\n";
+  o << "P5\n"
+    << f.width << " " << f.height << "\n65535\n";
   for (const auto v : f.pixels) o.put(static_cast<char>(v >> 8)).put(static_cast<char>(v & 0xff));
 }
 
@@ -134,7 +135,8 @@ Eigen::Vector3d true_position_mm(const cam::ChartPose& p, const sim::Scene& scen
   const double deg = std::numbers::pi / 180;
   const Eigen::Matrix3d R = (Eigen::AngleAxisd(p.rotation_deg * deg, Eigen::Vector3d::UnitZ()) *
                              Eigen::AngleAxisd(p.tilt_deg * deg, Eigen::Vector3d::UnitX()) *
-                             Eigen::AngleAxisd(p.swing_deg * deg, Eigen::Vector3d::UnitY())).toRotationMatrix();
+                             Eigen::AngleAxisd(p.swing_deg * deg, Eigen::Vector3d::UnitY()))
+                                .toRotationMatrix();
   const Eigen::Vector3d t = R * Eigen::Vector3d(-sim::chart_width_mm / 2, -sim::chart_height_mm / 2, 0) +
                             Eigen::Vector3d(p.shift_x * kWidth * p.distance_mm / kF, p.shift_y * kHeight * p.distance_mm / kF,
                                             p.distance_mm);
@@ -146,21 +148,36 @@ Eigen::Vector3d true_position_mm(const cam::ChartPose& p, const sim::Scene& scen
 json characterize_run(const ca::ChartLocation& loc) {
   json corners = json::array();
   for (const auto& c : loc.corners) corners.push_back({c.x, c.y});
-  json row{{"step", "chart/raw"}, {"quantity", "chart_location"}, {"value", loc.confidence},
-           {"data", {{"format", "raw"}, {"corners", corners}, {"width", kWidth}, {"height", kHeight},
-                     {"reprojection_rms_px", loc.reprojection_rms_px},}},};
-  return {{"run", {{"id", "0193c0de-0000-7000-8000-0000000cc0de"}, {"campaign", "characterize-camera"},
-                   {"params", json::object()}, {"status", "finished_ok"},}},
-          {"measurements", json::array({row})},};
+  json row{
+      {"step", "chart/raw"},
+      {"quantity", "chart_location"},
+      {"value", loc.confidence},
+      {"data", {
+                   {"format", "raw"},
+                   {"corners", corners},
+                   {"width", kWidth},
+                   {"height", kHeight},
+                   {"reprojection_rms_px", loc.reprojection_rms_px},
+               }},
+  };
+  return {
+      {"run", {
+                  {"id", "0193c0de-0000-7000-8000-0000000cc0de"},
+                  {"campaign", "characterize-camera"},
+                  {"params", json::object()},
+                  {"status", "finished_ok"},
+              }},
+      {"measurements", json::array({row})},
+  };
 }
 
 TEST(LensCalibrationSim, RecoversTheSimulatorsLensWithinItsStatedUncertainty) {
   const auto scene = make_scene();
   // Six bench poses: tilted different ways, the chart pushed towards each corner of the frame and across its
   // middle, so the distortion is seen where it is large.
-  const std::vector<cam::ChartPose> poses{pose(20, 0, 0, -0.18, -0.15, 800),  pose(-20, 15, 3, 0.18, -0.15, 850),
+  const std::vector<cam::ChartPose> poses{pose(20, 0, 0, -0.18, -0.15, 800), pose(-20, 15, 3, 0.18, -0.15, 850),
                                           pose(10, -20, -3, -0.18, 0.15, 800), pose(-15, -15, 5, 0.18, 0.15, 850),
-                                          pose(0, 25, -4, 0, 0, 750),         pose(25, 10, 2, 0.05, 0, 900)};
+                                          pose(0, 25, -4, 0, 0, 750), pose(25, 10, 2, 0.05, 0, 900)};
   const auto dir = std::filesystem::temp_directory_path() / ("colorlab-lens-sim-" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   std::vector<CalibrationView> views;
@@ -302,10 +319,10 @@ TEST(LensCalibrationTable, ChosenByNameElseByThePhotographsSize) {
   b.focal_length_mm = 50;
   c.width_px = 1752, c.height_px = 1168, c.intrinsics.cx = 870, c.intrinsics.cy = 580;
   const std::vector<LensCalibration> all{a, b, c};
-  EXPECT_EQ(choose_lens(all, "", 1752, 1168)->name(), c.name());       // the only one of that size
-  EXPECT_FALSE(choose_lens(all, "", 4000, 3000).has_value());          // none: nominal, said so by the export
+  EXPECT_EQ(choose_lens(all, "", 1752, 1168)->name(), c.name());  // the only one of that size
+  EXPECT_FALSE(choose_lens(all, "", 4000, 3000).has_value());     // none: nominal, said so by the export
   EXPECT_EQ(choose_lens(all, b.name(), 3504, 2336)->name(), b.name());
-  EXPECT_THROW(choose_lens(all, "", 3504, 2336), Error);               // two of that size: name one
+  EXPECT_THROW(choose_lens(all, "", 3504, 2336), Error);  // two of that size: name one
   EXPECT_THROW(choose_lens(all, "nothing", 3504, 2336), Error);
 }
 

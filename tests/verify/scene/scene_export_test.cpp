@@ -182,7 +182,9 @@ TEST(SceneExport, TheCliWritesSceneJsonAndTheBlenderScriptFromRunFiles) {
   // A bad run file is a typed refusal with a non-zero exit.
   std::ofstream(dir / "bad.json") << "{not json";
   EXPECT_NE(std::system((std::string(COLORLAB_BIN_DIR) + "/colorlab scene " + (dir / "bad.json").string() + " -o " +
-                         (dir / "out2").string() + " > /dev/null 2>&1").c_str()), 0);
+                         (dir / "out2").string() + " > /dev/null 2>&1")
+                            .c_str()),
+            0);
   std::filesystem::remove_all(dir);
 }
 

@@ -18,11 +18,20 @@ inline nlohmann::json chart_read_run(const sim::Scene& scene, std::uint64_t seed
   nlohmann::json m = nlohmann::json::array();
   for (const auto& p : scene.chart().patches) {
     const sim::Spectrum read = scene.noisy_reflectance(p.reflectance, rng);
-    m.push_back({{"quantity", "reflectance_spectrum"}, {"value", 50.0}, {"unit", "L*"}, {"instrument", "spectrolino"},
-                 {"data", {{"id", p.name}, {"first_nm", read.start_nm}, {"step_nm", read.step_nm}, {"values", read.values}}},});
+    m.push_back({
+        {"quantity", "reflectance_spectrum"},
+        {"value", 50.0},
+        {"unit", "L*"},
+        {"instrument", "spectrolino"},
+        {"data", {{"id", p.name}, {"first_nm", read.start_nm}, {"step_nm", read.step_nm}, {"values", read.values}}},
+    });
   }
-  return {{"run", {{"id", "0193c0de-0000-7000-8000-00000000c4a7"}, {"campaign", "chart-read"},
-                   {"params", {{"chart", "sg"}, {"pitch_mm", 19.0}}}, {"status", "finished_ok"},}},
+  return {{"run", {
+                      {"id", "0193c0de-0000-7000-8000-00000000c4a7"},
+                      {"campaign", "chart-read"},
+                      {"params", {{"chart", "sg"}, {"pitch_mm", 19.0}}},
+                      {"status", "finished_ok"},
+                  }},
           {"measurements", m}};
 }
 
@@ -39,15 +48,29 @@ inline nlohmann::json cabinet_grid_run(const sim::Scene& scene, const std::vecto
           const auto [x, y] = sim::Scene::floor_spot_position_mm(r, c);
           const double truth = scene.lamp_floor_luminance(lamp, level, x, y);
           const double read = truth + scene.luminance_noise_sigma(truth) * n01(rng);
-          m.push_back({{"quantity", "luminance"}, {"value", read}, {"unit", "cd/m2"}, {"instrument", "ls110"},
-                       {"data", {{"row", r}, {"col", c}, {"lamp", std::string(sim::to_string(lamp))},
-                                 {"dimmer_percent", level}, {"readings", {read}},}},});
+          m.push_back({
+              {"quantity", "luminance"},
+              {"value", read},
+              {"unit", "cd/m2"},
+              {"instrument", "ls110"},
+              {"data", {
+                           {"row", r},
+                           {"col", c},
+                           {"lamp", std::string(sim::to_string(lamp))},
+                           {"dimmer_percent", level},
+                           {"readings", {read}},
+                       }},
+          });
         }
       }
     }
   }
-  return {{"run", {{"id", "0193c0de-0000-7000-8000-0000000091d0"}, {"campaign", "cabinet-grid"}, {"params", nlohmann::json::object()},
-                   {"status", "finished_ok"},}},
+  return {{"run", {
+                      {"id", "0193c0de-0000-7000-8000-0000000091d0"},
+                      {"campaign", "cabinet-grid"},
+                      {"params", nlohmann::json::object()},
+                      {"status", "finished_ok"},
+                  }},
           {"measurements", m}};
 }
 

@@ -89,8 +89,13 @@ ca::FitTarget target_of(const std::string& name) {
 }  // namespace
 
 std::string illuminant_of_lamp(const std::string& lamp) {
-  static const std::map<std::string, std::string> table{{"D65", "D65"}, {"D50", "D50"}, {"A", "A"},
-                                                        {"TL84", "F11"}, {"CWF", "F2"},};
+  static const std::map<std::string, std::string> table{
+      {"D65", "D65"},
+      {"D50", "D50"},
+      {"A", "A"},
+      {"TL84", "F11"},
+      {"CWF", "F2"},
+  };
   auto it = table.find(lamp);
   if (it == table.end())
     throw Error(ErrorClass::bad_parameter, "lamp " + lamp + " has no standard spectrum to compare colour under",
@@ -275,7 +280,8 @@ MeasuredScene measured_scene_from_runs(const std::vector<json>& runs, const Rend
     const std::string campaign = run.value("campaign", "");
     if (!run.contains("measurements") || !run["measurements"].is_array())
       throw Error(ErrorClass::bad_data, "run " + id_of(run) + " came without its measurements");
-    const json** slot = campaign == kCharacterize ? &characterize : campaign == kChartRead ? &chart_read : nullptr;
+    const json** slot = campaign == kCharacterize ? &characterize : campaign == kChartRead ? &chart_read
+                                                                                           : nullptr;
     if (!slot) {
       light.push_back(run);
       continue;

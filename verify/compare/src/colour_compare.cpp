@@ -223,7 +223,8 @@ void compare_colour_74(const Rendering& r, const MeasuredScene& s, const Compare
     const Eigen::Vector3d pred = predicted[i] * sc.factor;
     Budget b;
     const Eigen::Matrix3d frame = Eigen::Vector3d(p.frame_noise[0] * p.frame_noise[0], p.frame_noise[1] * p.frame_noise[1],
-                                                  p.frame_noise[2] * p.frame_noise[2]).asDiagonal();
+                                                  p.frame_noise[2] * p.frame_noise[2])
+                                      .asDiagonal();
     b.add("black box", beyond(regional_covariance(cv_points, cv_res, meas / full, o.cv_neighbours), frame));
     b.add("frame noise", frame);
     if (a > 0)

@@ -111,7 +111,7 @@ void add_floor_luminance(MeasuredScene& scene, const std::vector<nlohmann::json>
   if (!(rms > 0))
     throw Error(ErrorClass::bad_data,
                 "the floor map's flat field has no calibration residual to judge it by (" +
-                                          std::to_string(residual_n) + " calibration spots)",
+                    std::to_string(residual_n) + " calibration spots)",
                 "run floor-luminance with more calibration spots than the flat field has terms (degree + 2)");
   for (auto& c : cells) c.relative_sd = rms;
   scene.floor.insert(scene.floor.end(), cells.begin(), cells.end());

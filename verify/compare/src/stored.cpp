@@ -5,8 +5,12 @@ namespace colorlab::verify {
 StoredVerification to_store(const Verification& v, const std::string& rendering, const std::vector<std::string>& against,
                             const CompareOptions& options) {
   StoredVerification s;
-  s.params = {{"rendering", rendering}, {"against", against},
-              {"scale", options.scale ? nlohmann::json(*options.scale) : nlohmann::json(nullptr)}, {"k", options.k},};
+  s.params = {
+      {"rendering", rendering},
+      {"against", against},
+      {"scale", options.scale ? nlohmann::json(*options.scale) : nlohmann::json(nullptr)},
+      {"k", options.k},
+  };
   const auto full = v.to_json();
   s.summary = full["summary"];
   s.summary["floor_difference"] = full["floor_difference"];

@@ -129,8 +129,13 @@ StoredVerification stored_from_request(const json& body) {
 
 json store_request(const Verification& v, const std::string& rendering, const std::vector<std::string>& against,
                    const CompareOptions& options) {
-  return {{"rendering", rendering}, {"against", against},
-          {"scale", options.scale ? json(*options.scale) : json(nullptr)}, {"k", options.k}, {"result", v.to_json()},};
+  return {
+      {"rendering", rendering},
+      {"against", against},
+      {"scale", options.scale ? json(*options.scale) : json(nullptr)},
+      {"k", options.k},
+      {"result", v.to_json()},
+  };
 }
 
 }  // namespace colorlab::verify

@@ -61,8 +61,11 @@ nlohmann::json Verification::summary() const {
         // The source that dominates there is what to improve in the measurement.
         const auto top = std::max_element(c->budget.begin(), c->budget.end(),
                                           [](const auto& a, const auto& b) { return a.second < b.second; });
-        blind.push_back({{"where", c->where}, {"expanded", c->expanded},
-                         {"dominant_source", top == c->budget.end() ? "" : top->first},});
+        blind.push_back({
+            {"where", c->where},
+            {"expanded", c->expanded},
+            {"dominant_source", top == c->budget.end() ? "" : top->first},
+        });
       }
     }
     std::sort(diffs.begin(), diffs.end());
@@ -86,10 +89,19 @@ nlohmann::json Verification::to_json() const {
   for (const auto& c : comparisons) {
     nlohmann::json budget = nlohmann::json::object();
     for (const auto& [name, u] : c.budget) budget[name] = u;
-    items.push_back({{"kind", c.kind}, {"where", c.where}, {"rendered", c.rendered}, {"measured", c.measured},
-                     {"difference", c.difference}, {"expanded", c.expanded}, {"mahalanobis", c.mahalanobis},
-                     {"threshold", c.threshold}, {"verdict", to_string(c.verdict)}, {"cannot_tell", c.cannot_tell},
-                     {"budget", budget},});
+    items.push_back({
+        {"kind", c.kind},
+        {"where", c.where},
+        {"rendered", c.rendered},
+        {"measured", c.measured},
+        {"difference", c.difference},
+        {"expanded", c.expanded},
+        {"mahalanobis", c.mahalanobis},
+        {"threshold", c.threshold},
+        {"verdict", to_string(c.verdict)},
+        {"cannot_tell", c.cannot_tell},
+        {"budget", budget},
+    });
   }
   nlohmann::json floor = nlohmann::json::array();
   for (const auto& row : floor_ratio) {

@@ -155,14 +155,14 @@ bool read_flat_float_scanlines(Imf::InputPart& in, const Imf::Header& header, co
               got != expected)
             bad_data(file,
                      "the ZIP chunk at scanline " + std::to_string(y0) + " does not inflate to its " +
-                               std::to_string(expected) + " bytes",
+                         std::to_string(expected) + " bytes",
                      "the file is corrupt; write it again");
           unpredict_and_interleave(tmp.data(), expected, plain.data());
           chunk = plain.data();
         } else if (raw.size() != expected) {
           bad_data(file,
                    "the chunk at scanline " + std::to_string(y0) + " holds " + std::to_string(raw.size()) +
-                             " bytes, not the " + std::to_string(expected) + " its channels need",
+                       " bytes, not the " + std::to_string(expected) + " its channels need",
                    "the file is corrupt; write it again");
         }
         // Little-endian on disk and in memory (x86-64, aarch64): a float's bytes copy as they are.

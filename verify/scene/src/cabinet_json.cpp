@@ -11,8 +11,12 @@ using nlohmann::json;
 json cabinet_to_json(const CabinetGeometry& c) {
   json emitters = json::array();
   for (const auto& e : c.emitters)
-    emitters.push_back({{"lamp", e.lamp}, {"center_mm", {e.x_mm, e.y_mm}}, {"size_mm", {e.length_mm, e.width_mm}},
-                        {"luminance_cd_m2", e.luminance_cd_m2},});
+    emitters.push_back({
+        {"lamp", e.lamp},
+        {"center_mm", {e.x_mm, e.y_mm}},
+        {"size_mm", {e.length_mm, e.width_mm}},
+        {"luminance_cd_m2", e.luminance_cd_m2},
+    });
   return {{"width_mm", c.width_mm},
           {"depth_mm", c.depth_mm},
           {"height_mm", c.height_mm},

@@ -193,9 +193,19 @@ std::string lens_to_toml(const LensCalibration& l) {
 }
 
 nlohmann::json lens_to_json(const LensCalibration& l) {
-  nlohmann::json j{{"name", l.name()}, {"camera", l.camera}, {"lens", l.lens}, {"focus", l.focus},
-                   {"width_px", l.width_px}, {"height_px", l.height_px}, {"rms_px", l.rms_px},
-                   {"photographs", l.photographs}, {"points", l.points}, {"source", l.source}, {"date", l.date},};
+  nlohmann::json j{
+      {"name", l.name()},
+      {"camera", l.camera},
+      {"lens", l.lens},
+      {"focus", l.focus},
+      {"width_px", l.width_px},
+      {"height_px", l.height_px},
+      {"rms_px", l.rms_px},
+      {"photographs", l.photographs},
+      {"points", l.points},
+      {"source", l.source},
+      {"date", l.date},
+  };
   j["focal_length_mm"] = l.focal_length_mm ? nlohmann::json(*l.focal_length_mm) : nlohmann::json(nullptr);
   nlohmann::json sigma;
   for (std::size_t i = 0; i < kParams.size(); ++i) j[kParams[i]] = param(l.intrinsics, i), sigma[kParams[i]] = param(l.sigma, i);

@@ -19,7 +19,7 @@ using nlohmann::json;
 
 namespace {
 
-constexpr double mm = 1e-3;  // scene.json is in metres, Blender's unit
+constexpr double mm = 1e-3;   // scene.json is in metres, Blender's unit
 constexpr double km = 683.0;  // lm/W, maximum luminous efficacy
 // The SG's outer size (dissertation appendix C.2: 21.59 × 27.94 cm); a CC24 is given the same board.
 constexpr double chart_w_mm = 279.4, chart_h_mm = 215.9;
@@ -181,8 +181,13 @@ json chart_part(const CabinetGeometry& cab, const json& doc, double& first_nm, d
     const auto k = static_cast<std::size_t>(*idx);
     const double bx = (layout.column[k] - (layout.columns - 1) / 2.0) * pitch, by = (layout.row[k] - (layout.rows - 1) / 2.0) * pitch;
     const double fx = cab.chart_center_x_mm + bx, fy = cab.chart_center_y_mm - by;
-    patches.push_back({{"id", pid}, {"index", *idx}, {"center_m", {fx * mm, fy * mm}}, {"size_m", size * mm},
-                       {"reflectance", spectrum(f, s, values)},});
+    patches.push_back({
+        {"id", pid},
+        {"index", *idx},
+        {"center_m", {fx * mm, fy * mm}},
+        {"size_m", size * mm},
+        {"reflectance", spectrum(f, s, values)},
+    });
   }
   for (int i = 0; i < static_cast<int>(layout.ids.size()); ++i)
     if (!seen[static_cast<std::size_t>(i)]) malformed(id, "patch " + layout.ids[static_cast<std::size_t>(i)] + " was not read");
@@ -400,10 +405,15 @@ json export_scene(const CabinetGeometry& cab, const std::vector<json>& runs, con
     if (r.grid) fit = fit_luminance(cab, *e, *r.grid, lamp, o.dimmer_percent, grid_spots);
     if (fit) {
       luminance = fit->luminance;
-      level = {{"source", "fitted"}, {"run", run_id(*r.grid)}, {"spots", fit->spots}, {"rms_residual_pct", fit->rms_pct},
-               {"standard_error_pct", fit->standard_error_pct},
-               {"how", "least squares of the LS-110 floor readings at this dimmer against ρ_floor·L·F(spot), F the "
-                       "emitter's analytic form factor: one factor per lamp"},};
+      level = {
+          {"source", "fitted"},
+          {"run", run_id(*r.grid)},
+          {"spots", fit->spots},
+          {"rms_residual_pct", fit->rms_pct},
+          {"standard_error_pct", fit->standard_error_pct},
+          {"how", "least squares of the LS-110 floor readings at this dimmer against ρ_floor·L·F(spot), F the "
+                  "emitter's analytic form factor: one factor per lamp"},
+      };
     } else if (e->luminance_cd_m2 > 0 && o.dimmer_percent == 100.0) {
       luminance = e->luminance_cd_m2;
       level = {{"source", "configured"}, {"how", "the lab configuration's [[cabinet.emitter]] luminance_cd_m2 at 100 %"}};
@@ -421,10 +431,12 @@ json export_scene(const CabinetGeometry& cab, const std::vector<json>& runs, con
     lamp_parts.push_back(
         {{"name", lamp},
          {"dimmer_percent", o.dimmer_percent},
-         {"emitter", {{"center_m", {e->x_mm * mm, e->y_mm * mm, cab.height_mm * mm}},
-                      {"size_m", {e->length_mm * mm, e->width_mm * mm}},
-                      {"normal", {0, 0, -1}},
-                      {"kind", "Lambertian rectangle, emitting downwards only"},}},
+         {"emitter", {
+                         {"center_m", {e->x_mm * mm, e->y_mm * mm, cab.height_mm * mm}},
+                         {"size_m", {e->length_mm * mm, e->width_mm * mm}},
+                         {"normal", {0, 0, -1}},
+                         {"kind", "Lambertian rectangle, emitting downwards only"},
+                     }},
          {"luminance_cd_m2", luminance},
          {"level", level},
          {"spectral_radiance", spectrum(first_nm, step_nm, radiance)},
@@ -436,21 +448,32 @@ json export_scene(const CabinetGeometry& cab, const std::vector<json>& runs, con
   return {{"schema", scene_schema},
           {"units", {{"length", "m"}, {"spectral_radiance", "W·sr⁻¹·m⁻²·nm⁻¹"}, {"luminance", "cd/m²"}}},
           {"coordinates", "x from the cabinet's left inner wall, y from its open front edge towards the back, z up from the floor"},
-          {"bands", {{"first_nm", first_nm}, {"step_nm", step_nm}, {"count", bands}, {"ybar", ybar_bands},
-                     {"note", "each band is its centre's value held over ±step/2 (box bands, JCGT 2021's default)"},}},
-          {"cabinet", {{"width_m", cab.width_mm * mm}, {"depth_m", cab.depth_mm * mm}, {"height_m", cab.height_mm * mm},
-                       {"front", "open"},
-                       {"walls_reflectance", 0.0},
-                       {"walls_note", "black: the exported scene carries direct light only, as the simulator's geometric cabinet computes it"},
-                       {"floor_reflectance", cab.floor_reflectance},
-                       {"grid_pitch_m", {cab.grid_pitch_x_mm * mm, cab.grid_pitch_y_mm * mm}},}},
+          {"bands", {
+                        {"first_nm", first_nm},
+                        {"step_nm", step_nm},
+                        {"count", bands},
+                        {"ybar", ybar_bands},
+                        {"note", "each band is its centre's value held over ±step/2 (box bands, JCGT 2021's default)"},
+                    }},
+          {"cabinet", {
+                          {"width_m", cab.width_mm * mm},
+                          {"depth_m", cab.depth_mm * mm},
+                          {"height_m", cab.height_mm * mm},
+                          {"front", "open"},
+                          {"walls_reflectance", 0.0},
+                          {"walls_note", "black: the exported scene carries direct light only, as the simulator's geometric cabinet computes it"},
+                          {"floor_reflectance", cab.floor_reflectance},
+                          {"grid_pitch_m", {cab.grid_pitch_x_mm * mm, cab.grid_pitch_y_mm * mm}},
+                      }},
           {"lamps", lamp_parts},
           {"chart", chart},
           {"camera", camera_part(cab, *r.chart, r.camera, o)},
-          {"luminance_scale", {{"instrument", "LS-110"},
-                               {"source_run", r.grid ? json(run_id(*r.grid)) : json(nullptr)},
-                               {"dimmer_percent", o.dimmer_percent},
-                               {"spots", grid_spots},}}};
+          {"luminance_scale", {
+                                  {"instrument", "LS-110"},
+                                  {"source_run", r.grid ? json(run_id(*r.grid)) : json(nullptr)},
+                                  {"dimmer_percent", o.dimmer_percent},
+                                  {"spots", grid_spots},
+                              }}};
 }
 
 void write_scene(const json& scene, const std::filesystem::path& dir) {

@@ -15,9 +15,9 @@ namespace colorlab::analysis {
 Eigen::VectorXd nnls(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, int max_iterations = 0);
 
 struct BlackBoxOptions {
-  double full_scale = 4095;           // RAW counts at saturation (12-bit Canon 20D)
-  bool smoothness = true;             // second-difference penalty
-  std::optional<double> lambda;       // relative penalty weight; unset = chosen by GCV per channel
+  double full_scale = 4095;      // RAW counts at saturation (12-bit Canon 20D)
+  bool smoothness = true;        // second-difference penalty
+  std::optional<double> lambda;  // relative penalty weight; unset = chosen by GCV per channel
   double lambda_min = 1e-9, lambda_max = 1e2;
   int lambda_steps = 45;
   // When set, the curves are fitted under a prior learned from other cameras' measured curves instead of the
@@ -26,7 +26,7 @@ struct BlackBoxOptions {
 };
 
 struct BlackBoxModel {
-  Eigen::MatrixXd sensitivities;  // 3 × bands (R, G, B)
+  Eigen::MatrixXd sensitivities;   // 3 × bands (R, G, B)
   std::array<double, 3> lambda{};  // penalty weights used: relative smoothness weight, or the prior's λ
   bool with_prior = false;
   // With a prior: 3 × bands posterior standard deviations of `sensitivities` (see PriorFit::sdev); credible_band()

@@ -10,11 +10,11 @@
 namespace colorlab::analysis {
 
 struct CgatsTable {
-  std::string file_type;                                   // first line: "CTI3", "SPECT", "CMF", "CGATS.17" ...
+  std::string file_type;                                      // first line: "CTI3", "SPECT", "CMF", "CGATS.17" ...
   std::vector<std::pair<std::string, std::string>> keywords;  // in file order, quotes removed
-  std::vector<std::string> fields;                          // BEGIN_DATA_FORMAT names
-  std::vector<std::vector<std::string>> rows;               // BEGIN_DATA values, one entry per field
-  std::string source;                                       // file name for error messages
+  std::vector<std::string> fields;                            // BEGIN_DATA_FORMAT names
+  std::vector<std::vector<std::string>> rows;                 // BEGIN_DATA values, one entry per field
+  std::string source;                                         // file name for error messages
 
   std::optional<std::string> keyword(std::string_view name) const;
   std::optional<std::size_t> field_index(std::string_view name) const;

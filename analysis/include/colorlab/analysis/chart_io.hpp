@@ -29,7 +29,7 @@ struct Ti3Options {
   // INPUT: a camera or scanner's values of a reflective chart (colprof makes an input profile);
   // OUTPUT: device values a chart was made from, read patch by patch (chartread's kind).
   std::string device_class = "INPUT";
-  bool with_lab = false;  // LAB_L/A/B beside XYZ_X/Y/Z
+  bool with_lab = false;                                      // LAB_L/A/B beside XYZ_X/Y/Z
   std::vector<std::pair<std::string, std::string>> keywords;  // more, e.g. where the data came from
 };
 

@@ -13,7 +13,10 @@
 
 namespace colorlab::analysis {
 
-enum class ChartType { sg140, cc24 };
+enum class ChartType {
+  sg140,
+  cc24
+};
 
 // "sg", "sg140", "cc24", "24" (case-insensitive); throws Error(bad_parameter).
 ChartType chart_type_from_string(std::string_view name);
@@ -21,9 +24,9 @@ std::string_view to_string(ChartType type);  // "sg" / "cc24"
 
 struct ChartLayout {
   ChartType type = ChartType::sg140;
-  std::string name;          // "ColorChecker SG"
+  std::string name;  // "ColorChecker SG"
   int columns = 0, rows = 0;
-  double patch_size = 0.8;   // patch side / pitch
+  double patch_size = 0.8;  // patch side / pitch
   // Patches in the chart's file order: SG A1, A2, …, A10, B1, … (letter = column); CC24 1…24 row by row.
   std::vector<std::string> ids;
   std::vector<int> column, row;  // of each patch, 0-based

@@ -45,18 +45,18 @@ struct LocateOptions {
   std::optional<std::array<Point2, 4>> corners;
   std::optional<LensCalibration> lens;
   std::optional<ChartReference> reference;
-  double sample_fraction = 0.6;   // sampled square side / patch side, before fitting it inside a tilted patch
-  double min_confidence = 0.6;    // below: Error(needs_operator)
-  double neutral_tolerance = 0.05;  // largest relative disagreement of a repeated neutral after the field fit
-  std::optional<double> robust_k;   // robust band half-width; default 5 counts at 8 bit, scaled by 2^(bits−8)
+  double sample_fraction = 0.6;        // sampled square side / patch side, before fitting it inside a tilted patch
+  double min_confidence = 0.6;         // below: Error(needs_operator)
+  double neutral_tolerance = 0.05;     // largest relative disagreement of a repeated neutral after the field fit
+  std::optional<double> robust_k;      // robust band half-width; default 5 counts at 8 bit, scaled by 2^(bits−8)
   const PixelMask* defects = nullptr;  // dead and hot pixels (full frame), excluded from every patch
 };
 
 struct ChartPatchSample {
   std::string id;
-  Point2 centre;                    // image pixels (pixel centres at integers)
-  Rect region;                      // sampled pixels
-  bool detected = false;            // its own square was found (not only predicted by the fit)
+  Point2 centre;          // image pixels (pixel centres at integers)
+  Rect region;            // sampled pixels
+  bool detected = false;  // its own square was found (not only predicted by the fit)
   // When detected: the centroid of its own square as photographed (lens distortion not removed) — the point a lens
   // calibration needs (issue 23), where `centre` is the fit's prediction.
   Point2 observed;
@@ -66,8 +66,8 @@ struct ChartPatchSample {
 
 struct SelfCheck {
   bool passed = true;
-  std::string method;               // "repeated neutrals", "neutral ramp" or "none"
-  double worst_disagreement = 0;    // relative, after removing a smooth field (repeated neutrals)
+  std::string method;             // "repeated neutrals", "neutral ramp" or "none"
+  double worst_disagreement = 0;  // relative, after removing a smooth field (repeated neutrals)
   std::string worst_patch;
   // The light field over the chart from the repeated neutrals: relative change of the brightest group across the
   // chart's width and height (grid axes).
@@ -77,13 +77,13 @@ struct SelfCheck {
 
 struct ChartLocation {
   ChartType type = ChartType::sg140;
-  std::array<Point2, 4> corners;          // image pixels, reading order (see chart_layout.hpp)
-  std::array<double, 9> homography{};     // grid units → undistorted image pixels, row-major
-  int rotation_deg = 0;                   // how the chart is turned in the image: 0, 90, 180, 270 (clockwise)
-  bool from_corners = false;              // the operator's corners were used
-  double confidence = 0;                  // 0..1
-  double orientation_margin = 0;          // best minus second-best orientation score
-  double reprojection_rms_px = 0;         // detected centres vs the fit
+  std::array<Point2, 4> corners;       // image pixels, reading order (see chart_layout.hpp)
+  std::array<double, 9> homography{};  // grid units → undistorted image pixels, row-major
+  int rotation_deg = 0;                // how the chart is turned in the image: 0, 90, 180, 270 (clockwise)
+  bool from_corners = false;           // the operator's corners were used
+  double confidence = 0;               // 0..1
+  double orientation_margin = 0;       // best minus second-best orientation score
+  double reprojection_rms_px = 0;      // detected centres vs the fit
   int patches_detected = 0;
   std::vector<ChartPatchSample> patches;  // layout order
   SelfCheck check;

@@ -9,7 +9,10 @@
 
 namespace colorlab::analysis {
 
-enum class SampleType { u8, u16 };
+enum class SampleType {
+  u8,
+  u16
+};
 
 // A view of pixel data owned elsewhere. channels = 1 (grey or CFA) or 3 (interleaved R, G, B).
 struct PhotoView {
@@ -17,10 +20,10 @@ struct PhotoView {
   int width = 0, height = 0;
   int channels = 1;
   SampleType type = SampleType::u16;
-  std::size_t stride = 0;           // samples per row; 0 = width · channels
-  int bit_depth = 0;                // significant bits (12 for a 12-bit raw); 0 = 8 or 16 from the type
-  double black_level = 0;           // subtracted for finding the chart (not from the reported values)
-  std::optional<CfaPattern> cfa;    // set: a raw mosaic (channels = 1), sampled per CFA colour
+  std::size_t stride = 0;         // samples per row; 0 = width · channels
+  int bit_depth = 0;              // significant bits (12 for a 12-bit raw); 0 = 8 or 16 from the type
+  double black_level = 0;         // subtracted for finding the chart (not from the reported values)
+  std::optional<CfaPattern> cfa;  // set: a raw mosaic (channels = 1), sampled per CFA colour
 
   std::size_t row_stride() const { return stride ? stride : static_cast<std::size_t>(width) * channels; }
   int bits() const { return bit_depth > 0 ? bit_depth : (type == SampleType::u8 ? 8 : 16); }

@@ -10,15 +10,15 @@
 namespace colorlab::analysis {
 
 struct CsvTable {
-  std::vector<std::string> header;               // empty when read without a header row
-  std::vector<std::vector<std::string>> rows;    // each row has header.size() cells (or the first row's count)
-  std::vector<std::size_t> row_lines;            // the file line each row starts on, for messages
+  std::vector<std::string> header;             // empty when read without a header row
+  std::vector<std::vector<std::string>> rows;  // each row has header.size() cells (or the first row's count)
+  std::vector<std::size_t> row_lines;          // the file line each row starts on, for messages
   std::string source;
 
   std::size_t columns() const { return header.empty() ? (rows.empty() ? 0 : rows.front().size()) : header.size(); }
   std::optional<std::size_t> column(std::string_view name) const;
-  std::size_t require_column(std::string_view name) const;  // throws Error(bad_data)
-  double number(std::size_t row, std::size_t col) const;     // throws Error(bad_data) naming file:line
+  std::size_t require_column(std::string_view name) const;                   // throws Error(bad_data)
+  double number(std::size_t row, std::size_t col) const;                     // throws Error(bad_data) naming file:line
   std::optional<double> try_number(std::size_t row, std::size_t col) const;  // nullopt: not a number
   std::size_t line_of(std::size_t row) const;
 };

@@ -44,10 +44,10 @@ struct FlatFieldSample {
 };
 
 struct FlatFieldFit {
-  int degree = 0;                     // terms − 1; lowered to (spots − 1) when fewer spots were given
-  std::vector<double> coefficients;   // c0, c1, …
+  int degree = 0;                    // terms − 1; lowered to (spots − 1) when fewer spots were given
+  std::vector<double> coefficients;  // c0, c1, …
   double centre_x = 0, centre_y = 0, radius = 1;
-  std::vector<double> residual_pct;   // per calibration spot: 100 · (fitted − read) / read
+  std::vector<double> residual_pct;  // per calibration spot: 100 · (fitted − read) / read
   double luminance(double x_px, double y_px, double signal) const;
   double gain(double x_px, double y_px) const;  // cd/m² per unit of signal there
 };

@@ -37,7 +37,7 @@ struct RobustOptions {
 };
 
 struct PatchValue {
-  double value = 0;   // mean of pixels within ±k of the median
+  double value = 0;  // mean of pixels within ±k of the median
   double median = 0;
   std::size_t used = 0, good = 0, total = 0;
 };
@@ -46,7 +46,12 @@ struct PatchValue {
 PatchValue robust_patch_value(const ImageView& image, const Rect& region, const RobustOptions& options = {},
                               const PixelMask* defects = nullptr);
 
-enum class CfaPattern { rggb, bggr, grbg, gbrg };
+enum class CfaPattern {
+  rggb,
+  bggr,
+  grbg,
+  gbrg
+};
 
 // Robust value of each colour of a Bayer mosaic within the region: R, G (both greens), B.
 std::array<PatchValue, 3> cfa_patch_values(const ImageView& raw, const Rect& region, CfaPattern pattern,

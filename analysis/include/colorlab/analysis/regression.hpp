@@ -40,12 +40,15 @@ const char* to_string(FitTarget t);
 
 // How a spline's λ search solves its 41 systems (scattered_data.hpp): one generalised eigendecomposition reused for
 // every λ, or an LU per λ — the original path, kept as the reference the faster one is checked against.
-enum class SmoothingSearch { eigen, direct };
+enum class SmoothingSearch {
+  eigen,
+  direct
+};
 
 struct FitOptions {
   FitTarget target = FitTarget::xyz_then_lab;
-  double ridge = 0;         // Tikhonov weight on the coefficients of the 0..1-scaled terms (0 = plain least squares)
-  double input_scale = 0;   // RGB divisor; 0 = largest training value, so inputs lie in 0..1
+  double ridge = 0;        // Tikhonov weight on the coefficients of the 0..1-scaled terms (0 = plain least squares)
+  double input_scale = 0;  // RGB divisor; 0 = largest training value, so inputs lie in 0..1
   // splines only
   SmoothingSearch spline_search = SmoothingSearch::eigen;
 };
@@ -79,7 +82,11 @@ struct ErrorStats {
 ErrorStats evaluate(const Eigen::MatrixXd& predicted_lab, const Eigen::MatrixXd& reference_lab);
 
 struct CvSpec {
-  enum class Kind { none, leave_one_out, k_fold } kind = Kind::leave_one_out;
+  enum class Kind {
+    none,
+    leave_one_out,
+    k_fold
+  } kind = Kind::leave_one_out;
   int folds = 10;
   unsigned seed = 1;
   static CvSpec loo() { return {}; }

@@ -33,9 +33,9 @@ namespace colorlab::analysis {
 // A lamp's spectrum and where it came from. A lab's TL84 is not CIE F11: the standard tables stand in only until the
 // lamp is measured, and every characterization that rests on one says so (warning()).
 struct LampSpectrum {
-  std::string name;       // the lab's name for the lamp ("TL84", "A", "D65", …)
-  SpectralSet spd;        // one row, any positive scale
-  bool measured = false;  // false: the CIE standard the lamp is named after stands in for it
+  std::string name;             // the lab's name for the lamp ("TL84", "A", "D65", …)
+  SpectralSet spd;              // one row, any positive scale
+  bool measured = false;        // false: the CIE standard the lamp is named after stands in for it
   std::string warning() const;  // empty when measured
 };
 // The CIE standard a cabinet lamp is named after: D65, D50, A, TL84 (→ F11), CWF (→ F2), F-series by name.
@@ -50,7 +50,7 @@ struct RelightingGrids;  // relighting.cpp: what rebuilding a chart under anothe
 struct ChartUnderLamp {
   std::string lamp;
   bool lamp_measured = false;
-  std::string lamp_warning;  // LampSpectrum::warning(), carried into every characterization under this lamp
+  std::string lamp_warning;         // LampSpectrum::warning(), carried into every characterization under this lamp
   std::vector<double> wavelengths;  // the curves' grid
   // n × bands: RAW = radiance · curveᵀ for a curve linear between the grid's wavelengths, integrated at 1 nm
   // (reflectances Sprague or cubic, lamp linear, so a fluorescent line between two bands counts in both).
@@ -89,7 +89,7 @@ SpectralSet draw_nominal_lamp(const SpectralSet& standard, const std::vector<dou
 // Spectral sensitivities with their posterior (the prior-based black box, blackbox.hpp).
 struct SensitivityEstimate {
   std::vector<double> wavelengths;
-  Eigen::MatrixXd curves;                  // 3 × bands, in the RAW's units per unit of ChartUnderLamp::radiance
+  Eigen::MatrixXd curves;                     // 3 × bands, in the RAW's units per unit of ChartUnderLamp::radiance
   std::array<Eigen::MatrixXd, 3> covariance;  // per channel, bands × bands
   // One set of curves drawn from the (Gaussian) posterior, clipped at 0 as the sensitivities are.
   Eigen::MatrixXd draw(std::mt19937& rng) const;
@@ -104,8 +104,8 @@ struct AcrossLampsOptions {
   std::vector<std::string> methods = all_methods();
   std::vector<FitTarget> targets = {FitTarget::xyz_then_lab, FitTarget::xyz_lightness_weighted, FitTarget::lab_direct};
   CvSpec cv = CvSpec::loo();
-  int draws = 40;      // posterior draws propagated to the per-patch uncertainty
-  unsigned seed = 1;   // of the draws: a characterization is reproducible
+  int draws = 40;     // posterior draws propagated to the per-patch uncertainty
+  unsigned seed = 1;  // of the draws: a characterization is reproducible
   // A nominal lamp (not measured) is itself uncertain: each draw also draws the lamp (draw_nominal_lamp). Off: the
   // band carries the sensitivities and the family's misfit only (the bench's before/after; docs/ACCURACY.md §6).
   bool nominal_lamp_uncertainty = true;
@@ -126,8 +126,8 @@ struct LampCharacterization {
   std::string family;  // the chosen family on the predicted chart ("rbf:ccm", "rootpoly:3", …)
   FitTarget target = FitTarget::xyz_then_lab;
   double parameters = 0;
-  ErrorStats cv;               // cross-validated on the predicted chart
-  Characterization model;      // white-balanced RGB under the lamp → L*a*b* (D50)
+  ErrorStats cv;                        // cross-validated on the predicted chart
+  Characterization model;               // white-balanced RGB under the lamp → L*a*b* (D50)
   std::vector<Characterization> draws;  // the family refitted on charts predicted from posterior draws
 
   double misfit95 = 0;  // 95th percentile of the cross-validated ΔE00 on the predicted chart

@@ -7,7 +7,10 @@
 
 namespace colorlab::analysis {
 
-enum class RgbSpace { srgb, adobe_rgb_1998 };
+enum class RgbSpace {
+  srgb,
+  adobe_rgb_1998
+};
 
 using Rgb = std::array<double, 3>;  // encoded (gamma) values on 0..1
 

@@ -25,15 +25,15 @@
 namespace colorlab::analysis {
 
 struct SplineOptions {
-  std::string base = "ccm";                       // polynomial term set under the spline ("ccm", "rootpoly:2", …)
+  std::string base = "ccm";  // polynomial term set under the spline ("ccm", "rootpoly:2", …)
   FitTarget target = FitTarget::xyz_then_lab;
-  double input_scale = 0;                         // as FitOptions::input_scale
-  std::optional<double> smoothing;                // λ; unset = chosen by leave-one-out ΔE00
+  double input_scale = 0;           // as FitOptions::input_scale
+  std::optional<double> smoothing;  // λ; unset = chosen by leave-one-out ΔE00
   double smoothing_min = 1e-8, smoothing_max = 1e2;
   int smoothing_steps = 41;
   // λ is the smoothest grid value whose LOO mean ΔE00 is within this of the best λ's; unset = one standard error of
   // the best λ's mean (the one-standard-error rule of Breiman et al. 1984).
-  std::optional<double> smoothing_tolerance;                      // log-spaced grid
+  std::optional<double> smoothing_tolerance;        // log-spaced grid
   SmoothingSearch search = SmoothingSearch::eigen;  // same λ and fit either way, to rounding; eigen is ~10× cheaper
   // false, at a given λ: the coefficients only, without the hat matrix (an n-column solve, most of a refit's time);
   // effective_parameters() is then NaN. For refits whose model alone is used (the across-lamps band's draws).
@@ -47,8 +47,8 @@ class SplineModel {
   Eigen::MatrixXd predict_target(const Eigen::MatrixXd& rgb) const;  // → XYZ or L*a*b*, as fitted
   const std::string& method() const { return method_; }
   FitTarget target() const { return target_; }
-  double smoothing() const { return smoothing_; }                    // λ used
-  double effective_parameters() const { return dof_; }               // tr(H)
+  double smoothing() const { return smoothing_; }                                    // λ used
+  double effective_parameters() const { return dof_; }                               // tr(H)
   std::size_t base_terms() const { return static_cast<std::size_t>(poly_.rows()); }  // incl. the added 1 and ∛rgb
   double input_scale() const { return input_scale_; }
   std::string describe() const;  // "r³ spline over ccm (λ …, … effective parameters)"

@@ -24,9 +24,9 @@ struct ChannelPrior {
 };
 
 struct SensitivityPrior {
-  std::vector<double> wavelengths;        // the grid the prior was resampled to (the fit's spectral grid)
-  std::array<ChannelPrior, 3> channels;   // R, G, B
-  std::vector<std::string> cameras;       // cameras that went into it, for reports
+  std::vector<double> wavelengths;       // the grid the prior was resampled to (the fit's spectral grid)
+  std::array<ChannelPrior, 3> channels;  // R, G, B
+  std::vector<std::string> cameras;      // cameras that went into it, for reports
 };
 
 // curves: one sample per camera channel, named "<camera>_R", "<camera>_G", "<camera>_B" (the layout of the camspec

@@ -21,7 +21,7 @@ namespace colorlab::analysis {
 struct StabilityOptions {
   // Any fit_method name: poly:N, hong:N, rootpoly:D, ccm, rbf:<term set>.
   std::vector<std::string> methods = {"poly:1", "poly:6", "poly:10", "rootpoly:2"};
-  FitOptions fit;            // target, ridge, input scale (0 = largest training value)
+  FitOptions fit;             // target, ridge, input scale (0 = largest training value)
   CvSpec cv = CvSpec::loo();  // the cross-validated case (leave-one-out or k folds)
   // A case fails when a model could not be fitted, its mean ΔE00 exceeds `tolerance_mean` or its largest exceeds
   // `tolerance_max`. The defaults are the dissertation's: ΔE*ab 4–8 is acceptable depending on the application (§3.2,
@@ -50,14 +50,14 @@ inline constexpr const char* kStabilityKinds[] = {"training", "cross_validated",
 
 struct StabilityCase {
   std::string method;
-  std::string kind;       // one of kStabilityKinds
-  double level = 0;       // noise: σ; exposure: k; training_patches: patches trained on; out_of_gamut: patches held
-                          // out; training, cross_validated, other_lamp: patches evaluated
-  std::string label;      // other_lamp: the lamp's name
+  std::string kind;           // one of kStabilityKinds
+  double level = 0;           // noise: σ; exposure: k; training_patches: patches trained on; out_of_gamut: patches held
+                              // out; training, cross_validated, other_lamp: patches evaluated
+  std::string label;          // other_lamp: the lamp's name
   std::size_t evaluated = 0;  // ΔE00 values summarised (pooled over the draws)
-  bool fitted = true;     // false: no model could be fitted (rank-deficient design); `why` says so
+  bool fitted = true;         // false: no model could be fitted (rank-deficient design); `why` says so
   std::string why;
-  Summary de00;           // min/max/median/mean/stdev; mean = max = inf when not fitted
+  Summary de00;  // min/max/median/mean/stdev; mean = max = inf when not fitted
   bool fails = false;
   // Per patch where the case is one evaluation (training, cross_validated, out_of_gamut, exposure, other_lamp).
   std::vector<std::string> ids;
@@ -66,8 +66,8 @@ struct StabilityCase {
 
 struct StabilityVerdict {
   std::string method;
-  bool fails = false;           // any case fails
-  std::string first_kind;       // the first failing case in suite order ("" when none fails)
+  bool fails = false;      // any case fails
+  std::string first_kind;  // the first failing case in suite order ("" when none fails)
   double first_level = 0;
   std::string first_label;
 };

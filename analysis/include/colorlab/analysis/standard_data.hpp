@@ -6,7 +6,10 @@
 
 namespace colorlab::analysis {
 
-enum class Observer { cie1931_2deg, cie1964_10deg };
+enum class Observer {
+  cie1931_2deg,
+  cie1964_10deg
+};
 
 Observer observer_from_degrees(int degrees);  // 2 or 10; throws Error(bad_parameter)
 // Three rows named xbar, ybar, zbar.

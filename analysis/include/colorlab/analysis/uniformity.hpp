@@ -30,9 +30,9 @@ Eigen::MatrixXd mirror_left_half(const Eigen::MatrixXd& left_half);
 UniformityResult analyse_uniformity(const Eigen::MatrixXd& left_half, const UniformityOptions& options = {});
 
 struct DimmerCheck {
-  double setting = 0;           // e.g. 0.5
-  Eigen::MatrixXd scaled;       // lower setting's difference grid × 1/setting
-  Eigen::MatrixXd error;        // full-power difference grid − scaled
+  double setting = 0;      // e.g. 0.5
+  Eigen::MatrixXd scaled;  // lower setting's difference grid × 1/setting
+  Eigen::MatrixXd error;   // full-power difference grid − scaled
   double max_abs_error = 0;
 };
 // Both grids are mirrored grids' difference distributions (as analyse_uniformity().difference).

@@ -10,23 +10,23 @@
 namespace colorlab {
 
 enum class ErrorClass {
-  timeout,            // no (complete) answer within the deadline
-  no_comms,           // link could not be opened or is gone
-  coms_fail,          // link open but bytes are wrong: framing, parity, garbled
-  protocol_error,     // well-formed but unexpected answer
-  device_error,       // the instrument reported an error code
+  timeout,         // no (complete) answer within the deadline
+  no_comms,        // link could not be opened or is gone
+  coms_fail,       // link open but bytes are wrong: framing, parity, garbled
+  protocol_error,  // well-formed but unexpected answer
+  device_error,    // the instrument reported an error code
   needs_calibration,
-  needs_operator,     // a human must act (power-cycle, place on tile, load chart)
-  misread,            // measurement out of range or invalid; a retry may succeed
+  needs_operator,  // a human must act (power-cycle, place on tile, load chart)
+  misread,         // measurement out of range or invalid; a retry may succeed
   unsupported,
-  bad_parameter,      // caller asked for something invalid
+  bad_parameter,  // caller asked for something invalid
   hardware_fail,
-  bad_data,           // input data (file, spectrum, request) is malformed
-  io_error,           // disk, database
+  bad_data,  // input data (file, spectrum, request) is malformed
+  io_error,  // disk, database
   not_found,
   conflict,
-  script_error,       // a campaign script failed: syntax, runtime error, budget, forbidden call
-  aborted,            // a person or the daemon's shutdown stopped the work on purpose
+  script_error,  // a campaign script failed: syntax, runtime error, budget, forbidden call
+  aborted,       // a person or the daemon's shutdown stopped the work on purpose
   internal,
 };
 

@@ -5,7 +5,13 @@
 
 namespace colorlab::log {
 
-enum class Level { error = 3, warning = 4, notice = 5, info = 6, debug = 7 };
+enum class Level {
+  error = 3,
+  warning = 4,
+  notice = 5,
+  info = 6,
+  debug = 7
+};
 
 void set_level(Level max_level);
 void write(Level level, std::string_view component, std::string_view message);

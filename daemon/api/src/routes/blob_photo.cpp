@@ -61,7 +61,10 @@ BlobPhoto from_array(const fs::path& file, const json& meta) {
     throw Error(ErrorClass::bad_data, "the array's meta has no shape [h, w] or [h, w, c]");
   const long h = shape[0].get<long>(), w = shape[1].get<long>(), c = shape.size() == 3 ? shape[2].get<long>() : 1;
   if (h <= 0 || w <= 0 || (c != 1 && c != 3)) throw Error(ErrorClass::unsupported, "an array of shape " + shape.dump() + " is not a photograph");
-  const std::size_t item = dtype == "<f4" ? 4 : dtype == "<f8" ? 8 : dtype == "<u2" ? 2 : (dtype == "|u1" || dtype == "<u1") ? 1 : 0;
+  const std::size_t item = dtype == "<f4" ? 4 : dtype == "<f8"                   ? 8
+                                            : dtype == "<u2"                     ? 2
+                                            : (dtype == "|u1" || dtype == "<u1") ? 1
+                                                                                 : 0;
   if (item == 0) throw Error(ErrorClass::unsupported, "the chart is located in arrays of dtype <f4, <f8, <u2 or u1, not '" + dtype + "'");
   const std::size_t n = static_cast<std::size_t>(h) * static_cast<std::size_t>(w) * static_cast<std::size_t>(c);
   std::ifstream in(file, std::ios::binary);
@@ -72,10 +75,19 @@ BlobPhoto from_array(const fs::path& file, const json& meta) {
   std::vector<double> v(n);
   for (std::size_t i = 0; i < n; ++i) {
     const char* s = bytes.data() + i * item;
-    if (item == 4) { float f; std::memcpy(&f, s, 4); v[i] = f; }
-    else if (item == 8) { std::memcpy(&v[i], s, 8); }
-    else if (item == 2) { std::uint16_t u; std::memcpy(&u, s, 2); v[i] = u; }
-    else { v[i] = static_cast<unsigned char>(*s); }
+    if (item == 4) {
+      float f;
+      std::memcpy(&f, s, 4);
+      v[i] = f;
+    } else if (item == 8) {
+      std::memcpy(&v[i], s, 8);
+    } else if (item == 2) {
+      std::uint16_t u;
+      std::memcpy(&u, s, 2);
+      v[i] = u;
+    } else {
+      v[i] = static_cast<unsigned char>(*s);
+    }
   }
   BlobPhoto out;
   out.photo.width = static_cast<int>(w);
@@ -85,7 +97,8 @@ BlobPhoto from_array(const fs::path& file, const json& meta) {
   if (c == 1) out.cfa = cfa_from_name(meta.value("cfa", std::string()));
   if (out.cfa && meta.contains("black_level") && meta["black_level"].is_number()) out.black_level = meta["black_level"].get<double>();
   double top = 0;
-  for (double x : v) if (std::isfinite(x)) top = std::max(top, x);
+  for (double x : v)
+    if (std::isfinite(x)) top = std::max(top, x);
   const double white = meta.contains("white_level") && meta["white_level"].is_number() ? meta["white_level"].get<double>() : top;
   out.bits = item == 1 ? 8 : bits_for(std::max(1.0, white));
   if (item == 4 || item == 8) out.scale = std::ldexp(1.0, std::max(0, 16 - bits_for(std::max({1.0, top, white}))));

@@ -49,7 +49,7 @@ HttpResponse post_execution(ApiContext& ctx, const HttpRequest& req, const PathP
   auto ct = req.header("content-type").value_or("");
   if (ct.rfind("application/json", 0) != 0) {
     return problem_response(415, "unsupported-media-type", "Unsupported media type",
-                                 "POST /v1/executions takes application/json, got '" + ct + "'");
+                            "POST /v1/executions takes application/json, got '" + ct + "'");
   }
   json body = json::parse(req.body, nullptr, false);
   if (body.is_discarded()) {
@@ -57,8 +57,8 @@ HttpResponse post_execution(ApiContext& ctx, const HttpRequest& req, const PathP
   }
   if (!body.is_object() || !body.contains("campaign") || !body["campaign"].is_string()) {
     return problem_response(400, "bad-request", "Invalid request",
-                                 "the body must be an object with a string 'campaign' (and optional 'params')",
-                                 "e.g. {\"campaign\": \"luminance-spot\", \"params\": {\"readings\": 3}}");
+                            "the body must be an object with a string 'campaign' (and optional 'params')",
+                            "e.g. {\"campaign\": \"luminance-spot\", \"params\": {\"readings\": 3}}");
   }
   json params = body.value("params", json::object());
   if (body.contains("dry_run") && !body["dry_run"].is_boolean()) {

@@ -17,11 +17,13 @@ HttpResponse get_run_export(ApiContext& ctx, const HttpRequest& req, const PathP
   auto run = db.run(id);
   if (!run) throw Error(ErrorClass::not_found, "no run with id '" + id + "'");
   StoreRunReader runs(db);
-  return rx::export_response(req, format, *run,
-                             [&db](const std::string& run_id, const store::MeasurementFilter& filter,
-                                                      std::int64_t after, unsigned limit) {
-    return db.measurements_page(run_id, filter, after, limit);
-  }, runs);
+  return rx::export_response(
+      req, format, *run,
+      [&db](const std::string& run_id, const store::MeasurementFilter& filter,
+            std::int64_t after, unsigned limit) {
+        return db.measurements_page(run_id, filter, after, limit);
+      },
+      runs);
 }
 
 }  // namespace colorlab::daemon::routes

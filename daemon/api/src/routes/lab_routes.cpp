@@ -39,8 +39,10 @@ HttpResponse get_root(ApiContext& ctx, const HttpRequest&, const PathParams&) {
                                   {"simulated_lab", ctx.simulated_lab},
                                   {"running_executions", ctx.executions.running()},
                                   {"features", features},
-                                  {"limits", {{"max_request_body", protocol::kMaxRequestBody},
-                                              {"max_page_limit", protocol::kMaxPageLimit},}}});
+                                  {"limits", {
+                                                 {"max_request_body", protocol::kMaxRequestBody},
+                                                 {"max_page_limit", protocol::kMaxPageLimit},
+                                             }}});
 }
 
 HttpResponse get_instruments(ApiContext& ctx, const HttpRequest&, const PathParams&) {

@@ -106,7 +106,7 @@ ca::ChartReference reference_from_run(ApiContext& ctx, const std::string& run_id
   if (ref.value("chart", std::string()) != ca::to_string(chart))
     throw Error(ErrorClass::bad_parameter,
                 "reference_run " + run_id + " read a " + ref.value("chart", std::string("?")) + " chart, not " +
-                                               std::string(ca::to_string(chart)),
+                    std::string(ca::to_string(chart)),
                 "give a chart-read run of the chart in the photograph");
   const ca::ChartLayout& layout = ca::chart_layout(chart);
   ca::ChartReference out;

@@ -24,7 +24,7 @@ std::variant<json, HttpResponse> json_body(const HttpRequest& req, const std::st
   auto ct = req.header("content-type").value_or("");
   if (ct.rfind("application/json", 0) != 0) {
     return problem_response(415, "unsupported-media-type", "Unsupported media type",
-                                 req.method + " " + req.path + " takes application/json, got '" + ct + "'");
+                            req.method + " " + req.path + " takes application/json, got '" + ct + "'");
   }
   json body = json::parse(req.body, nullptr, false);
   if (body.is_discarded()) return problem_response(400, "bad-json", "Malformed JSON", "the request body is not valid JSON");

@@ -22,7 +22,7 @@ HttpResponse report_response(ReportService* reports, const HttpRequest& req, con
   const auto state = reports->request(key, run_ids);
   if (state.kind == ReportService::State::Kind::failed) {
     return problem_response(500, "report-failed", "Report failed", state.error,
-                                 "the daemon retries a minute after a failure; its log says more");
+                            "the daemon retries a minute after a failure; its log says more");
   }
   if (state.kind == ReportService::State::Kind::generating) {
     HttpResponse g;
@@ -33,7 +33,8 @@ HttpResponse report_response(ReportService* reports, const HttpRequest& req, con
     if (req.header("accept").value_or("").find("text/html") != std::string::npos) {
       g.content_type = "text/html; charset=utf-8";
       g.body = "<!doctype html><meta charset=utf-8><meta http-equiv=refresh content=2><link rel=icon href=\"data:,\"><title>Making the report…</title>"
-               "<p>Making the report of " + what + "… this page reloads itself.</p>";
+               "<p>Making the report of " +
+               what + "… this page reloads itself.</p>";
     } else {
       g.body = json{{"state", "generating"}, {"report", key}, {"runs", run_ids}, {"retry_after_s", 2}}.dump();
     }

@@ -232,7 +232,8 @@ std::string camera_ti3(const store::RunRecord& run, const std::vector<store::Mea
   for (std::size_t i = 0; i < reference.at("ids").size(); ++i) ref[reference["ids"][i].get<std::string>()] = i;
   // 8- and 16-bit codes have a full scale; raw counts above black have none recorded, so the largest is 100.
   const std::string unit = rows.front()->unit;
-  double full = unit == "8-bit code" ? 255.0 : unit == "16-bit code" ? 65535.0 : 0.0;
+  double full = unit == "8-bit code" ? 255.0 : unit == "16-bit code" ? 65535.0
+                                                                     : 0.0;
   std::vector<std::array<double, 3>> rgb;
   for (const auto* m : rows) {
     rgb.push_back(triple(m->data, "rgb", *m));

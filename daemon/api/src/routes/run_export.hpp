@@ -13,7 +13,11 @@
 
 namespace colorlab::daemon::run_export {
 
-enum class Format { ti3, csv, json };
+enum class Format {
+  ti3,
+  csv,
+  json
+};
 
 // "ti3", "csv" or "json"; throws Error(bad_parameter) naming the choices.
 Format parse_format(std::string_view name);

@@ -74,9 +74,15 @@ HttpResponse get_shipping(ApiContext& ctx, const HttpRequest&, const PathParams&
   // A bench that does not ship has nothing to count, and the console asks every few seconds: without a position
   // the backlog would read the whole event log each time.
   if (!ctx.blobs->config().keep_unshipped && agent.is_null()) {
-    return HttpResponse::json(200, json{{"enabled", false}, {"shipped_position", position}, {"last_event", nullptr},
-                                        {"lag", nullptr}, {"agent", nullptr}, {"last_error", nullptr},
-                                        {"agent_seen_s_ago", nullptr},});
+    return HttpResponse::json(200, json{
+                                       {"enabled", false},
+                                       {"shipped_position", position},
+                                       {"last_event", nullptr},
+                                       {"lag", nullptr},
+                                       {"agent", nullptr},
+                                       {"last_error", nullptr},
+                                       {"agent_seen_s_ago", nullptr},
+                                   });
   }
   // A read-only connection of its own: the pool's connections belong to their threads' snapshots, and this one
   // reads the log after the agent's position only.

@@ -28,8 +28,11 @@ HttpResponse post_verification(ApiContext& ctx, const HttpRequest& req, const Pa
                   "colorlab runs lists this daemon's runs");
   }
   const std::string run_id = verify::store_verification(ctx.store, stored);
-  auto r = HttpResponse::json(201, {{"run_id", run_id}, {"verdict", stored.summary["verdict"]},
-                                    {"comparisons", stored.measurements.size()},});
+  auto r = HttpResponse::json(201, {
+                                       {"run_id", run_id},
+                                       {"verdict", stored.summary["verdict"]},
+                                       {"comparisons", stored.measurements.size()},
+                                   });
   r.headers["Location"] = std::string(protocol::kPrefix) + "/runs/" + run_id;
   return r;
 }

@@ -67,7 +67,7 @@ Camera::Connected SimulatedCamera::do_connect() {
   if (ec) {
     throw Error(ErrorClass::io_error,
                 "cannot create capture directory " + options_.capture_dir.string() + ": " +
-                                          ec.message(),
+                    ec.message(),
                 "check the path and permissions");
   }
   unplugged_ = false;
@@ -89,8 +89,12 @@ void SimulatedCamera::do_disconnect() noexcept {}
 
 void SimulatedCamera::do_configure(const CameraSettings& s) {
   if (unplugged_) {
-    throw Error(ErrorInfo{.cls = ErrorClass::no_comms, .message = name() + " is unplugged",
-                          .hint = "reconnect the camera", .retryable = true,});
+    throw Error(ErrorInfo{
+        .cls = ErrorClass::no_comms,
+        .message = name() + " is unplugged",
+        .hint = "reconnect the camera",
+        .retryable = true,
+    });
   }
   std::lock_guard lock(fault_mutex_);
   if (s.iso) exposure_.iso = *s.iso;

@@ -33,8 +33,8 @@ struct BackupReport {
   std::uint64_t database_bytes = 0;
   std::int64_t last_event = 0;
   std::int64_t runs = 0;
-  std::int64_t blobs = 0;           // referenced by the snapshot
-  std::int64_t blobs_uploaded = 0;  // not in the bucket before
+  std::int64_t blobs = 0;                  // referenced by the snapshot
+  std::int64_t blobs_uploaded = 0;         // not in the bucket before
   std::vector<std::string> blobs_missing;  // neither on the bench's disk nor in the bucket: lost before this backup
   std::vector<std::string> rotated_out;    // snapshots removed by the rotation policy
 };

@@ -21,7 +21,7 @@ struct CentralConfig {
   std::filesystem::path s3_ca_file;       // an https:// store's CA (PEM); empty: the system's CAs
   std::filesystem::path tls_certificate;  // both set: the listener speaks TLS
   std::filesystem::path tls_private_key;
-  bool allow_plaintext = false;           // beyond loopback without TLS (keys would cross in the clear)
+  bool allow_plaintext = false;  // beyond loopback without TLS (keys would cross in the clear)
 
   // The API keys (colorlabd's own key table, the same hashes and checks): colorlab-central keys ...
   std::filesystem::path keys_database() const { return state_dir / "central-keys.db"; }

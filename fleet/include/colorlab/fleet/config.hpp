@@ -10,10 +10,10 @@ namespace colorlab::fleet {
 
 struct ShipConfig {
   std::filesystem::path state_dir = "./colorlab-state";  // colorlabd's: colorlab.db and blobs/
-  std::string bench_id;                                   // stable, unique in the lab: the events' key
+  std::string bench_id;                                  // stable, unique in the lab: the events' key
   std::string bench_name;
-  std::string postgres;      // libpq conninfo; a password belongs in a passfile=, never here
-  std::string s3_endpoint;   // e.g. https://s3.lab.example:443 (path-style requests)
+  std::string postgres;     // libpq conninfo; a password belongs in a passfile=, never here
+  std::string s3_endpoint;  // e.g. https://s3.lab.example:443 (path-style requests)
   std::string bucket;
   std::string region = "us-east-1";
   std::filesystem::path access_key_file;
@@ -21,7 +21,7 @@ struct ShipConfig {
   // An https:// s3_endpoint's CA (PEM) when the store's certificate is not signed by a CA the system trusts
   // (docs/fleet.md, "HTTPS object store"); empty: the system's CA certificates.
   std::filesystem::path s3_ca_file;
-  int batch_runs = 50;       // runs shipped per cycle
+  int batch_runs = 50;  // runs shipped per cycle
   // One PostgreSQL transaction (one fsync'd commit) takes consecutive runs until it holds transaction_runs runs
   // or at least transaction_measurements measurements; a run is never split (docs/fleet.md, "Sizing").
   int transaction_runs = 100;

@@ -25,7 +25,7 @@ struct CycleReport {
   int runs_shipped = 0;
   std::int64_t measurements = 0;
   std::int64_t events = 0;
-  int blobs_uploaded = 0;  // not already in the bucket
+  int blobs_uploaded = 0;               // not already in the bucket
   std::vector<Divergence> divergences;  // shipping stopped at the first
   // Runs a restored bench ended again that central holds from before the restore (backup.hpp): central's copy
   // stays, the position moves on.

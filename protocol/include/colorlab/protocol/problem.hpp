@@ -9,12 +9,18 @@
 
 namespace colorlab::protocol {
 
-enum class ProblemCategory { validation, defined_execution, undefined_execution, framework, connection };
+enum class ProblemCategory {
+  validation,
+  defined_execution,
+  undefined_execution,
+  framework,
+  connection
+};
 std::string_view to_string(ProblemCategory c);
 
 struct Problem {
   int status = 500;
-  std::string code;    // stable, documented: "not-found", "bad-json", ...
+  std::string code;  // stable, documented: "not-found", "bad-json", ...
   std::string title;
   std::string detail;
   ProblemCategory category = ProblemCategory::framework;

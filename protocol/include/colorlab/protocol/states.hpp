@@ -8,7 +8,16 @@
 
 namespace colorlab::protocol {
 
-enum class ExecutionStatus { waiting, running, paused, suspended, finished_ok, finished_error, aborted, interrupted };
+enum class ExecutionStatus {
+  waiting,
+  running,
+  paused,
+  suspended,
+  finished_ok,
+  finished_error,
+  aborted,
+  interrupted
+};
 
 std::string_view to_string(ExecutionStatus s);
 std::optional<ExecutionStatus> execution_status_from_string(std::string_view s);

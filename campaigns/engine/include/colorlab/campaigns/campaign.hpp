@@ -15,12 +15,12 @@
 namespace colorlab::campaigns {
 
 struct Measurement {
-  std::string step;           // stable key within the run, e.g. "spot/r3c4/reading/2"
+  std::string step;  // stable key within the run, e.g. "spot/r3c4/reading/2"
   std::string instrument_id;
-  std::string quantity;       // "luminance", "reflectance_spectrum", ...
-  double value = 0;           // scalar value, or NaN when the payload is in `data`
+  std::string quantity;  // "luminance", "reflectance_spectrum", ...
+  double value = 0;      // scalar value, or NaN when the payload is in `data`
   std::string unit;
-  nlohmann::json data;        // spectra, raw replies, positions
+  nlohmann::json data;  // spectra, raw replies, positions
 };
 
 // Implemented by the daemon's store; a recorded measurement is durable when record() returns.

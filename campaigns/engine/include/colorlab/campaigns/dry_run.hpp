@@ -31,8 +31,8 @@ struct DryRunSetup {
   std::shared_ptr<const CampaignScript> script;
   nlohmann::json params;  // validated, defaults filled in
   const InstrumentSet* instruments = nullptr;
-  LabOptions options;     // time scale, the stability criterion, the configured lamp warm-up
-  TimingBook timings;     // what each kind of call has cost on this lab
+  LabOptions options;  // time scale, the stability criterion, the configured lamp warm-up
+  TimingBook timings;  // what each kind of call has cost on this lab
   RunReader* runs = nullptr;
   const OperatorHands* hands = nullptr;  // actions the simulated lab does itself
   std::filesystem::path state_dir;       // where the run's data would go (free space)

@@ -59,23 +59,29 @@ class ExecutionSink {
 };
 
 struct RunOutcome {
-  enum class Kind { finished, paused, aborted, suspended, failed };
+  enum class Kind {
+    finished,
+    paused,
+    aborted,
+    suspended,
+    failed
+  };
   Kind kind = Kind::failed;
-  nlohmann::json result;             // the run function's return value (finished)
-  std::optional<Error> error;        // failed
-  nlohmann::json script_location;    // failed in the script: {script, line, step, traceback}
-  std::string reason;                // paused, aborted, suspended
-  std::int64_t calls = 0;            // lab calls made, replayed included
-  std::int64_t replayed = 0;         // of which answered from the journal
+  nlohmann::json result;           // the run function's return value (finished)
+  std::optional<Error> error;      // failed
+  nlohmann::json script_location;  // failed in the script: {script, line, step, traceback}
+  std::string reason;              // paused, aborted, suspended
+  std::int64_t calls = 0;          // lab calls made, replayed included
+  std::int64_t replayed = 0;       // of which answered from the journal
 };
 
 struct ScriptRunSetup {
   std::shared_ptr<const CampaignScript> script;
-  nlohmann::json params;                   // validated, defaults filled in
-  std::vector<JournalEntry> journal;       // committed calls of a previous attempt, in order
-  std::set<std::string> stored_steps;      // recorded steps already stored
+  nlohmann::json params;               // validated, defaults filled in
+  std::vector<JournalEntry> journal;   // committed calls of a previous attempt, in order
+  std::set<std::string> stored_steps;  // recorded steps already stored
   std::uint64_t random_seed = 0;
-  std::string initial_label;               // progress label to start from
+  std::string initial_label;  // progress label to start from
   double initial_progress = 0;
   // After a crash the port, even the unit, may have changed: instrument id → serial recorded when
   // the run started. A unit that now reports another serial pauses the run for the operator

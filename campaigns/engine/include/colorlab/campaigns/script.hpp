@@ -16,9 +16,9 @@ namespace colorlab::campaigns {
 inline constexpr const char* kRoles[] = {"luminance_meter", "spectrophotometer", "table", "lamps", "dimmer", "camera"};
 
 struct CampaignScript {
-  std::string name;         // the file's stem; the API's campaign name
+  std::string name;            // the file's stem; the API's campaign name
   std::filesystem::path path;  // empty for a script read back from a run
-  std::string origin;       // "shipped", "lab" or "stored"
+  std::string origin;          // "shipped", "lab" or "stored"
   std::string source;
   std::string sha256;
   std::string description;

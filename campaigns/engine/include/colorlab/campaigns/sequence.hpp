@@ -19,11 +19,11 @@
 namespace colorlab::campaigns {
 
 struct SequenceStep {
-  std::string name;      // unique within the sequence
+  std::string name;  // unique within the sequence
   std::string campaign;
   nlohmann::json params = nlohmann::json::object();
   std::optional<std::string> reference_param, reference_step;  // both or neither
-  std::string covers;    // what of the report the step is for
+  std::string covers;                                          // what of the report the step is for
   nlohmann::json to_json() const;
 };
 

@@ -6,7 +6,12 @@
 namespace colorlab::campaigns {
 
 struct ExecutionControl {
-  enum class Request { none, pause, abort, shutdown };
+  enum class Request {
+    none,
+    pause,
+    abort,
+    shutdown
+  };
   Request request = Request::none;
   std::string reason;
   std::string execution_id;  // whose calls these are (operator requests name it)

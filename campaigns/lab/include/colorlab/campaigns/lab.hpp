@@ -44,8 +44,8 @@ struct StabilityCriterion {
 // disk): it is suspended, the condition is checked every `retry_s`, and once it has cleared and
 // stayed clear for `settle_s` the interrupted step is measured again. After `max_s` it fails.
 struct SuspendPolicy {
-  double retry_s = 30;    // lab seconds between checks (at least 0.2 s of wall time)
-  double settle_s = 60;   // lab seconds the condition must stay clear
+  double retry_s = 30;   // lab seconds between checks (at least 0.2 s of wall time)
+  double settle_s = 60;  // lab seconds the condition must stay clear
   double max_s = 8 * 3600;
   // A reading below this fraction of what the last stable reading predicts means a lamp went out, at the aim
   // where the lamps were found stable.
@@ -62,10 +62,10 @@ struct SuspendPolicy {
 };
 
 struct LabOptions {
-  double time_scale = 1;              // lab seconds per wall-clock second (the simulator's time scale)
-  StabilityCriterion warmup;          // how a resume decides that relit lamps are stable again
-  double lamp_warmup_s = 900;         // with no luminance meter: wait this long after relighting
-  bool lamps_off_at_shutdown = false; // otherwise lamps stay as they are (a warm cabinet for the next run)
+  double time_scale = 1;               // lab seconds per wall-clock second (the simulator's time scale)
+  StabilityCriterion warmup;           // how a resume decides that relit lamps are stable again
+  double lamp_warmup_s = 900;          // with no luminance meter: wait this long after relighting
+  bool lamps_off_at_shutdown = false;  // otherwise lamps stay as they are (a warm cabinet for the next run)
   std::chrono::seconds connect_timeout{60};
   SuspendPolicy suspend;
 };

@@ -25,10 +25,20 @@ struct LabState;
 // How the journal and a replay treat a call: an effect changes the lab (a replay folds it into the
 // state the lab is restored to), a reading returns a value (a replay answers it from the journal),
 // control only marks a safe point (the step is committed; nothing is journaled).
-enum class CallKind { effect, reading, control };
+enum class CallKind {
+  effect,
+  reading,
+  control
+};
 
 // An argument's type as a script passes it; a list and a table both accept an empty Lua table.
-enum class ArgType { string, number, boolean, list, table };
+enum class ArgType {
+  string,
+  number,
+  boolean,
+  list,
+  table
+};
 struct ArgSpec {
   ArgType type;
   bool optional = false;

@@ -18,7 +18,7 @@ namespace colorlab::campaigns {
 struct LightDrift {
   std::vector<std::string> lamps;
   double dimmer_percent = 0;
-  double expected = 0;    // the level's reference
+  double expected = 0;  // the level's reference
   double reading = 0;
   double change_pct = 0;  // (reading − expected) / expected, in %
 };

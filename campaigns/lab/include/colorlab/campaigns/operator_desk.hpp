@@ -17,18 +17,18 @@
 namespace colorlab::campaigns {
 
 struct OperatorRequest {
-  std::string id;            // UUIDv7
+  std::string id;  // UUIDv7
   std::string execution_id;
-  std::string action;        // "aim_meter", "load_chart", "white_tile", "confirm", or the script's own word
-  std::string prompt;        // what to do, in words for a person
+  std::string action;  // "aim_meter", "load_chart", "white_tile", "confirm", or the script's own word
+  std::string prompt;  // what to do, in words for a person
   std::vector<std::string> options;
   std::string default_option;
-  double timeout_s = 0;      // lab seconds until the default is taken
-  nlohmann::json details;    // e.g. {"row": 2, "col": 7}
-  std::string posted_at;     // ISO 8601 UTC
-  std::string deadline;      // ISO 8601 UTC, wall clock (lab seconds divided by the time scale)
+  double timeout_s = 0;    // lab seconds until the default is taken
+  nlohmann::json details;  // e.g. {"row": 2, "col": 7}
+  std::string posted_at;   // ISO 8601 UTC
+  std::string deadline;    // ISO 8601 UTC, wall clock (lab seconds divided by the time scale)
   std::optional<std::string> answer;
-  std::string answered_by;   // "operator", "default", "simulator", or the API client's name
+  std::string answered_by;  // "operator", "default", "simulator", or the API client's name
 
   nlohmann::json to_json() const;
 };
@@ -42,7 +42,7 @@ class OperatorHands {
  public:
   virtual ~OperatorHands() = default;
   virtual boost::asio::awaitable<std::optional<nlohmann::json>> perform(const std::string& action,
-                                                                         const nlohmann::json& details) = 0;
+                                                                        const nlohmann::json& details) = 0;
   // Whether perform would do `action` itself (a dry run lists the rest as waits for a person).
   virtual bool can_perform(const std::string& action) const = 0;
 };

@@ -11,7 +11,7 @@
 namespace colorlab::drivers::camera {
 class Camera;
 class CameraInstrument;
-}
+}  // namespace colorlab::drivers::camera
 
 namespace colorlab::campaigns {
 

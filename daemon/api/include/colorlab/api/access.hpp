@@ -77,7 +77,13 @@ class Access {
   ControlLock* control() const { return control_; }
 
  private:
-  enum class KeyState { none, ok, malformed, unknown, revoked };
+  enum class KeyState {
+    none,
+    ok,
+    malformed,
+    unknown,
+    revoked
+  };
   struct Identified {
     Caller caller;
     KeyState key = KeyState::none;
@@ -92,7 +98,7 @@ class Access {
   ControlLock* control_;
   KeyFailureLimit failures_;
   mutable std::mutex mutex_;
-  std::map<std::string, store::ApiKeyEntry> keys_;  // by secret SHA-256
+  std::map<std::string, store::ApiKeyEntry> keys_;                        // by secret SHA-256
   std::map<std::string, std::chrono::steady_clock::time_point> touched_;  // key id → last write
 };
 

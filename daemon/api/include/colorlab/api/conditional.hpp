@@ -11,7 +11,11 @@ namespace colorlab::daemon {
 // unit, a malformed header — is answered whole, as the RFC allows; a range that starts beyond the
 // end is unsatisfiable (416).
 struct ByteRange {
-  enum class Kind { whole, partial, unsatisfiable } kind = Kind::whole;
+  enum class Kind {
+    whole,
+    partial,
+    unsatisfiable
+  } kind = Kind::whole;
   std::uint64_t first = 0;
   std::uint64_t last = 0;  // inclusive
 };

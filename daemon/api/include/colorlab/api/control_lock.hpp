@@ -26,8 +26,9 @@ class ControlLock {
   // Receives each event's payload; the daemon posts it to the writer's thread.
   using EventSink = std::function<void(const nlohmann::json&)>;
 
-  explicit ControlLock(std::chrono::seconds lease, EventSink record = {},
-                       std::function<Clock::time_point()> now = [] { return Clock::now(); });
+  explicit ControlLock(
+      std::chrono::seconds lease, EventSink record = {},
+      std::function<Clock::time_point()> now = [] { return Clock::now(); });
 
   struct Holder {
     std::string identity;  // "key:<id>" or "local": who may renew and release it
@@ -44,8 +45,8 @@ class ControlLock {
   // `force` (admin only: 403 otherwise), which breaks it. Returns the status or that problem.
   struct Outcome {
     bool ok = true;
-    nlohmann::json status;         // when ok
-    http::HttpResponse problem;    // when not
+    nlohmann::json status;       // when ok
+    http::HttpResponse problem;  // when not
   };
   Outcome acquire(const Caller& caller, const std::string& name, bool force);
   // Gives the lock up. Not held: nothing to do. Held by another: 409 unless `force` (admin).

@@ -17,7 +17,10 @@ struct ApiContext;
 // thread's own read-only store connection (ctx.reads()) — for routes that read stored data only.
 // `main`: posted to the daemon's main (io) thread, where live state (executions, instruments, the
 // queue, the writer connection) lives and requests are handled in order.
-enum class Placement { pool, main };
+enum class Placement {
+  pool,
+  main
+};
 
 // The values of a pattern's {name} segments, e.g. {"id": "0190…"} for /v1/runs/{id}.
 class PathParams {

@@ -19,11 +19,11 @@ namespace colorlab::daemon {
 
 // Where a request goes, found once (the daemon needs the thread before it can answer).
 struct Routed {
-  bool console = false;        // outside /v1: a console file
+  bool console = false;          // outside /v1: a console file
   const Route* route = nullptr;  // null: no row serves the request
   PathParams params;
-  std::string allow;           // with no row: the path's methods ("GET, HEAD, POST"), empty when no path matches
-  Scope scope = Scope::read;   // what the access check requires (step 3)
+  std::string allow;          // with no row: the path's methods ("GET, HEAD, POST"), empty when no path matches
+  Scope scope = Scope::read;  // what the access check requires (step 3)
   // The row's; without one the pool (404, 405 and console files touch no live state).
   Placement placement() const;
 };

@@ -6,7 +6,11 @@
 
 namespace colorlab::daemon {
 
-enum class Scope { read = 0, control = 1, admin = 2 };
+enum class Scope {
+  read = 0,
+  control = 1,
+  admin = 2
+};
 std::string_view to_string(Scope s);
 std::optional<Scope> scope_from_string(std::string_view s);
 

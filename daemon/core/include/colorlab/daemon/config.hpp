@@ -14,7 +14,7 @@
 namespace colorlab::daemon {
 
 struct SimulatorConfig {
-  bool enabled = false;                       // start colorlab-sim as a child process
+  bool enabled = false;                         // start colorlab-sim as a child process
   std::optional<std::filesystem::path> config;  // its TOML; none = the default lab
   std::optional<double> time_scale;
   std::optional<std::uint64_t> seed;
@@ -24,15 +24,15 @@ struct SimulatorConfig {
 // [priority]: CPU priority of the heavy work beside the threads that answer (docs/configuration.md,
 // "CPU priority"; core/thread_priority.hpp). Nice steps below colorlabd's own; 0 = the same.
 struct PriorityConfig {
-  int heavy_work_nice = 0;   // worker pool (fits, analyses), RAW decoding, reports, the blob check
-  int simulator_nice = 0;    // the embedded simulated lab: a real lab's instruments have their own processors
+  int heavy_work_nice = 0;  // worker pool (fits, analyses), RAW decoding, reports, the blob check
+  int simulator_nice = 0;   // the embedded simulated lab: a real lab's instruments have their own processors
 };
 
 // [campaigns]: where the lab's own scripts live, and how executions survive restarts.
 struct CampaignConfig {
   // default: <state_dir>/campaigns
   std::optional<std::filesystem::path> directory;
-  int max_resume_attempts = 3;       // restarts in a row without a committed step before the crash-loop guard trips
+  int max_resume_attempts = 3;  // restarts in a row without a committed step before the crash-loop guard trips
   // The guard suspends the execution and retries it itself after a back-off that doubles from
   // crash_loop_backoff_s up to crash_loop_backoff_max_s (the daemon's own seconds, not lab seconds), at
   // most crash_loop_retries times; a crash after the last retry ends the run (its queue item's on_failure).
@@ -40,8 +40,8 @@ struct CampaignConfig {
   double crash_loop_backoff_max_s = 1800;
   int crash_loop_retries = 6;
   bool lamps_off_at_shutdown = false;
-  double lamp_warmup_s = 900;        // after relighting on resume, when there is no luminance meter
-  double stable_tolerance_pct = 0.5; // lamp stability on resume: drift over the window (LS-110)
+  double lamp_warmup_s = 900;         // after relighting on resume, when there is no luminance meter
+  double stable_tolerance_pct = 0.5;  // lamp stability on resume: drift over the window (LS-110)
   double stable_window_s = 60;
   double stable_interval_s = 5;
   double stable_timeout_s = 1800;
@@ -50,7 +50,7 @@ struct CampaignConfig {
   double suspend_retry_s = 30;
   double suspend_settle_s = 60;
   double suspend_max_s = 8 * 3600;
-  double time_scale = 1;             // lab seconds per wall second for an external simulated lab
+  double time_scale = 1;  // lab seconds per wall second for an external simulated lab
 };
 
 // [queue]: the night's queue (docs/campaigns.md, "A night's queue").

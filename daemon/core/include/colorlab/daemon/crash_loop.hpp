@@ -25,9 +25,13 @@ struct CrashLoopPolicy {
 };
 
 struct CrashLoopVerdict {
-  enum class Kind { resume, suspend, give_up } kind = Kind::resume;
-  int round = 0;          // 1.. for suspend; retries + 1 for give_up
-  double backoff_s = 0;   // for suspend
+  enum class Kind {
+    resume,
+    suspend,
+    give_up
+  } kind = Kind::resume;
+  int round = 0;         // 1.. for suspend; retries + 1 for give_up
+  double backoff_s = 0;  // for suspend
 };
 
 // What to do with an execution a restarted daemon finds running, after `attempts` resumes in a row

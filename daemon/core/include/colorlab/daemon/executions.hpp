@@ -30,10 +30,10 @@ class WorkerPool;
 class StepCommitter;
 
 struct ExecutionOptions {
-  CrashLoopPolicy crash_loop;       // includes max_resume_attempts
-  std::filesystem::path state_dir;  // where runs are stored (a dry run checks its free space)
-  Notifier* notifier = nullptr;     // told of suspensions, crash loops and failures; none: nobody is
-  WorkerPool* workers = nullptr;    // where scripts' analyses (fits) and dry runs compute; none: inline
+  CrashLoopPolicy crash_loop;          // includes max_resume_attempts
+  std::filesystem::path state_dir;     // where runs are stored (a dry run checks its free space)
+  Notifier* notifier = nullptr;        // told of suspensions, crash loops and failures; none: nobody is
+  WorkerPool* workers = nullptr;       // where scripts' analyses (fits) and dry runs compute; none: inline
   StepCommitter* committer = nullptr;  // where steps before a live call are made durable; none: the io thread
 };
 

@@ -20,7 +20,7 @@ namespace colorlab::daemon {
 class ReportService {
  public:
   struct Options {
-    std::filesystem::path directory;   // <state>/reports
+    std::filesystem::path directory;    // <state>/reports
     std::filesystem::path unix_socket;  // the daemon's own socket: the child reads the run through the API
     std::string python = "/usr/bin/python3";
     std::string version;  // part of the file name: a new colorlabd makes its reports anew
@@ -31,7 +31,11 @@ class ReportService {
     int nice = 0;
   };
   struct State {
-    enum class Kind { ready, generating, failed } kind = Kind::generating;
+    enum class Kind {
+      ready,
+      generating,
+      failed
+    } kind = Kind::generating;
     std::filesystem::path file;  // ready: the HTML
     std::string error;           // failed: why, with the end of the child's output
   };

@@ -17,7 +17,7 @@ class SimulatorHands final : public campaigns::OperatorHands {
     return action == "aim_meter" || action == "load_chart" || action == "white_tile" || action == "aim_camera";
   }
   boost::asio::awaitable<std::optional<nlohmann::json>> perform(const std::string& action,
-                                                                 const nlohmann::json& details) override;
+                                                                const nlohmann::json& details) override;
 
  private:
   // One line of JSON out, one back; Error{no_comms|timeout|device_error} otherwise.

@@ -57,7 +57,10 @@ class WorkerPoolFull : public Error {
 // Campaigns' analyses are always taken: each execution waits for its own, so they are bounded by the
 // executions running, and refusing one would fail a night's run for a busy moment. Requests' jobs
 // (a dry run asked over the API) are bounded by the queue.
-enum class Admission { bounded, always };
+enum class Admission {
+  bounded,
+  always
+};
 
 class WorkerPool {
  public:

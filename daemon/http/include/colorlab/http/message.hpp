@@ -16,7 +16,11 @@ namespace colorlab::http {
 
 // Who is asking, as far as the connection tells: what access control decides on.
 struct Peer {
-  enum class Transport { unix_socket, loopback, remote };
+  enum class Transport {
+    unix_socket,
+    loopback,
+    remote
+  };
   Transport transport = Transport::loopback;
   bool tls = false;
   std::string address;  // "127.0.0.1:53412", or the socket path
@@ -24,9 +28,9 @@ struct Peer {
 
 struct HttpRequest {
   Peer peer;
-  std::string method;   // "GET"
-  std::string target;   // "/v1/runs?limit=5"
-  std::string path;     // "/v1/runs"
+  std::string method;  // "GET"
+  std::string target;  // "/v1/runs?limit=5"
+  std::string path;    // "/v1/runs"
   std::map<std::string, std::string> query;
   std::map<std::string, std::string> headers;  // lower-case names
   std::string body;

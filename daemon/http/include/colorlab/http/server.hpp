@@ -21,9 +21,9 @@
 namespace colorlab::http {
 
 struct ServerOptions {
-  std::string tcp_host = "127.0.0.1";   // empty: no TCP listener
-  unsigned short tcp_port = 8765;       // 0: pick a free port (see bound_port())
-  std::filesystem::path unix_socket;    // empty: no Unix listener (created mode 0660: its permissions are its guard)
+  std::string tcp_host = "127.0.0.1";  // empty: no TCP listener
+  unsigned short tcp_port = 8765;      // 0: pick a free port (see bound_port())
+  std::filesystem::path unix_socket;   // empty: no Unix listener (created mode 0660: its permissions are its guard)
   std::chrono::seconds idle_timeout{30};
   std::string server_name = "colorlabd";
   unsigned threads = 0;

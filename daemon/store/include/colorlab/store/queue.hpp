@@ -24,8 +24,18 @@
 
 namespace colorlab::store {
 
-enum class QueueItemState { queued, running, done, failed, skipped, removed };
-enum class OnFailure { stop, go_on };  // "stop" | "continue" on the wire
+enum class QueueItemState {
+  queued,
+  running,
+  done,
+  failed,
+  skipped,
+  removed
+};
+enum class OnFailure {
+  stop,
+  go_on
+};  // "stop" | "continue" on the wire
 
 std::string_view to_string(QueueItemState s);
 std::optional<QueueItemState> queue_item_state_from_string(std::string_view s);
@@ -51,7 +61,7 @@ std::map<std::string, std::string> run_of_references(const nlohmann::json& param
 OnFailure on_failure_from_string(std::string_view s);
 
 struct QueueItem {
-  std::string id;  // UUIDv7
+  std::string id;                        // UUIDv7
   std::optional<std::int64_t> position;  // 1-based, while queued
   std::string campaign;
   nlohmann::json params;

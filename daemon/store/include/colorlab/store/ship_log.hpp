@@ -19,10 +19,10 @@ inline const std::string kEndEventSql = std::string("topic = 'execution' AND jso
 // What the bench holds ended but not yet shipped after a position.
 struct ShipBacklog {
   std::int64_t runs = 0;
-  std::string oldest_run_id;     // empty when runs == 0
+  std::string oldest_run_id;  // empty when runs == 0
   std::string oldest_status;
-  std::string oldest_ended_at;   // the oldest run's finished_at (ISO 8601, this bench's clock)
-  std::int64_t last_event = 0;   // the newest event on the bench
+  std::string oldest_ended_at;  // the oldest run's finished_at (ISO 8601, this bench's clock)
+  std::int64_t last_event = 0;  // the newest event on the bench
 };
 
 // On a connection of its own (colorlabd's route opens one read-only per request, as the agent does), never inside a

@@ -52,7 +52,10 @@ class Statement {
 
   // True while a row is available.
   bool step();
-  void run() { while (step()) {} }
+  void run() {
+    while (step()) {
+    }
+  }
   // Ready to run again with new bindings (one prepared statement for many rows).
   void reset();
 

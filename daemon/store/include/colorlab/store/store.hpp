@@ -254,7 +254,7 @@ class Store {
  private:
   // The queue's rows live in their own file and share this connection (one writer, one thread).
   friend class QueueStore;
-  friend class BlobIndex;  // blob_index.hpp: the blob store's rows
+  friend class BlobIndex;    // blob_index.hpp: the blob store's rows
   friend class ApiKeyStore;  // api_keys.hpp: keys on the same writer connection
   RunRecord read_run(Statement& st);
   ExecutionRecord read_execution(Statement& st);

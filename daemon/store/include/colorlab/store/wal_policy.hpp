@@ -14,7 +14,7 @@ namespace colorlab::store {
 
 inline constexpr int kWalAutocheckpointPages = 1000;                      // 4 MiB at SQLite's 4 KiB pages
 inline constexpr std::int64_t kJournalSizeLimitBytes = 16 * 1024 * 1024;  // the WAL's size once reset
-inline constexpr int kBusyTimeoutMs = 5000;                                // the writer's busy_timeout (store.cpp)
+inline constexpr int kBusyTimeoutMs = 5000;                               // the writer's busy_timeout (store.cpp)
 
 // The writer connection's WAL settings (journal_mode itself is set by the store).
 void apply_wal_policy(Database& db);

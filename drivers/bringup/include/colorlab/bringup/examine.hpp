@@ -16,9 +16,9 @@
 namespace colorlab::bringup {
 
 struct ExamineOptions {
-  std::string expect;          // the kind the operator says is on this port; empty = find out
-  bool measure = false;        // the operator agreed to one reading
-  double deadline_scale = 1.0; // multiplies every deadline (replays on a slow machine)
+  std::string expect;           // the kind the operator says is on this port; empty = find out
+  bool measure = false;         // the operator agreed to one reading
+  double deadline_scale = 1.0;  // multiplies every deadline (replays on a slow machine)
 };
 
 // The probing order a plan implies: the expected kind first, then the others in serial_kinds() order.
@@ -34,7 +34,7 @@ struct Confirmation {
 struct Examination {
   std::string port;
   std::string expected_kind;
-  std::string kind;     // what answered ("" when nothing recognisable did)
+  std::string kind;  // what answered ("" when nothing recognisable did)
   // identified | wrong_instrument | unknown_protocol | silent | cannot_open | failed
   std::string verdict;
   std::string message;  // one plain sentence

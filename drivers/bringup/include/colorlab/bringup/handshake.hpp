@@ -24,16 +24,16 @@ std::string instrument_name(const std::string& kind);
 bool is_serial_kind(const std::string& kind);
 
 struct Heard {
-  std::string kind;       // the protocol recognised ("dmx", "ls110", "spectrolino"); empty: none
-  std::string detail;     // "SpectroScan status answer", "OK00", "label 10, 4 bytes"
-  unsigned baud = 0;      // the speed it answered at
+  std::string kind;    // the protocol recognised ("dmx", "ls110", "spectrolino"); empty: none
+  std::string detail;  // "SpectroScan status answer", "OK00", "label 10, 4 bytes"
+  unsigned baud = 0;   // the speed it answered at
 };
 
 struct HandshakeResult {
   Heard heard;
-  std::string garbage;            // bytes received that no recogniser accepted
-  std::vector<std::string> tried; // "dmx @115200", "ls110 @4800 7E2", …
-  std::string open_error;         // the OS's refusal, when the port could not be opened
+  std::string garbage;             // bytes received that no recogniser accepted
+  std::vector<std::string> tried;  // "dmx @115200", "ls110 @4800 7E2", …
+  std::string open_error;          // the OS's refusal, when the port could not be opened
   std::string open_hint;
 };
 

@@ -14,9 +14,9 @@ namespace colorlab::bringup {
 struct NodeAccess {
   std::string path;
   std::string owner, group;
-  std::string mode;          // "crw-rw----"
+  std::string mode;  // "crw-rw----"
   bool readable_writable = false;
-  std::string problem;       // empty when this user may open it
+  std::string problem;  // empty when this user may open it
   std::string hint;
 };
 
@@ -36,10 +36,10 @@ struct HostPaths {
 // The known instrument a USB VID:PID (and product string) belongs to, or empty.
 std::string known_usb_device(int vid, int pid, const std::string& product);
 
-nlohmann::json host_identity();                          // user, uid, groups, the colorlab group
-nlohmann::json udev_rules_state(const HostPaths& paths); // installed where, read by udevd or not
-nlohmann::json serial_ports(const HostPaths& paths);     // libserialport's list with by-id links and access
-nlohmann::json usb_devices(const HostPaths& paths);      // sysfs, each with its /dev/bus/usb node's access
+nlohmann::json host_identity();                           // user, uid, groups, the colorlab group
+nlohmann::json udev_rules_state(const HostPaths& paths);  // installed where, read by udevd or not
+nlohmann::json serial_ports(const HostPaths& paths);      // libserialport's list with by-id links and access
+nlohmann::json usb_devices(const HostPaths& paths);       // sysfs, each with its /dev/bus/usb node's access
 // dcttech boards by hidapi, each with its hidraw node's access
 nlohmann::json relay_boards();
 

@@ -11,10 +11,15 @@
 namespace colorlab::bringup {
 
 struct ByteEvent {
-  enum class Kind { host, device, settings, mark };
+  enum class Kind {
+    host,
+    device,
+    settings,
+    mark
+  };
   Kind kind = Kind::host;
-  double t_ms = 0;    // since the recording started
-  std::string data;   // raw bytes (host, device) or text (settings, mark)
+  double t_ms = 0;   // since the recording started
+  std::string data;  // raw bytes (host, device) or text (settings, mark)
 };
 
 class Recording {

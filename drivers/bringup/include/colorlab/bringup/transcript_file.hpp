@@ -27,7 +27,7 @@ struct TranscriptFile {
   std::vector<ByteEvent> events;
   nlohmann::json decoded = nlohmann::json::object();
   nlohmann::json expected = nlohmann::json::object();  // key -> {"value": v, "tolerance": t?, "unit": u?}
-  std::string expected_source;                          // "operator", "simulator ground truth …", "" = unconfirmed
+  std::string expected_source;                         // "operator", "simulator ground truth …", "" = unconfirmed
   std::string expected_note;
 };
 

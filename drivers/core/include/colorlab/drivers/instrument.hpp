@@ -13,11 +13,19 @@
 
 namespace colorlab::drivers {
 
-enum class InstrumentState { disconnected, initialising, ready, busy, needs_calibration, needs_operator, fault };
+enum class InstrumentState {
+  disconnected,
+  initialising,
+  ready,
+  busy,
+  needs_calibration,
+  needs_operator,
+  fault
+};
 std::string_view to_string(InstrumentState s);
 
 enum class Capability {
-  luminance,             // spot luminance in cd/m²
+  luminance,  // spot luminance in cd/m²
   reflectance_spectrum,
   emission_spectrum,
   transmission_spectrum,
@@ -29,18 +37,18 @@ enum class Capability {
 std::string_view to_string(Capability c);
 
 struct Identity {
-  std::string kind;      // "ls110", "spectrolino", ...
-  std::string model;     // as the instrument names itself
+  std::string kind;   // "ls110", "spectrolino", ...
+  std::string model;  // as the instrument names itself
   std::string serial;
   std::string firmware;
-  std::string port;      // where it is attached
+  std::string port;  // where it is attached
   bool simulated = false;
 };
 
 struct CalibrationStatus {
-  std::string type;                       // "white", "emission", ...
+  std::string type;  // "white", "emission", ...
   bool valid = false;
-  std::optional<int> readings_left;       // count-based expiry
+  std::optional<int> readings_left;  // count-based expiry
   std::optional<std::chrono::system_clock::time_point> valid_until;
 };
 
@@ -62,10 +70,10 @@ class Instrument {
 };
 
 struct LuminanceReading {
-  double luminance = 0;          // in `unit`
+  double luminance = 0;  // in `unit`
   std::string unit = "cd/m2";
   std::chrono::system_clock::time_point time;
-  std::string raw_reply;         // the instrument's own words, kept for provenance
+  std::string raw_reply;  // the instrument's own words, kept for provenance
 };
 
 class LuminanceMeter : public virtual Instrument {

@@ -15,7 +15,11 @@
 
 namespace colorlab::drivers {
 
-enum class SpectralMode { reflectance, emission, transmission };
+enum class SpectralMode {
+  reflectance,
+  emission,
+  transmission
+};
 std::string_view to_string(SpectralMode m);
 
 struct SpectralReading {

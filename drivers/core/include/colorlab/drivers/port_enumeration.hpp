@@ -8,9 +8,9 @@
 namespace colorlab::drivers {
 
 struct SerialPortInfo {
-  std::string path;         // /dev/ttyUSB0
+  std::string path;  // /dev/ttyUSB0
   std::string description;
-  std::string transport;    // native, usb, bluetooth
+  std::string transport;  // native, usb, bluetooth
   std::optional<int> usb_vid;
   std::optional<int> usb_pid;
   std::string usb_serial;

@@ -23,7 +23,15 @@ struct ReconnectPolicy {
   std::chrono::milliseconds backoff(int attempt) const;  // attempt 1 → initial_backoff
 };
 
-enum class ReconnectPhase { idle, closing, backing_off, reopening, verifying, connected, gave_up };
+enum class ReconnectPhase {
+  idle,
+  closing,
+  backing_off,
+  reopening,
+  verifying,
+  connected,
+  gave_up
+};
 std::string_view to_string(ReconnectPhase p);
 
 // Errors after which reopening the link can help (the link is gone or the device stopped answering).

@@ -21,8 +21,16 @@
 
 namespace colorlab::drivers {
 
-enum class Parity { none, even, odd };
-enum class FlowControl { none, hardware, software };
+enum class Parity {
+  none,
+  even,
+  odd
+};
+enum class FlowControl {
+  none,
+  hardware,
+  software
+};
 
 struct SerialSettings {
   unsigned baud = 9600;

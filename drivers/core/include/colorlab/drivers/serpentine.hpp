@@ -12,7 +12,7 @@ struct ChartLayout {
   double pass_x_mm = 0, pass_y_mm = 0;      // strip s → s+1
   int patches_per_strip = 0;
   int strips = 0;
-  int patch_count = 0;                      // 0 = patches_per_strip × strips; patches are numbered strip by strip
+  int patch_count = 0;  // 0 = patches_per_strip × strips; patches are numbered strip by strip
 };
 
 struct PatchVisit {

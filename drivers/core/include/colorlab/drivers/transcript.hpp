@@ -31,7 +31,11 @@ class Transcript {
 
   // Every byte, unbounded, to whoever records a bring-up session (colorlab doctor): the ring
   // above keeps only the last lines for error reports.
-  enum class Event { sent, received, settings };
+  enum class Event {
+    sent,
+    received,
+    settings
+  };
   using Tap = std::function<void(Event, std::string_view)>;
   void set_tap(Tap tap) { tap_ = std::move(tap); }
 

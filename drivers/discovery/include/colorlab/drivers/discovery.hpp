@@ -28,7 +28,7 @@ struct DiscoveryRule {
 };
 
 struct DiscoveredInstrument {
-  std::string id;           // from a rule, else "<kind>-<serial or path>"
+  std::string id;  // from a rule, else "<kind>-<serial or path>"
   std::string kind;
   std::string port;         // device path to open
   std::string stable_port;  // /dev/serial/by-id/… link to it, when udev made one

@@ -22,14 +22,14 @@ struct EnttecDmxOptions {
   std::string id = "dmx";
   std::string port;
   bool simulated = false;
-  LampMap lamps;                                    // lamp name → DMX channel (1..512)
-  int dimmer_channel = 0;                           // 0 = no dimmer channel; its level scales nothing else
-  double ramp_per_second = 0;                       // level change per second (1.0 = 0→full in 1 s); 0 = step
-  std::chrono::milliseconds settle{0};              // wait after the last ramp step
-  std::chrono::milliseconds frame_interval{25};     // ramp step spacing (40 packets/s, the widget's maximum rate)
+  LampMap lamps;                                 // lamp name → DMX channel (1..512)
+  int dimmer_channel = 0;                        // 0 = no dimmer channel; its level scales nothing else
+  double ramp_per_second = 0;                    // level change per second (1.0 = 0→full in 1 s); 0 = step
+  std::chrono::milliseconds settle{0};           // wait after the last ramp step
+  std::chrono::milliseconds frame_interval{25};  // ramp step spacing (40 packets/s, the widget's maximum rate)
   std::chrono::milliseconds reply_timeout{1000};
   int attempts = 3;
-  std::size_t slots = 512;                          // full universes: some widgets ignore short frames
+  std::size_t slots = 512;  // full universes: some widgets ignore short frames
   ReconnectPolicy reconnect;
 };
 

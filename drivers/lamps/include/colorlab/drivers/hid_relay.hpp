@@ -21,7 +21,7 @@ struct HidRelayOptions {
   std::string expected_board_id;  // 5-char board id to insist on; empty = any
   LampMap lamps;
   bool simulated = false;
-  int switch_attempts = 3;        // per relay, before declaring it stuck
+  int switch_attempts = 3;  // per relay, before declaring it stuck
   ReconnectPolicy reconnect;
 };
 

@@ -8,7 +8,7 @@
 
 namespace colorlab::drivers {
 
-inline constexpr std::uint16_t kDcttechVendorId = 0x16C0;   // shared V-USB IDs: match the strings too
+inline constexpr std::uint16_t kDcttechVendorId = 0x16C0;  // shared V-USB IDs: match the strings too
 inline constexpr std::uint16_t kDcttechProductId = 0x05DF;
 
 // Boards whose IDs, manufacturer "www.dcttech.com" and product "USBRelay<N>" all match.

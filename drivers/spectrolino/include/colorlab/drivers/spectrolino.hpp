@@ -26,17 +26,17 @@ struct SpectrolinoOptions {
   std::string id = "spectrolino";
   std::string port;
   bool simulated = false;
-  unsigned max_baud = 57600;          // the highest speed both Spectrolino and SpectroScan offer
-  bool initialise_table = true;       // D0 0A InitializeDevice at connect (homes the motors)
+  unsigned max_baud = 57600;     // the highest speed both Spectrolino and SpectroScan offer
+  bool initialise_table = true;  // D0 0A InitializeDevice at connect (homes the motors)
   sl::Illuminant illuminant = sl::Illuminant::D50;
   sl::Observer observer = sl::Observer::Deg2;
   sl::WhiteBase white_base = sl::WhiteBase::Absolute;
   sl::DensityStandard density_standard = sl::DensityStandard::AnsiT;
-  std::uint8_t white_tile = 0;        // SpectroScan tile 1
-  int reflective_cal_interval = 50;   // readings between white calibrations (Argyll SS_REF_CAL_COUNT)
+  std::uint8_t white_tile = 0;       // SpectroScan tile 1
+  int reflective_cal_interval = 50;  // readings between white calibrations (Argyll SS_REF_CAL_COUNT)
   int transmissive_cal_interval = 10;
-  int command_attempts = 3;           // per exchange, for timeouts, garbled lines and COM errors
-  int patch_attempts = 5;             // per chart patch, with a recalibration after each failure
+  int command_attempts = 3;  // per exchange, for timeouts, garbled lines and COM errors
+  int patch_attempts = 5;    // per chart patch, with a recalibration after each failure
   SpectrolinoTimeouts timeouts;
   ReconnectPolicy reconnect;
 };

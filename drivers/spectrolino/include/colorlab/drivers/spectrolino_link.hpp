@@ -26,7 +26,11 @@ struct SpectrolinoTimeouts {
   std::chrono::milliseconds probe{500};  // per speed during the baud scan
 };
 
-enum class SpectrolinoTopology { standalone, spectroscan, spectroscan_t };
+enum class SpectrolinoTopology {
+  standalone,
+  spectroscan,
+  spectroscan_t
+};
 
 class SpectrolinoLink {
  public:

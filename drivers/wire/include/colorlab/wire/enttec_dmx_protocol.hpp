@@ -65,17 +65,17 @@ constexpr std::uint16_t firmware_version(std::uint8_t major, std::uint8_t minor)
 // Label 3 reply / label 4 request body.
 struct WidgetParameters {
   std::uint16_t firmware = firmware_version(1, 44);
-  std::uint8_t break_time = 9;      // units of 10.67 us, 9..127
-  std::uint8_t mab_time = 1;        // units of 10.67 us, 1..127
-  std::uint8_t output_rate = 40;    // packets/s, 0..40 (0 = as fast as possible)
+  std::uint8_t break_time = 9;    // units of 10.67 us, 9..127
+  std::uint8_t mab_time = 1;      // units of 10.67 us, 1..127
+  std::uint8_t output_rate = 40;  // packets/s, 0..40 (0 = as fast as possible)
   Bytes user_config;
 };
 
 Bytes get_parameters_request(std::uint16_t user_config_size = 0);  // label 3 frame
-std::uint16_t decode_get_parameters_request(const Frame& f);        // user-config size
-Bytes get_parameters_reply(const WidgetParameters& p);              // label 3 frame
+std::uint16_t decode_get_parameters_request(const Frame& f);       // user-config size
+Bytes get_parameters_reply(const WidgetParameters& p);             // label 3 frame
 WidgetParameters decode_parameters_reply(const Frame& f);
-Bytes set_parameters_request(const WidgetParameters& p);            // label 4 frame (no reply)
+Bytes set_parameters_request(const WidgetParameters& p);  // label 4 frame (no reply)
 // Throws Error{bad_parameter} when break/MAB/rate are outside the spec ranges.
 WidgetParameters decode_set_parameters_request(const Frame& f);
 
@@ -87,8 +87,8 @@ struct DmxPacket {
 };
 DmxPacket decode_send_dmx(const Frame& f);
 
-Bytes get_serial_request();                            // label 10, no payload
-Bytes serial_reply(std::uint32_t serial);              // label 10, 4 bytes little-endian (BCD digits)
+Bytes get_serial_request();                // label 10, no payload
+Bytes serial_reply(std::uint32_t serial);  // label 10, 4 bytes little-endian (BCD digits)
 std::uint32_t decode_serial_reply(const Frame& f);
 // A decimal serial such as 12345678 as the BCD value the widget stores (0x12345678).
 std::uint32_t bcd_serial(std::uint32_t decimal);

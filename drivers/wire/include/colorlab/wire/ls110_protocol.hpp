@@ -11,11 +11,11 @@ namespace colorlab::wire::ls110 {
 
 inline constexpr std::string_view kTerminator = "\r\n";
 
-std::string command_measure();                 // "MES\r\n"
-std::string command_set_mode(int mode);        // "MDS,04\r\n"; 04 absolute, 08 peak, 09 continuous
+std::string command_measure();           // "MES\r\n"
+std::string command_set_mode(int mode);  // "MDS,04\r\n"; 04 absolute, 08 peak, 09 continuous
 
 struct ErrorCode {
-  std::string code;       // "ER10"
+  std::string code;  // "ER10"
   ErrorClass cls;
   std::string meaning;
   std::string hint;
@@ -25,9 +25,9 @@ ErrorCode lookup_error(std::string_view code);
 
 struct Reply {
   bool ok = false;
-  std::string status;               // the two digits after OK
-  std::optional<double> value;      // last numeric field, when present
-  std::string error_code;           // "ER10" when !ok
+  std::string status;           // the two digits after OK
+  std::optional<double> value;  // last numeric field, when present
+  std::string error_code;       // "ER10" when !ok
 };
 // Parses one reply line (with or without CR LF). Throws Error{coms_fail} for a garbled line.
 Reply parse_reply(std::string_view line);

@@ -197,7 +197,16 @@ inline constexpr std::uint8_t SpecialHeadDownWhileMoving = 0x01, SpecialTransmis
 // ---------------------------------------------------------------- error tables (§1.8)
 
 // How Argyll classifies a code; simulator tests use this to check the client's view.
-enum class ArgyllClass { ok, notify, warning, comms_fail, misread, hardware, unsupported, other };
+enum class ArgyllClass {
+  ok,
+  notify,
+  warning,
+  comms_fail,
+  misread,
+  hardware,
+  unsupported,
+  other
+};
 std::string_view to_string(ArgyllClass c);
 
 struct CodeInfo {
@@ -254,42 +263,42 @@ void throw_on_remote_error(std::uint16_t set, std::string_view op_name);
 // ---------------------------------------------------------------- requests (bodies, unframed)
 
 namespace req {
-Bytes parameter_request();                                                          // 00
+Bytes parameter_request();                                                               // 00
 Bytes parameter_download(DensityStandard ds, WhiteBase wb, Illuminant il, Observer ob);  // 16 ds wb il ob
-Bytes meas_control_download(std::uint8_t ctt);                                     // 4D ctt
-Bytes meas_control_request(std::uint8_t ctt);                                      // 5B ctt
-Bytes reset_status(std::uint8_t sm);                                               // 5A 01 04 sm
-Bytes white_ref_to_orig();                                                         // 4A
-Bytes device_data_request();                                                       // B5
-Bytes target_id_request();                                                         // 2B
-Bytes white_reference_request(Filter f);                                           // B3 f
-Bytes white_reference_download(Filter f, const Spectrum& s, std::string_view name);  // B7
-Bytes illum_tab_request(Illuminant il);                                            // 38 00 il
-Bytes illum_tab_download(const Spectrum& s);                                       // 3A 08 floats
-Bytes dxx_temperature_request();                                                   // 47 60
-Bytes dxx_temperature_set(std::uint16_t kelvin_over_100);                          // 3A 60 u16
-Bytes float_request(std::uint8_t type);                                            // C0 type
-Bytes float_download(std::uint8_t type, float v);                                  // C2 type f
-Bytes set_measurement_output(std::uint8_t type, std::uint8_t mask);                // B1
-Bytes exec_ref_measurement(RefMode mode);                                          // 22 09 mode
-Bytes exec_white_measurement();                                                    // 21
-Bytes exec_measurement();                                                          // 20
-Bytes new_measure_request();                                                       // 07
-Bytes new_key_request();                                                           // 08
-Bytes target_on_off(bool deactivated);                                             // 33 00 oo 00
-Bytes spec_parameter_request(SpectrumType t);                                      // B8 09 t
-Bytes spectrum_request();                                                          // 05 09
-Bytes c_parameter_request(ColourType t);                                           // BA 09 t
-Bytes c_request();                                                                 // 06 09
-Bytes density_parameter_request();                                                 // BD 09
-Bytes density_request();                                                           // 03 09
-Bytes dmax_request();                                                              // 04 09
-Bytes act_error_request();                                                         // 29
+Bytes meas_control_download(std::uint8_t ctt);                                           // 4D ctt
+Bytes meas_control_request(std::uint8_t ctt);                                            // 5B ctt
+Bytes reset_status(std::uint8_t sm);                                                     // 5A 01 04 sm
+Bytes white_ref_to_orig();                                                               // 4A
+Bytes device_data_request();                                                             // B5
+Bytes target_id_request();                                                               // 2B
+Bytes white_reference_request(Filter f);                                                 // B3 f
+Bytes white_reference_download(Filter f, const Spectrum& s, std::string_view name);      // B7
+Bytes illum_tab_request(Illuminant il);                                                  // 38 00 il
+Bytes illum_tab_download(const Spectrum& s);                                             // 3A 08 floats
+Bytes dxx_temperature_request();                                                         // 47 60
+Bytes dxx_temperature_set(std::uint16_t kelvin_over_100);                                // 3A 60 u16
+Bytes float_request(std::uint8_t type);                                                  // C0 type
+Bytes float_download(std::uint8_t type, float v);                                        // C2 type f
+Bytes set_measurement_output(std::uint8_t type, std::uint8_t mask);                      // B1
+Bytes exec_ref_measurement(RefMode mode);                                                // 22 09 mode
+Bytes exec_white_measurement();                                                          // 21
+Bytes exec_measurement();                                                                // 20
+Bytes new_measure_request();                                                             // 07
+Bytes new_key_request();                                                                 // 08
+Bytes target_on_off(bool deactivated);                                                   // 33 00 oo 00
+Bytes spec_parameter_request(SpectrumType t);                                            // B8 09 t
+Bytes spectrum_request();                                                                // 05 09
+Bytes c_parameter_request(ColourType t);                                                 // BA 09 t
+Bytes c_request();                                                                       // 06 09
+Bytes density_parameter_request();                                                       // BD 09
+Bytes density_request();                                                                 // 03 09
+Bytes dmax_request();                                                                    // 04 09
+Bytes act_error_request();                                                               // 29
 
 // SpectroScan (D0 ...)
 Bytes scan(std::uint8_t scan_opcode, std::span<const std::uint8_t> args = {});
 Bytes move_absolute(ScanRef ref, std::uint16_t x_tenth_mm, std::uint16_t y_tenth_mm);  // D0 00
-Bytes move_relative(std::int16_t dx_tenth_mm, std::int16_t dy_tenth_mm);              // D0 01
+Bytes move_relative(std::int16_t dx_tenth_mm, std::int16_t dy_tenth_mm);               // D0 01
 Bytes move_home();                                                                     // D0 02
 Bytes move_up();                                                                       // D0 03
 Bytes move_down();                                                                     // D0 04
@@ -471,7 +480,7 @@ struct CAnswer {  // 11 09 type 3 floats rv rem2
   Bytes encode() const;
   static CAnswer decode(std::span<const std::uint8_t> body);
 };
-struct DensityParameterAnswer {  // BC 09 4 floats sdf rv filter wb 02 ds rem2
+struct DensityParameterAnswer {    // BC 09 4 floats sdf rv filter wb 02 ds rem2
   std::array<float, 4> density{};  // Db Dc Dm Dy
   std::uint8_t std_density_filter = 0;
   std::uint8_t ref_valid = 1;

@@ -18,7 +18,7 @@ class ControlChannel {
   ~ControlChannel();
   const std::filesystem::path& path() const;
 
- struct Impl;  // public so the connection coroutines can share it
+  struct Impl;  // public so the connection coroutines can share it
 
  private:
   std::shared_ptr<Impl> impl_;

@@ -19,7 +19,7 @@ namespace colorlab::sim {
 struct Ls110SimConfig {
   bool enabled = true;
   std::string id = "ls110";
-  int aim_row = 0;   // floor grid spot the meter is aimed at (row 0 = front)
+  int aim_row = 0;  // floor grid spot the meter is aimed at (row 0 = front)
   int aim_col = 9;
   nlohmann::json faults = nlohmann::json::object();
 };
@@ -29,7 +29,7 @@ struct SpectrolinoLabConfig {
   std::string id = "spectrolino";
   SpectrolinoConfig device;
   std::optional<std::pair<double, double>> head_mm;  // initial head position (default: home, or the tile
-                                                      // for a stand-alone Spectrolino)
+                                                     // for a stand-alone Spectrolino)
   nlohmann::json faults = nlohmann::json::object();
 };
 
@@ -59,7 +59,11 @@ struct DslrLabConfig {
   int width = 3504;
   int height = 2336;
   // The chart's pose in front of the camera: seeded (random_chart_pose of pose_seed), square, or given.
-  enum class Pose { seeded, square, given } pose = Pose::seeded;
+  enum class Pose {
+    seeded,
+    square,
+    given
+  } pose = Pose::seeded;
   std::optional<std::uint64_t> pose_seed;  // default: derived from the lab seed
   camera::ChartPose given_pose;
   std::optional<std::filesystem::path> socket;       // default: beside the control socket
@@ -90,7 +94,7 @@ struct LabConfig {
   // [cabinet]'s emitters light the floor by their form factor; docs/verify.md, "The measured scene").
   bool geometric_floor = false;
   verify::CabinetGeometry cabinet = verify::default_cabinet();  // [cabinet]
-  std::optional<std::filesystem::path> control_socket;  // default: a fresh path under $XDG_RUNTIME_DIR or /tmp
+  std::optional<std::filesystem::path> control_socket;          // default: a fresh path under $XDG_RUNTIME_DIR or /tmp
   // Where the DSLR's default card folder goes (colorlab-sim --scratch-dir; colorlabd passes <state_dir>/sim):
   // default the temporary directory. Killed simulators' folders there are reclaimed at start.
   std::optional<std::filesystem::path> scratch_dir;

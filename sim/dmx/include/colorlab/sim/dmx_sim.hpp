@@ -19,8 +19,8 @@ namespace colorlab::sim {
 class Scene;
 
 struct DmxChannelMapping {
-  int channel = 1;       // DMX slot, 1-based
-  std::string target;    // a lamp name (D65, TL84, CWF, A, UV: on at >= 128) or "dimmer" (0..255 -> 0..100 %)
+  int channel = 1;     // DMX slot, 1-based
+  std::string target;  // a lamp name (D65, TL84, CWF, A, UV: on at >= 128) or "dimmer" (0..255 -> 0..100 %)
 };
 
 struct DmxConfig {

@@ -17,21 +17,21 @@
 namespace colorlab::sim {
 
 struct Ls110Faults {
-  bool silent = false;                 // remote mode lost: no answer at all
-  std::string error_code;              // e.g. "ER10": answer MES with it
-  bool error_once = false;             // clear error_code after one use
-  double garble_probability = 0;       // corrupt a reply's characters
-  double partial_probability = 0;      // send only the first half of a reply
-  double drop_probability = 0;         // swallow a reply
-  double extra_latency_s = 0;          // added device time per command
-  double jitter_s = 0;                 // uniform 0..jitter added per command
+  bool silent = false;             // remote mode lost: no answer at all
+  std::string error_code;          // e.g. "ER10": answer MES with it
+  bool error_once = false;         // clear error_code after one use
+  double garble_probability = 0;   // corrupt a reply's characters
+  double partial_probability = 0;  // send only the first half of a reply
+  double drop_probability = 0;     // swallow a reply
+  double extra_latency_s = 0;      // added device time per command
+  double jitter_s = 0;             // uniform 0..jitter added per command
 };
 void from_json(const nlohmann::json& j, Ls110Faults& f);
 void to_json(nlohmann::json& j, const Ls110Faults& f);
 
 struct Ls110Truth {
-  double luminance = 0;   // scene value at the aimed spot, cd/m²
-  double noise_sigma = 0; // standard deviation of one reading
+  double luminance = 0;    // scene value at the aimed spot, cd/m²
+  double noise_sigma = 0;  // standard deviation of one reading
 };
 
 class Ls110Sim final : public PtyDevice {

@@ -14,9 +14,9 @@
 namespace colorlab::sim {
 
 struct RelayBoardFaults {
-  std::uint8_t stuck_mask = 0;   // relays whose contacts no longer move (they keep their current state)
-  bool unplugged = false;        // every transfer fails, opening fails
-  int replug_after_opens = -1;   // while unplugged: the n-th open attempt finds it plugged in again
+  std::uint8_t stuck_mask = 0;  // relays whose contacts no longer move (they keep their current state)
+  bool unplugged = false;       // every transfer fails, opening fails
+  int replug_after_opens = -1;  // while unplugged: the n-th open attempt finds it plugged in again
 };
 
 class RelayBoard {

@@ -23,7 +23,13 @@
 
 namespace colorlab::sim {
 
-enum class Lamp { d65, tl84, cwf, a, uv };
+enum class Lamp {
+  d65,
+  tl84,
+  cwf,
+  a,
+  uv
+};
 inline constexpr std::array<Lamp, 5> all_lamps{Lamp::d65, Lamp::tl84, Lamp::cwf, Lamp::a, Lamp::uv};
 
 std::string_view to_string(Lamp lamp);  // "D65", "TL84", "CWF", "A", "UV"
@@ -37,7 +43,7 @@ inline constexpr double floor_spot_pitch_x_mm = cabinet_width_mm / floor_cols;  
 inline constexpr double floor_spot_pitch_y_mm = 54.0;
 inline constexpr double cabinet_depth_mm = 600.0;
 
-inline constexpr int chart_patch_count = 140;   // ColorChecker SG: columns A..N, rows 1..10
+inline constexpr int chart_patch_count = 140;  // ColorChecker SG: columns A..N, rows 1..10
 inline constexpr int chart_columns = 14;
 inline constexpr int chart_rows = 10;
 inline constexpr double chart_width_mm = 279.4;
@@ -91,17 +97,17 @@ struct LampDrift {
 };
 
 struct ChartPatch {
-  std::string name;       // "A1".."N10"
-  int column = 0;         // 0..13 (A..N)
-  int row = 0;            // 0..9  (1..10)
+  std::string name;  // "A1".."N10"
+  int column = 0;    // 0..13 (A..N)
+  int row = 0;       // 0..9  (1..10)
   // Patch square in chart coordinates, mm from the chart's top-left corner (x right, y down).
   double x_mm = 0, y_mm = 0, size_mm = 0;
-  Spectrum reflectance;   // 380–730 nm, 10 nm
+  Spectrum reflectance;  // 380–730 nm, 10 nm
 };
 
 struct Chart {
-  std::string source;                // file path or "synthetic"
-  std::vector<ChartPatch> patches;   // 140, in A1, A2, ..., A10, B1, ... order
+  std::string source;               // file path or "synthetic"
+  std::vector<ChartPatch> patches;  // 140, in A1, A2, ..., A10, B1, ... order
   // Index of the patch containing chart point (x_mm, y_mm), or nullopt (border/gap).
   std::optional<int> patch_at(double x_mm, double y_mm) const;
   std::optional<int> index_of(std::string_view name) const;
@@ -118,7 +124,7 @@ class Scene {
   void set_lamp(Lamp lamp, bool on);
   bool lamp_on(Lamp lamp) const;
   std::vector<Lamp> lamps_on() const;
-  void set_dimmer(double percent);   // 0..100; throws Error(bad_parameter) outside
+  void set_dimmer(double percent);  // 0..100; throws Error(bad_parameter) outside
   double dimmer() const;
   // Relative light output of the dimmer (1 at 100 %, non-proportional below, 0 at 0 %).
   static double dimmer_output(double percent);
@@ -172,7 +178,7 @@ class Scene {
   // What the Spectrolino's aperture sees at table point (x, y) mm: a chart patch, the chart's dark surround,
   // or the table's off-white paper-hold plate. Throws Error(bad_parameter) off the table.
   struct TableSample {
-    std::optional<int> patch;  // chart patch index when on a patch
+    std::optional<int> patch;               // chart patch index when on a patch
     const Spectrum* reflectance = nullptr;  // owned by the scene
   };
   TableSample table_sample(double x_mm, double y_mm) const;

@@ -27,27 +27,27 @@ namespace colorlab::sim {
 class Scene;
 
 struct SpectrolinoConfig {
-  bool table = true;                 // false: a stand-alone Spectrolino (no D0 commands)
+  bool table = true;  // false: a stand-alone Spectrolino (no D0 commands)
   int power_on_baud = 9600;
-  std::uint32_t serial = 12345;      // Spectrolino serial (u16 in the 2B answer)
+  std::uint32_t serial = 12345;  // Spectrolino serial (u16 in the 2B answer)
   std::uint32_t table_serial = 54321;
   wire::spectrolino::Filter filter = wire::spectrolino::Filter::None;  // the physical filter fitted
-  double chart_origin_x_mm = 15.0;   // chart top-left corner on the table
+  double chart_origin_x_mm = 15.0;                                     // chart top-left corner on the table
   double chart_origin_y_mm = 7.0;
-  double tile_x_mm = 298.0;          // white tile 1 (tile 2 is 30 mm further down)
+  double tile_x_mm = 298.0;  // white tile 1 (tile 2 is 30 mm further down)
   double tile_y_mm = 20.0;
-  double tile_radius_mm = 6.0;       // head counts as "on the tile" within this distance
+  double tile_radius_mm = 6.0;  // head counts as "on the tile" within this distance
   double table_surface_reflectance = 0.80;
   double chart_border_reflectance = 0.035;  // the SG's black surround
-  double emission_x_mm = 600.0;      // cabinet floor point read in emission mode
+  double emission_x_mm = 600.0;             // cabinet floor point read in emission mode
   double emission_y_mm = 140.0;
 };
 
 // What the answer is and what it does to the link.
 struct SpectrolinoReply {
-  std::string bytes;                 // framed answer (":...\r\n"), empty when the device stays silent
-  double device_seconds = 0;         // simulated instrument time before the answer starts
-  std::optional<int> baud_after;     // the device listens at this speed once the answer is out
+  std::string bytes;              // framed answer (":...\r\n"), empty when the device stays silent
+  double device_seconds = 0;      // simulated instrument time before the answer starts
+  std::optional<int> baud_after;  // the device listens at this speed once the answer is out
 };
 
 // Device timings (not published; plausible values, Argyll's timeouts bound them).
@@ -55,8 +55,8 @@ struct SpectrolinoTiming {
   double command_s = 0.02;
   double measure_s = 1.5;
   double white_cal_s = 1.5;
-  double head_s = 0.3;            // head up or down
-  double speed_mm_s = 250.0;      // table axes, trapezoidal profile
+  double head_s = 0.3;        // head up or down
+  double speed_mm_s = 250.0;  // table axes, trapezoidal profile
   double accel_mm_s2 = 1000.0;
   double init_s = 3.0;
   double reset_s = 1.0;

@@ -20,9 +20,9 @@ struct SpectrolinoFaults {
   LinkFaults link;
   std::optional<std::uint8_t> exec_error;  // e.g. 0x04 lamp failure, answered to measure/calibrate commands
   bool exec_error_once = false;
-  double calibration_lifetime_s = 0;       // white calibration expires after this (0 = never)
-  bool expire_calibration = false;         // one-shot: forget the calibration now
-  bool power_cycle = false;                // one-shot: back to power-on speed and state
+  double calibration_lifetime_s = 0;  // white calibration expires after this (0 = never)
+  bool expire_calibration = false;    // one-shot: forget the calibration now
+  bool power_cycle = false;           // one-shot: back to power-on speed and state
 };
 // "exec_error" accepts a number or a hex string ("04") or a name: lamp_failure, measuring_disabled,
 // no_valid_measurement, too_much_light, hardware_failure, not_ready. Throws Error{bad_parameter}.

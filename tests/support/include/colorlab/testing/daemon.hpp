@@ -29,8 +29,8 @@ class DaemonProcess {
   // Vision port on 127.0.0.1 a moment longer than its parent lives).
   ~DaemonProcess();
   void start();
-  void kill9();       // no cleanup: the embedded simulated lab dies with it (waited for)
-  int terminate();    // SIGTERM and wait; returns the exit code
+  void kill9();     // no cleanup: the embedded simulated lab dies with it (waited for)
+  int terminate();  // SIGTERM and wait; returns the exit code
   bool running();
   const std::string& url() const { return url_; }
   // The Unix socket has every scope (docs/API.md, "Access"): tests that drive the lab use it; loopback

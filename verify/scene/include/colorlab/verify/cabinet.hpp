@@ -11,10 +11,10 @@
 namespace colorlab::verify {
 
 struct CabinetEmitter {
-  std::string lamp;             // D65, TL84, CWF, A, UV (the lamp map's names)
-  double x_mm = 0, y_mm = 0;    // centre of the emitting rectangle
-  double length_mm = 0;         // along x (a tube's length)
-  double width_mm = 0;          // along y
+  std::string lamp;           // D65, TL84, CWF, A, UV (the lamp map's names)
+  double x_mm = 0, y_mm = 0;  // centre of the emitting rectangle
+  double length_mm = 0;       // along x (a tube's length)
+  double width_mm = 0;        // along y
   // Luminance of the emitting surface at full output (cd/m²); 0 = unknown (a real lab: the export fits it
   // to the LS-110's floor readings).
   double luminance_cd_m2 = 0;

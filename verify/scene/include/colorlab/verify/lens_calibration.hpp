@@ -17,18 +17,18 @@
 namespace colorlab::verify {
 
 struct LensCalibration {
-  std::string camera;                   // the body, e.g. "Canon EOS 20D #1234"
-  std::string lens;                     // e.g. "EF 50mm f/1.8 II"
+  std::string camera;                     // the body, e.g. "Canon EOS 20D #1234"
+  std::string lens;                       // e.g. "EF 50mm f/1.8 II"
   std::optional<double> focal_length_mm;  // the zoom's setting, for a zoom
-  std::string focus;                    // the focus setting, where it was fixed ("" = not stated)
-  int width_px = 0, height_px = 0;      // the photographs it holds for
-  CameraIntrinsics intrinsics;          // fx, fy, cx, cy (px, pixel centres at integers), k1, k2
-  CameraIntrinsics sigma;               // one standard uncertainty of each parameter
-  double rms_px = 0;                    // reprojection RMS of the calibration points
+  std::string focus;                      // the focus setting, where it was fixed ("" = not stated)
+  int width_px = 0, height_px = 0;        // the photographs it holds for
+  CameraIntrinsics intrinsics;            // fx, fy, cx, cy (px, pixel centres at integers), k1, k2
+  CameraIntrinsics sigma;                 // one standard uncertainty of each parameter
+  double rms_px = 0;                      // reprojection RMS of the calibration points
   int photographs = 0, points = 0;
-  std::string source;                   // how it was obtained
-  std::string date;                     // ISO 8601 day
-  std::string name() const;             // "camera / lens[ @ f mm][, focus …]": how scene.json and the CLI name it
+  std::string source;        // how it was obtained
+  std::string date;          // ISO 8601 day
+  std::string name() const;  // "camera / lens[ @ f mm][, focus …]": how scene.json and the CLI name it
 };
 
 // One photograph of the chart: the detected patch centres as photographed (pixels) and the same patches on the

@@ -22,13 +22,13 @@ struct Region {
 };
 
 struct AravisOptions {
-  std::string device_id;                  // "127.0.0.1", "<vendor>-<serial>", ...; empty: first found
-  std::optional<Region> region;           // sensor ROI; empty: full sensor
-  std::optional<double> frame_rate_hz;    // upper bound on the trigger rate, if the camera has it
+  std::string device_id;                // "127.0.0.1", "<vendor>-<serial>", ...; empty: first found
+  std::optional<Region> region;         // sensor ROI; empty: full sensor
+  std::optional<double> frame_rate_hz;  // upper bound on the trigger rate, if the camera has it
   unsigned n_buffers = 4;
   unsigned socket_buffer_bytes = 4'000'000;
   std::chrono::milliseconds frame_timeout{2000};
-  unsigned max_retries_per_frame = 3;     // re-trigger after a timed-out or incomplete buffer
+  unsigned max_retries_per_frame = 3;  // re-trigger after a timed-out or incomplete buffer
   bool software_trigger = true;
   // GenICam has no standard way to report the sensor's black offset in the pixel data, so it is
   // configured (from the camera's data sheet or a dark frame) and attached to every frame.

@@ -42,8 +42,18 @@
 
 namespace colorlab::drivers::camera {
 
-enum class CameraKind { dslr, genicam, simulated };
-enum class CameraState { disconnected, initialising, ready, busy, fault };
+enum class CameraKind {
+  dslr,
+  genicam,
+  simulated
+};
+enum class CameraState {
+  disconnected,
+  initialising,
+  ready,
+  busy,
+  fault
+};
 
 std::string_view to_string(CameraKind k);
 std::string_view to_string(CameraState s);
@@ -72,8 +82,8 @@ struct CaptureOptions {
 
 struct CaptureReport {
   std::size_t requested = 0;
-  std::size_t delivered = 0;        // frames the sink accepted
-  std::optional<Error> error;       // why the series stopped early (or the sink's failure)
+  std::size_t delivered = 0;   // frames the sink accepted
+  std::optional<Error> error;  // why the series stopped early (or the sink's failure)
   std::vector<std::filesystem::path> saved_files;
   std::chrono::nanoseconds capture_time{0};  // summed over frames, capture stage
   std::chrono::nanoseconds decode_time{0};   // summed over frames, decode + sink

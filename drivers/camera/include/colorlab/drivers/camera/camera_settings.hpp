@@ -12,13 +12,22 @@ namespace colorlab::drivers::camera {
 // raw_jpeg_tiff: the raw plus the camera's own JPEG and its 8-bit and 16-bit TIFF from the same
 // exposure (chapter 7 compares all four). Only the simulated DSLR offers it; on a bench the TIFFs
 // come from the raw converter.
-enum class ImageFormat { raw, jpeg, raw_and_jpeg, raw_jpeg_tiff };
-enum class PixelFormat { bayer_rg12, bayer_rg16, mono16 };
+enum class ImageFormat {
+  raw,
+  jpeg,
+  raw_and_jpeg,
+  raw_jpeg_tiff
+};
+enum class PixelFormat {
+  bayer_rg12,
+  bayer_rg16,
+  mono16
+};
 
 std::string_view to_string(ImageFormat f);
 std::string_view to_string(PixelFormat f);
 PixelFormat pixel_format_from_string(std::string_view genicam_name);  // throws bad_parameter
-ImageFormat image_format_from_string(std::string_view name);         // "raw+jpeg"; throws bad_parameter
+ImageFormat image_format_from_string(std::string_view name);          // "raw+jpeg"; throws bad_parameter
 
 struct Range {
   double min = 0;

@@ -26,7 +26,7 @@ struct PipelineRun {
   std::size_t requested = 0;
   std::size_t produced = 0;
   std::size_t consumed = 0;
-  std::exception_ptr error;          // first failure, from either stage
+  std::exception_ptr error;  // first failure, from either stage
   bool error_in_consumer = false;
   std::chrono::nanoseconds produce_time{0};  // summed time inside produce()
   std::chrono::nanoseconds consume_time{0};  // summed time inside consume()

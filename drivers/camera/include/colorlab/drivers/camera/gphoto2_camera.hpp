@@ -48,7 +48,7 @@ std::vector<DetectedCamera> gphoto2_autodetect();
 struct Gphoto2Options {
   std::string model = "Canon EOS 20D (normal mode)";  // empty: first autodetected camera
   std::string port;                                   // empty: autodetect; "usb:001,005"; "disk:/dir"
-  std::filesystem::path keep_dir;  // downloaded raw + JPEG are saved here; empty: memory only
+  std::filesystem::path keep_dir;                     // downloaded raw + JPEG are saved here; empty: memory only
   bool delete_on_card = true;
   int pair_wait_ms = 3000;  // how long to wait for the JPEG partner of a RAW+JPEG capture
   // Longest a single libgphoto2 call may take (Canon captures take 4-15 s; init a few s) before

@@ -12,7 +12,12 @@
 
 namespace colorlab::drivers::camera {
 
-enum class CfaColor : std::uint8_t { red = 0, green = 1, blue = 2, none = 3 };
+enum class CfaColor : std::uint8_t {
+  red = 0,
+  green = 1,
+  blue = 2,
+  none = 3
+};
 
 // Colour of each cell of the 2x2 repeat, indexed [row % 2][col % 2] in visible-area coordinates.
 struct CfaPattern {
@@ -36,7 +41,7 @@ struct RawImage {
   std::size_t raw_height = 0;
   std::size_t left_margin = 0;
   std::size_t top_margin = 0;
-  std::size_t width = 0;   // visible area
+  std::size_t width = 0;  // visible area
   std::size_t height = 0;
   CfaPattern cfa = CfaPattern::rggb();
   std::array<std::uint16_t, 4> black_level{};  // per CFA cell, [row%2 * 2 + col%2]

@@ -23,13 +23,13 @@ namespace colorlab::sim::camera {
 // Where the chart sits in front of the camera (issue 14). Unset in CameraConfig: the chart square to the sensor,
 // centred, filling chart_height_fraction of the frame height, no lens distortion (the original behaviour).
 struct ChartPose {
-  double rotation_deg = 0;   // in the image plane, clockwise
-  double tilt_deg = 0;       // about the chart's horizontal axis (positive: its top edge leans away)
-  double swing_deg = 0;      // about its vertical axis (positive: its right edge leans away)
-  double distance_mm = 1200; // camera to chart centre; the focal length keeps the chart at chart_height_fraction
+  double rotation_deg = 0;    // in the image plane, clockwise
+  double tilt_deg = 0;        // about the chart's horizontal axis (positive: its top edge leans away)
+  double swing_deg = 0;       // about its vertical axis (positive: its right edge leans away)
+  double distance_mm = 1200;  // camera to chart centre; the focal length keeps the chart at chart_height_fraction
   // chart centre offset as a fraction of the frame width / height
   double shift_x = 0, shift_y = 0;
-  double k1 = 0, k2 = 0;     // radial lens distortion (OpenCV's model, coordinates normalised by the focal length)
+  double k1 = 0, k2 = 0;  // radial lens distortion (OpenCV's model, coordinates normalised by the focal length)
 };
 // A plausible bench pose for a seed: a few degrees of rotation and tilt, some shift, mild barrel distortion.
 ChartPose random_chart_pose(std::uint64_t seed);
@@ -40,8 +40,8 @@ struct LensIntrinsics {
 };
 
 struct CameraConfig {
-  int width = 3504;    // even
-  int height = 2336;   // even
+  int width = 3504;                   // even
+  int height = 2336;                  // even
   std::optional<std::uint64_t> seed;  // default: the scene's "camera" stream
   // CSV wavelength_nm,R,G,B. Unset: the shared set's Canon 20D curves when present, else parametric.
   std::optional<std::filesystem::path> sensitivity_file;
@@ -53,13 +53,13 @@ struct CameraConfig {
   double read_noise_e = 9.0;
   double adc_noise_dn = 0.8;
   double dark_current_e_per_s = 0.5;
-  double prnu_sigma = 0.006;           // pixel gain non-uniformity (relative)
-  double dsnu_sigma_dn = 0.5;          // pixel offset non-uniformity
-  double column_offset_sigma_dn = 0.3; // column fixed-pattern
+  double prnu_sigma = 0.006;            // pixel gain non-uniformity (relative)
+  double dsnu_sigma_dn = 0.5;           // pixel offset non-uniformity
+  double column_offset_sigma_dn = 0.3;  // column fixed-pattern
   double hot_pixel_fraction = 2e-5;
   double dead_pixel_fraction = 1e-5;
-  int dust_specks = 6;                 // dust shadows, each on a patch
-  int threads = 2;                     // for rendering frames
+  int dust_specks = 6;  // dust shadows, each on a patch
+  int threads = 2;      // for rendering frames
   // Electrons per (cd·s·m⁻²) of green-channel exposure L·t/N² (sets the overall brightness).
   double electrons_per_exposure = 15500.0;
 };
@@ -70,7 +70,10 @@ struct PatchRegion {
 
 struct PixelDefect {
   int x = 0, y = 0;
-  enum class Kind { hot, dead } kind = Kind::hot;
+  enum class Kind {
+    hot,
+    dead
+  } kind = Kind::hot;
 };
 
 struct DustSpeck {
@@ -85,7 +88,10 @@ class CameraModel {
   // taken out and the camera aimed at the whole floor from the cabinet's open front, as an imaging luminance meter
   // sees it (docs/simulator.md, "camera_view"). The floor is the scene's one luminance field, the one the LS-110
   // reads, seen through this view's perspective, its lens's cos⁴ fall-off and the camera's own vignetting and noise.
-  enum class View { chart, floor };
+  enum class View {
+    chart,
+    floor
+  };
 
   CameraModel(std::shared_ptr<const Scene> scene, CameraConfig config = {});
   ~CameraModel();

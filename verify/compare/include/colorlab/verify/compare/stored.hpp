@@ -16,8 +16,8 @@ namespace colorlab::verify {
 inline constexpr const char* kVerifyCampaign = "verify";
 
 struct StoredVerification {
-  nlohmann::json params;   // {rendering, against: [run ids], scale (null: fitted), k}
-  nlohmann::json summary;  // Verification::summary() plus floor_difference
+  nlohmann::json params;                           // {rendering, against: [run ids], scale (null: fitted), k}
+  nlohmann::json summary;                          // Verification::summary() plus floor_difference
   std::vector<records::Measurement> measurements;  // step "<kind>/<where>", value = the difference
 };
 

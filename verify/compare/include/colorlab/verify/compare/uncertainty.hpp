@@ -19,7 +19,7 @@ double coverage_probability(double k);
 double chi_square_quantile(double p, int dof);
 
 struct UncertaintySource {
-  std::string name;           // "characterization", "frame noise", "ls110 repeatability", "lamp drift", "misregistration", …
+  std::string name;            // "characterization", "frame noise", "ls110 repeatability", "lamp drift", "misregistration", …
   Eigen::MatrixXd covariance;  // in the compared quantity's coordinates
 };
 
@@ -36,9 +36,9 @@ struct Budget {
 };
 
 struct Judgement {
-  double mahalanobis = 0;   // √(Δᵀ Σ⁻¹ Δ)
-  double threshold = 0;     // √(chi-square quantile at k = 2's coverage, dof = dimension)
-  bool differs = false;     // mahalanobis > threshold
+  double mahalanobis = 0;  // √(Δᵀ Σ⁻¹ Δ)
+  double threshold = 0;    // √(chi-square quantile at k = 2's coverage, dof = dimension)
+  bool differs = false;    // mahalanobis > threshold
   // The expanded uncertainty along the difference: how far the quantity may move that way and still agree,
   // in the difference's own units (|Δ| · threshold / mahalanobis). Equal to k·u for one dimension.
   double expanded_along = 0;

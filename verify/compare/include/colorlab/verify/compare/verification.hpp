@@ -27,8 +27,8 @@ struct PixelRect {
 // One chart patch as the raw photograph gave it.
 struct PatchMeasurement {
   std::string id;
-  Rgb3 camera{};       // robust patch value, counts above black (linear), the characterization's input
-  Rgb3 frame_noise{};  // standard error of `camera` after averaging the frames, per channel
+  Rgb3 camera{};               // robust patch value, counts above black (linear), the characterization's input
+  Rgb3 frame_noise{};          // standard error of `camera` after averaging the frames, per channel
   PixelRect rendering_region;  // where the chart locator found the patch in the rendering
 };
 
@@ -74,8 +74,8 @@ struct FloorCell {  // one spot of the floor-luminance map (the camera as an ima
 };
 
 struct MeasuredScene {
-  std::string lamp;                      // e.g. "CWF"
-  std::vector<std::string> runs;         // the run ids it came from
+  std::string lamp;               // e.g. "CWF"
+  std::vector<std::string> runs;  // the run ids it came from
   std::vector<PatchMeasurement> patches;
   std::optional<Characterization> characterization;
   std::optional<BlackBox> black_box;
@@ -84,9 +84,9 @@ struct MeasuredScene {
   std::vector<SpotMeasurement> spots;
   std::vector<FloorCell> floor;
   int floor_rows = 0, floor_cols = 0;
-  double lamp_drift_bound = 0;      // relative: how far the lamp may have moved over the run (a bound, not a σ)
-  double locator_accuracy_px = 0;   // the chart locator's stated accuracy, one σ, rendering pixels
-  double floor_accuracy_px = 0;     // the floor homography's, one σ, rendering pixels
+  double lamp_drift_bound = 0;     // relative: how far the lamp may have moved over the run (a bound, not a σ)
+  double locator_accuracy_px = 0;  // the chart locator's stated accuracy, one σ, rendering pixels
+  double floor_accuracy_px = 0;    // the floor homography's, one σ, rendering pixels
 };
 
 // ---- the comparison -------------------------------------------------------------------------------------------
@@ -96,21 +96,24 @@ struct CompareOptions {
   // the result says so — a fitted factor cannot see a lamp that is uniformly too bright.
   std::optional<double> scale;
   int cv_neighbours = 12;  // training patches that stand for a patch's region of colour space
-  double k = 2;           // coverage factor, read as its one-dimensional coverage probability
+  double k = 2;            // coverage factor, read as its one-dimensional coverage probability
   // Expanded uncertainties above these mean the measurement cannot tell a renderer error of that size there.
   double cannot_tell_de00 = 2.0;
   double cannot_tell_relative = 0.02;
 };
 
-enum class Verdict { agrees, differs };
+enum class Verdict {
+  agrees,
+  differs
+};
 std::string_view to_string(Verdict v);
 
 struct Comparison {
-  std::string kind;   // "colour_7_3", "colour_7_4", "light_spot", "light_floor"
-  std::string where;  // patch id, or "r<row>c<col>"
+  std::string kind;                        // "colour_7_3", "colour_7_4", "light_spot", "light_floor"
+  std::string where;                       // patch id, or "r<row>c<col>"
   std::vector<double> rendered, measured;  // L*a*b*, raw counts, or cd/m²
-  double difference = 0;  // ΔE00 (7.3); |Δ| / |measured| (7.4); rendered / measured − 1 (light)
-  double expanded = 0;    // the expanded uncertainty along the difference, same unit
+  double difference = 0;                   // ΔE00 (7.3); |Δ| / |measured| (7.4); rendered / measured − 1 (light)
+  double expanded = 0;                     // the expanded uncertainty along the difference, same unit
   double mahalanobis = 0, threshold = 0;
   Verdict verdict = Verdict::agrees;
   bool cannot_tell = false;

@@ -35,7 +35,11 @@ struct SimulatedCameraOptions {
   bool write_tiff16 = false;
 };
 
-enum class CameraFault { capture_timeout, busy, disconnect };
+enum class CameraFault {
+  capture_timeout,
+  busy,
+  disconnect
+};
 
 class SimulatedCamera final : public Camera {
  public:
