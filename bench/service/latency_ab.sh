@@ -5,7 +5,7 @@
 # OUT/B1.json, … (the probe's --json) and OUT/A1.log … (the daemon's log, with the io-thread lines of
 # COLORLAB_IO_LAG_MS=5), then prints one line per pass and route: the study phase's n, p50, p99 and max (ms).
 # With AB=priority the switch is colorlabd's CPU priority of its heavy work instead (docs/configuration.md, "CPU
-# priority"): A `--priority 0 0` (everything at colorlabd's own priority, as before), B colorlabd's defaults; the
+# priority"): A `--priority 0 0` (everything at colorlabd's own priority, colorlabd's default), B `--priority 10 10`; the
 # commits on the committer thread in both.
 # Usage: [AB=commit|priority] bench/service/latency_ab.sh BUILD OUT [PASSES] [IDLE_S]
 set -eu
@@ -18,7 +18,7 @@ while [ "$i" -le "$passes" ]; do
   for side in A B; do
     on_io=0 priority=
     if [ "$ab" = priority ]; then
-      [ "$side" = A ] && priority="--priority 0 0"
+      if [ "$side" = A ]; then priority="--priority 0 0"; else priority="--priority 10 10"; fi
     else
       [ "$side" = A ] && on_io=1
     fi
