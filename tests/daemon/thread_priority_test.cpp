@@ -69,8 +69,8 @@ TEST(ThreadPriority, WorkerPoolThreadsRunAtTheConfiguredNiceAndTheCommitterAsThe
           seen_name = thread_name();
           return json(); },
         [&](std::exception_ptr, json) { done = true; });
-    run_until(
-        io, [&] { return done; }, "the job");
+    const auto finished = [&] { return done; };
+    ASSERT_NO_FATAL_FAILURE(run_until(io, finished, "the job"));
     EXPECT_EQ(seen, expected) << name;
     EXPECT_EQ(seen_name, name);
   }
@@ -79,17 +79,24 @@ TEST(ThreadPriority, WorkerPoolThreadsRunAtTheConfiguredNiceAndTheCommitterAsThe
 TEST(ThreadPriority, AHeavyThreadLowersItselfAndWhatItStartsInherits) {
   core::set_heavy_thread_nice(4);
   const int expected = lowered(4);
-  int mine = -100, child = -100;
+  int mine = -100, child = -100, heavy_child = -100;
   std::string name;
   std::thread([&] {
     core::become_heavy_thread("heavy-test-thread-name");
     mine = core::thread_nice();
     name = thread_name();
     std::thread([&] { child = core::thread_nice(); }).join();
+    // A heavy thread started by a heavy thread (a camera's decode thread rebuilt on its device thread) stays at
+    // the process's nice + steps: the steps do not add up.
+    std::thread([&] {
+      core::become_heavy_thread("heavy-inner");
+      heavy_child = core::thread_nice();
+    }).join();
   }).join();
   core::set_heavy_thread_nice(0);
   EXPECT_EQ(mine, expected);
   EXPECT_EQ(child, expected);
+  EXPECT_EQ(heavy_child, expected);
   EXPECT_EQ(name, "heavy-test-thre");  // the kernel keeps 15 characters
   // 0 leaves a thread as it was (main's behaviour before issue 27).
   int same = -100;
