@@ -16,6 +16,8 @@
 #include "colorlab/sim/camera/camera_model.hpp"
 #include "colorlab/verify/cabinet.hpp"
 #include "colorlab/verify/scene_export.hpp"
+#include "located_chart_run.hpp"
+#include "raw_photo_view.hpp"
 #include "simulated_runs.hpp"
 
 namespace colorlab::verify {
@@ -26,19 +28,6 @@ namespace ca = colorlab::analysis;
 using nlohmann::json;
 
 constexpr double kSigmas = 4.0;
-
-ca::PhotoView raw_view(const cam::RawFrame& f) {
-  ca::PhotoView v;
-  v.data = f.pixels.data();
-  v.width = f.width;
-  v.height = f.height;
-  v.channels = 1;
-  v.type = ca::SampleType::u16;
-  v.bit_depth = 12;
-  v.black_level = f.black_level;
-  v.cfa = ca::CfaPattern::rggb;
-  return v;
-}
 
 // The SG's look for the locator (which way up), from the scene's own patches, as characterize-camera passes
 // the chart-read's Y per patch.
@@ -74,25 +63,7 @@ Truth truth_of(const cam::ChartPose& p, const cam::CameraConfig& cc, const sim::
 json characterize_run(const ca::ChartLocation& loc, int width, int height) {
   json corners = json::array();
   for (const auto& c : loc.corners) corners.push_back({c.x, c.y});
-  json row{
-      {"step", "chart/raw"},
-      {"quantity", "chart_location"},
-      {"value", loc.confidence},
-      {"data", {
-                   {"format", "raw"},
-                   {"corners", corners},
-                   {"width", width},
-                   {"height", height},
-                   {"reprojection_rms_px", loc.reprojection_rms_px},
-               }},
-  };
-  return {{"run", {
-                      {"id", "0193c0de-0000-7000-8000-0000000cc0de"},
-                      {"campaign", "characterize-camera"},
-                      {"params", json::object()},
-                      {"status", "finished_ok"},
-                  }},
-          {"measurements", json::array({row})}};
+  return testing::located_chart_run(corners, loc.confidence, width, height, loc.reprojection_rms_px);
 }
 
 TEST(SceneCameraPose, FromTheLocatedChartWhereTheSimulatorsCameraIs) {
@@ -114,7 +85,7 @@ TEST(SceneCameraPose, FromTheLocatedChartWhereTheSimulatorsCameraIs) {
     const cam::RawFrame frame = camera.render(settings, 1);
     ca::LocateOptions lo;
     lo.reference = reference_of(*scene);
-    const ca::ChartLocation loc = ca::locate_chart(raw_view(frame), ca::ChartType::sg140, lo);
+    const ca::ChartLocation loc = ca::locate_chart(testing::raw_view(frame), ca::ChartType::sg140, lo);
 
     const auto l = camera.lens();  // the lab's lens calibration: the simulator's lens
     SceneExportOptions o;

@@ -19,6 +19,7 @@
 #include "colorlab/verify/cabinet_toml.hpp"
 #include "colorlab/verify/lens_calibration.hpp"
 #include "colorlab/verify/scene_export.hpp"
+#include "located_chart_run.hpp"
 
 namespace {
 
@@ -69,21 +70,7 @@ json characterize_run() {
       {876 + 131 * s, 584 + 93 * s},
       {876 - 131 * s, 584 + 93 * s},
   });
-  json row{
-      {"step", "chart/raw"},
-      {"quantity", "chart_location"},
-      {"value", 1.0},
-      {"data", {{"format", "raw"}, {"corners", corners}, {"width", 1752}, {"height", 1168}, {"reprojection_rms_px", 0.2}}},
-  };
-  return {
-      {"run", {
-                  {"id", "0193c0de-0000-7000-8000-0000000cc0de"},
-                  {"campaign", "characterize-camera"},
-                  {"params", json::object()},
-                  {"status", "finished_ok"},
-              }},
-      {"measurements", json::array({row})},
-  };
+  return colorlab::verify::testing::located_chart_run(corners, 1.0, 1752, 1168, 0.2);
 }
 
 std::string read_file(const std::filesystem::path& p) {

@@ -24,6 +24,8 @@
 #include "colorlab/verify/cabinet.hpp"
 #include "colorlab/verify/lens_calibration.hpp"
 #include "colorlab/verify/scene_export.hpp"
+#include "located_chart_run.hpp"
+#include "raw_photo_view.hpp"
 #include "simulated_runs.hpp"
 
 namespace colorlab::verify {
@@ -51,19 +53,6 @@ cam::ChartPose pose(double tilt, double swing, double rot, double sx, double sy,
   p.tilt_deg = tilt, p.swing_deg = swing, p.rotation_deg = rot, p.shift_x = sx, p.shift_y = sy, p.distance_mm = distance;
   p.k1 = true_lens().k1, p.k2 = true_lens().k2;
   return p;
-}
-
-ca::PhotoView raw_view(const cam::RawFrame& f) {
-  ca::PhotoView v;
-  v.data = f.pixels.data();
-  v.width = f.width;
-  v.height = f.height;
-  v.channels = 1;
-  v.type = ca::SampleType::u16;
-  v.bit_depth = 12;
-  v.black_level = f.black_level;
-  v.cfa = ca::CfaPattern::rggb;
-  return v;
 }
 
 std::shared_ptr<sim::Scene> make_scene() {
@@ -112,7 +101,7 @@ ca::ChartLocation photograph_and_locate(const std::shared_ptr<sim::Scene>& scene
     if (!lo.reference) lo.reference.emplace();
     lo.reference->luminance.push_back(scene->patch_xyz(static_cast<int>(k))[1]);
   }
-  return ca::locate_chart(raw_view(frame), ca::ChartType::sg140, lo);
+  return ca::locate_chart(testing::raw_view(frame), ca::ChartType::sg140, lo);
 }
 
 // The calibration points of one photograph: each detected patch's centroid as photographed, and its centre on the
@@ -148,27 +137,7 @@ Eigen::Vector3d true_position_mm(const cam::ChartPose& p, const sim::Scene& scen
 json characterize_run(const ca::ChartLocation& loc) {
   json corners = json::array();
   for (const auto& c : loc.corners) corners.push_back({c.x, c.y});
-  json row{
-      {"step", "chart/raw"},
-      {"quantity", "chart_location"},
-      {"value", loc.confidence},
-      {"data", {
-                   {"format", "raw"},
-                   {"corners", corners},
-                   {"width", kWidth},
-                   {"height", kHeight},
-                   {"reprojection_rms_px", loc.reprojection_rms_px},
-               }},
-  };
-  return {
-      {"run", {
-                  {"id", "0193c0de-0000-7000-8000-0000000cc0de"},
-                  {"campaign", "characterize-camera"},
-                  {"params", json::object()},
-                  {"status", "finished_ok"},
-              }},
-      {"measurements", json::array({row})},
-  };
+  return testing::located_chart_run(corners, loc.confidence, kWidth, kHeight, loc.reprojection_rms_px);
 }
 
 TEST(LensCalibrationSim, RecoversTheSimulatorsLensWithinItsStatedUncertainty) {
