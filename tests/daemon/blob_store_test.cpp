@@ -2,6 +2,8 @@
 // sha256sum, an independent tool), durable before any row names them, written once per content;
 // a scan that tells blobs from partial writes and strays; the rows a step commits with its journal;
 // retention's choice of what has expired.
+#include <unistd.h>
+
 #include <fstream>
 #include <map>
 #include <set>
@@ -102,6 +104,17 @@ TEST(BlobStore, ScanTellsPartialWritesAndStraysFromBlobs) {
   for (const auto& s : scan.strays) why.insert(s.why);
   EXPECT_TRUE(why.count("partial write"));
   EXPECT_TRUE(why.count("not a blob name"));
+}
+
+// The start-up check runs while frames are being kept: this process's own temporary file is a write in progress.
+TEST(BlobStore, AWriteInProgressOfThisProcessIsNotAPartialOne) {
+  TempDir dir;
+  BlobStore blobs(dir / "blobs");
+  const std::string sha = blobs.put(bytes_of("x"));
+  std::ofstream(blobs.path_of(sha).parent_path() / (".tmp-" + std::to_string(::getpid()) + "-7")) << "being written";
+  const auto scan = blobs.scan();
+  EXPECT_EQ(scan.files.size(), 1u);
+  EXPECT_TRUE(scan.strays.empty());
 }
 
 TEST(BlobStore, RefusesNamesThatAreNoSha256) {

@@ -221,6 +221,9 @@ std::string BlobStore::hash_file(const fs::path& file) {
 BlobScan BlobStore::scan() const {
   BlobScan out;
   std::error_code ec;
+  // A temporary file of this very process is a write in progress (the check runs while frames are being kept),
+  // not a partial one: only another process's — a colorlabd that died mid-write — is left over.
+  const std::string own_temp = std::string(kTempPrefix) + std::to_string(::getpid()) + "-";
   for (const auto& top : fs::directory_iterator(root_, ec)) {
     const std::string dir = top.path().filename().string();
     if (!top.is_directory() || dir.size() != 2 || !is_hex(dir)) {
@@ -229,7 +232,9 @@ BlobScan BlobStore::scan() const {
     }
     for (const auto& f : fs::directory_iterator(top.path(), ec)) {
       const std::string name = f.path().filename().string();
-      if (name.rfind(kTempPrefix, 0) == 0) {
+      if (name.rfind(own_temp, 0) == 0) {
+        continue;
+      } else if (name.rfind(kTempPrefix, 0) == 0) {
         out.strays.push_back({f.path(), "partial write"});
       } else if (f.is_regular_file() && name.size() == 62 && is_hex(name)) {
         std::error_code size_ec;
