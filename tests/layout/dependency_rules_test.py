@@ -6,8 +6,8 @@ target links (every target_link_libraries line, each target resolved to the fold
 - sim/ uses the wire codecs (drivers/wire/) and never a driver folder;
 - analysis/ does no networking: no Asio, Beast or socket headers, no link to Boost, colorlab_asio, daemon/ or
   drivers/ targets, no include of their headers;
-- core/ depends on nothing else in the project, links nothing, and includes only the standard library and the two
-  header-only parsers it is built on;
+- core/ depends on nothing else in the project, links nothing, and includes only the standard library, the two
+  header-only parsers it is built on and four of the C library's POSIX headers (CORE_LIBC_HEADERS);
 - drivers/ never links or includes daemon/ (the daemon drives the drivers, not the other way);
 - colorlabd's production targets (everything its link lines reach) link no sim/ target and their code includes no
   sim/ header, except what EMBEDDED_LAB_NEEDS names with its reason: the simulated lab stays out of the daemon.
@@ -39,6 +39,9 @@ PRODUCTION_ROOT = "colorlabd"
 
 NETWORK_HEADERS = re.compile(r"^(boost/asio|boost/beast|asio\.hpp|asio/|sys/socket\.h|netinet/|arpa/|netdb\.h|sys/un\.h)")
 CORE_EXTERNAL_HEADERS = {"nlohmann/json.hpp", "toml++/toml.h"}  # header-only; no library behind them
+# The C library's POSIX headers core/ may use: they add no library to a link line (every program links libc), and
+# a thread's name and CPU priority (core/thread_priority.hpp, shared by the daemon, campaigns and drivers) need them.
+CORE_LIBC_HEADERS = {"pthread.h", "sys/resource.h", "sys/syscall.h", "unistd.h"}
 INCLUDE = re.compile(r'^\s*#\s*include\s*([<"])([^>"]+)[>"]', re.M)
 
 
@@ -206,7 +209,7 @@ class DependencyRules(unittest.TestCase):
             elif kind == '"':
                 if not (SOURCE / path).parent.joinpath(header).exists():
                     found.append(("include", path, header))
-            elif ("/" in header or "." in header) and header not in CORE_EXTERNAL_HEADERS:
+            elif ("/" in header or "." in header) and header not in CORE_EXTERNAL_HEADERS | CORE_LIBC_HEADERS:
                 found.append(("include", path, header))  # a system or third-party library's header
         for target, item, _ in self.links_of("core"):
             found.append(("link", target, item))
