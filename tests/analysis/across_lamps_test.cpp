@@ -59,6 +59,33 @@ ca::SpectralSet camera(const ca::SpectralSet& cams, const std::string& name) {
   return s;
 }
 
+// A small chart of smooth reflectances (380–730 nm, 10 nm) and three smooth curves with an uncertain posterior:
+// enough for the band's arithmetic, nothing of a real camera.
+ca::SpectralSet smooth_chart(int patches) {
+  ca::SpectralSet refl;
+  refl.wavelengths = ca::uniform_grid(380, 730, 10);
+  refl.values.resize(patches, static_cast<Eigen::Index>(refl.wavelengths.size()));
+  for (int i = 0; i < patches; ++i) {
+    refl.names.push_back("p" + std::to_string(i));
+    for (std::size_t j = 0; j < refl.wavelengths.size(); ++j)
+      refl.values(i, static_cast<Eigen::Index>(j)) =
+          0.5 + 0.4 * std::sin(0.3 * i + (refl.wavelengths[j] - 380) / (40.0 + 3 * i)) * std::cos(0.7 * i);
+  }
+  return refl;
+}
+
+ca::SensitivityEstimate smooth_sensitivities(const std::vector<double>& grid) {
+  ca::SensitivityEstimate est;
+  est.wavelengths = grid;
+  est.curves.resize(3, static_cast<Eigen::Index>(grid.size()));
+  for (int c = 0; c < 3; ++c) {
+    for (std::size_t j = 0; j < grid.size(); ++j)
+      est.curves(c, static_cast<Eigen::Index>(j)) = std::exp(-0.5 * std::pow((grid[j] - (600.0 - 70 * c)) / 35.0, 2));
+    est.covariance[static_cast<std::size_t>(c)] = 1e-4 * Eigen::MatrixXd::Identity(est.curves.cols(), est.curves.cols());
+  }
+  return est;
+}
+
 }  // namespace
 
 TEST(AcrossLamps, BeatsTheSameLampModelAndItsBandHoldsTheTruth) {
@@ -182,24 +209,8 @@ TEST(AcrossLamps, NominalLampDrawsAreSmoothAndMeasuredLampsAreNotDrawn) {
   for (double v : g) changed |= std::abs(v) > 1e-6;
   EXPECT_TRUE(changed) << "a nominal lamp's draw must depart from its standard";
 
-  // A small chart of smooth reflectances and three smooth curves with an uncertain posterior.
-  ca::SpectralSet refl;
-  refl.wavelengths = ca::uniform_grid(380, 730, 10);
-  refl.values.resize(30, static_cast<Eigen::Index>(refl.wavelengths.size()));
-  for (int i = 0; i < 30; ++i) {
-    refl.names.push_back("p" + std::to_string(i));
-    for (std::size_t j = 0; j < refl.wavelengths.size(); ++j)
-      refl.values(i, static_cast<Eigen::Index>(j)) =
-          0.5 + 0.4 * std::sin(0.3 * i + (refl.wavelengths[j] - 380) / (40.0 + 3 * i)) * std::cos(0.7 * i);
-  }
-  ca::SensitivityEstimate est;
-  est.wavelengths = grid;
-  est.curves.resize(3, static_cast<Eigen::Index>(grid.size()));
-  for (int c = 0; c < 3; ++c) {
-    for (std::size_t j = 0; j < grid.size(); ++j)
-      est.curves(c, static_cast<Eigen::Index>(j)) = std::exp(-0.5 * std::pow((grid[j] - (600.0 - 70 * c)) / 35.0, 2));
-    est.covariance[static_cast<std::size_t>(c)] = 1e-4 * Eigen::MatrixXd::Identity(est.curves.cols(), est.curves.cols());
-  }
+  const ca::SpectralSet refl = smooth_chart(30);
+  const ca::SensitivityEstimate est = smooth_sensitivities(grid);
   const auto measured = ca::chart_under_lamp(refl, ca::measured_lamp("A", a.spd), grid);
   ca::AcrossLampsOptions on, off;
   on.methods = off.methods = {"ccm"};
@@ -219,23 +230,8 @@ TEST(AcrossLamps, NominalLampDrawsAreSmoothAndMeasuredLampsAreNotDrawn) {
 // chart built from scratch under it.
 TEST(AcrossLamps, BandSharingTheDrawsWorkEqualsRebuildingIt) {
   const std::vector<double> grid = ca::uniform_grid(400, 720, 10);
-  ca::SpectralSet refl;
-  refl.wavelengths = ca::uniform_grid(380, 730, 10);
-  refl.values.resize(40, static_cast<Eigen::Index>(refl.wavelengths.size()));
-  for (int i = 0; i < 40; ++i) {
-    refl.names.push_back("p" + std::to_string(i));
-    for (std::size_t j = 0; j < refl.wavelengths.size(); ++j)
-      refl.values(i, static_cast<Eigen::Index>(j)) =
-          0.5 + 0.4 * std::sin(0.3 * i + (refl.wavelengths[j] - 380) / (40.0 + 3 * i)) * std::cos(0.7 * i);
-  }
-  ca::SensitivityEstimate est;
-  est.wavelengths = grid;
-  est.curves.resize(3, static_cast<Eigen::Index>(grid.size()));
-  for (int c = 0; c < 3; ++c) {
-    for (std::size_t j = 0; j < grid.size(); ++j)
-      est.curves(c, static_cast<Eigen::Index>(j)) = std::exp(-0.5 * std::pow((grid[j] - (600.0 - 70 * c)) / 35.0, 2));
-    est.covariance[static_cast<std::size_t>(c)] = 1e-4 * Eigen::MatrixXd::Identity(est.curves.cols(), est.curves.cols());
-  }
+  const ca::SpectralSet refl = smooth_chart(40);
+  const ca::SensitivityEstimate est = smooth_sensitivities(grid);
   const auto f11 = ca::chart_under_lamp(refl, ca::nominal_lamp("TL84"), grid);  // nominal: every draw draws the lamp too
   std::mt19937 rng(5);
   const ca::SpectralSet drawn = ca::draw_nominal_lamp(f11.lamp_spd, grid, rng);
