@@ -220,8 +220,12 @@ class Records:
         self.rows.append((route, ms, status, timing, client))
 
 
-def client_process(target, args, stop, out):
+def client_process(target, args, stop, out, client_nice=None):
     """One client in a process of its own: its thread's wait for a CPU is then its own, not a GIL's."""
+    if client_nice is not None:
+        # Raising the clients above the study (root only) takes their own scheduling out of the answer times, so
+        # what is left is the daemon's: the separation the quiet-machine A/B of issue 27 needs.
+        os.setpriority(os.PRIO_PROCESS, 0, client_nice)
     records = Records()
     try:
         target(*args[:1], records, stop, *args[1:], clock=ClientClock())
@@ -360,13 +364,13 @@ def thread_groups(pid):
     return out
 
 
-def probe(url, until, label, ended_id, pid=None, log_path=None, slow_ms=50.0):
+def probe(url, until, label, ended_id, pid=None, log_path=None, slow_ms=50.0, client_nice=None):
     times = Times(slow_ms)
     ctx = multiprocessing.get_context("fork")
     stop = ctx.Event()
     out = ctx.Queue()
-    clients = [ctx.Process(target=client_process, args=(reader, (url, [""]), stop, out)) for _ in range(2)]
-    clients.append(ctx.Process(target=client_process, args=(operator, (url, ended_id), stop, out)))
+    clients = [ctx.Process(target=client_process, args=(reader, (url, [""]), stop, out, client_nice)) for _ in range(2)]
+    clients.append(ctx.Process(target=client_process, args=(operator, (url, ended_id), stop, out, client_nice)))
     load0 = os.getloadavg()
     sched0 = main_thread_schedstat(pid) if pid else None
     groups0 = thread_groups(pid) if pid else {}
@@ -479,18 +483,22 @@ def main():
     ap.add_argument("--priority", nargs=2, type=int, metavar=("HEAVY", "SIM"),
                     help="colorlabd's [priority] heavy_work_nice and simulator_nice (default: colorlabd's own defaults;"
                          " 0 0 = as before issue 27)")
+    ap.add_argument("--client-nice", type=int,
+                    help="the probe's clients at this nice value (negative needs root), colorlabd left at its own")
     a = ap.parse_args()
     with tempfile.TemporaryDirectory(prefix="latency-probe-") as state:
         proc, url, log_path = start_daemon(a.build, state, a.time_scale, a.log, a.stage_ms, a.priority)
         try:
             ended = answered_execution(url)
-            idle = probe(url, lambda: time.sleep(a.idle_s), "idle", ended, proc.pid, log_path, a.slow_ms)
+            idle = probe(url, lambda: time.sleep(a.idle_s), "idle", ended, proc.pid, log_path, a.slow_ms,
+                         a.client_nice)
             study = {}
-            busy = probe(url, lambda: study.update(run_study(url)), "study", ended, proc.pid, log_path, a.slow_ms)
+            busy = probe(url, lambda: study.update(run_study(url)), "study", ended, proc.pid, log_path, a.slow_ms,
+                         a.client_nice)
         finally:
             proc.terminate()
             proc.wait(timeout=60)
-    result = {"time_scale": a.time_scale, "priority": a.priority, "phases": [idle, busy], "study_state": study.get("state"),
+    result = {"time_scale": a.time_scale, "priority": a.priority, "client_nice": a.client_nice, "phases": [idle, busy], "study_state": study.get("state"),
               "cpus": os.cpu_count()}
     for phase in (idle, busy):
         print(f"\n{phase['phase']}: {phase['wall_s']:.0f} s, load average {phase['load_before'][0]:.2f} -> "
