@@ -139,14 +139,18 @@ json place_light(client::ApiClient& api, const VerifyOptions& o, const std::vect
       described = "lens calibration \"" + name + "\" (" + l->source + ", " + l->date + ")";
     }
   }
-  if (!k)
+  if (!k) {
+    const std::string why = "no lens calibration for " + frame +
+                            " photographs (GET /v1/lab/lenses): the floor photograph's corners taken as a pinhole camera's; "
+                            "a distorted lens misplaces spots towards the frame's edges";
     return {{"light", {
                           {"model", "pinhole"},
                           {"lens", nullptr},
-                          {"how", "no lens calibration for " + frame + " photographs (GET /v1/lab/lenses): the floor photograph's corners "
-                                  "taken as a pinhole camera's; a distorted lens misplaces spots towards the frame's edges"},
+                          {"how", why},
                       }}};
+  }
   so.lens = verify::PhotographLens{k->fx, k->fy, k->cx, k->cy, k->k1, k->k2, described};
+  const std::string how = "the floor photograph's corners undistorted through the " + described + "; the rendering taken as that camera's pinhole";
   return {{"light", {
                         {"model", "lens calibration"},
                         {"lens", {
@@ -160,8 +164,7 @@ json place_light(client::ApiClient& api, const VerifyOptions& o, const std::vect
                                      {"k1", k->k1},
                                      {"k2", k->k2},
                                  }},
-                        {"how", "the floor photograph's corners undistorted through the " + described +
-                                    "; the rendering taken as that camera's pinhole"},
+                        {"how", how},
                     }}};
 }
 

@@ -68,7 +68,7 @@ void load_dslr(const std::filesystem::path& file, const toml::table& t, DslrLabC
           else if (f == "principal_dy_px") p.principal_dy_px = *v;
           else if (f == "fy_over_fx") p.fy_over_fx = *v;
           else bad(file, pn, "unknown key dslr.pose." + f + " (rotation_deg, tilt_deg, swing_deg, distance_mm, shift_x, shift_y, k1, k2, "
-                                                           "principal_dx_px, principal_dy_px, fy_over_fx)");
+                                                            "principal_dx_px, principal_dy_px, fy_over_fx)");
         }
       } else {
         bad(file, sn, "dslr.pose must be \"seeded\", \"square\" or a table of ChartPose fields");

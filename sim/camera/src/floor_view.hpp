@@ -12,9 +12,9 @@ namespace colorlab::sim::camera::detail {
 class FloorGeometry {
  public:
   FloorGeometry(int width, int height, double k1 = 0, double k2 = 0);
-  std::pair<double, double> image_of(double floor_x_mm, double floor_y_mm) const;   // distorted
+  std::pair<double, double> image_of(double floor_x_mm, double floor_y_mm) const;    // distorted
   std::pair<double, double> pinhole_of(double floor_x_mm, double floor_y_mm) const;  // without the distortion
-  std::pair<double, double> floor_of(double image_x, double image_y) const;         // from a distorted position
+  std::pair<double, double> floor_of(double image_x, double image_y) const;          // from a distorted position
   double focal_px() const { return f_; }
   double cx() const { return cx_; }
   double cy() const { return cy_; }

@@ -107,8 +107,16 @@ TEST(VerifyLensCli, TheFloorIsPlacedThroughTheNamedCalibrationAndSaysSo) {
     corners.push_back((c[0].get<double>() + 0.5) / t["width"].get<double>());
     corners.push_back((c[1].get<double>() + 0.5) / t["height"].get<double>());
   }
-  const json params = {{"lamps", {"D65"}}, {"dimmer_levels", {100}}, {"settle_s", 0}, {"rows", 2}, {"cols", 3},
-                       {"frames", 2}, {"corners", corners}, {"calibration", {"r0c0", "r1c2"}}};
+  const json params = {
+      {"lamps", {"D65"}},
+      {"dimmer_levels", {100}},
+      {"settle_s", 0},
+      {"rows", 2},
+      {"cols", 3},
+      {"frames", 2},
+      {"corners", corners},
+      {"calibration", {"r0c0", "r1c2"}},
+  };
   const std::string floor = run_to_end(api, "floor-luminance", params)["id"].get<std::string>();
   const int w = t["width"].get<int>(), h = t["height"].get<int>();
   ASSERT_EQ(w, 3504);

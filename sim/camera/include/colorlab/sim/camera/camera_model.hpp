@@ -23,11 +23,11 @@ namespace colorlab::sim::camera {
 // Where the chart sits in front of the camera (issue 14). Unset in CameraConfig: the chart square to the sensor,
 // centred, filling chart_height_fraction of the frame height, no lens distortion (the original behaviour).
 struct ChartPose {
-  double rotation_deg = 0;    // in the image plane, clockwise
+  double rotation_deg = 0;  // in the image plane, clockwise
   // Positive tilt: the chart's top edge (row 1) leans away from the camera, as a chart on the cabinet floor (row 1
   // at the back) leans for a camera at the open front. Positive swing: its right edge leans away.
-  double tilt_deg = 0;   // about the chart's horizontal axis
-  double swing_deg = 0;  // about its vertical axis
+  double tilt_deg = 0;        // about the chart's horizontal axis
+  double swing_deg = 0;       // about its vertical axis
   double distance_mm = 1200;  // camera to chart centre; the focal length keeps the chart at chart_height_fraction
   // chart centre offset as a fraction of the frame width / height
   double shift_x = 0, shift_y = 0;
