@@ -7,12 +7,12 @@
 #include <memory>
 #include <optional>
 #include <sstream>
-#include <stdexcept>
 #include <string>
 #include <tuple>
 #include <vector>
 
 #include "client_support.hpp"
+#include "lens_option.hpp"
 #include "colorlab/core/error.hpp"
 #include "colorlab/verify/cabinet_json.hpp"
 #include "colorlab/verify/cabinet_toml.hpp"
@@ -34,29 +34,6 @@ struct SceneOptions {
   std::string lens;
   std::string lens_calibration;
 };
-
-// --lens fx,fy,cx,cy[,k1,k2]: the lab's lens calibration, as `colorlab analyze locate-chart --lens` takes it.
-std::optional<verify::CameraIntrinsics> parse_lens(const std::string& text) {
-  if (text.empty()) return std::nullopt;
-  std::vector<double> v;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    try {
-      std::size_t used = 0;
-      v.push_back(std::stod(item, &used));
-      if (used != item.size()) throw std::invalid_argument(item);
-    } catch (const std::exception&) {
-      throw Error(ErrorClass::bad_parameter, "--lens: \"" + item + "\" is not a number", "--lens fx,fy,cx,cy[,k1,k2] in pixels");
-    }
-  }
-  if (v.size() != 4 && v.size() != 6)
-    throw Error(ErrorClass::bad_parameter, "--lens needs 4 or 6 numbers, got " + std::to_string(v.size()),
-                "--lens fx,fy,cx,cy[,k1,k2] (OpenCV's model, pixels of the located photograph)");
-  verify::CameraIntrinsics k{v[0], v[1], v[2], v[3], 0, 0};
-  if (v.size() == 6) k.k1 = v[4], k.k2 = v[5];
-  return k;
-}
 
 // A run is its id (fetched as the daemon's JSON export) or a file holding that export, so a scene can be made
 // where the daemon is not, from `colorlab export RUN -f json` files.

@@ -6,14 +6,18 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <sstream>
+#include <utility>
 
 #include "client_support.hpp"
+#include "lens_option.hpp"
 #include "colorlab/client/runs.hpp"
 #include "colorlab/core/error.hpp"
 #include "colorlab/verify/compare/scene_from_runs.hpp"
 #include "colorlab/verify/compare/stored.hpp"
 #include "colorlab/verify/compare/stored_request.hpp"
+#include "colorlab/verify/lens_calibration.hpp"
 #include "colorlab/verify/rendering.hpp"
 #ifdef COLORLAB_HAVE_VERIFY_COLOUR
 #include "colour_from_runs.hpp"
@@ -32,6 +36,8 @@ struct VerifyOptions {
   std::string lamp;
   std::optional<double> dimmer;
   double corner_accuracy_px = 0.5;
+  std::string lens;
+  std::string lens_calibration;
   bool json = false;
   bool store = false;
 };
@@ -81,8 +87,85 @@ std::string human(const json& j) {
   }
   if (j.contains("not_compared"))
     for (const auto& [kind, why] : j["not_compared"].items()) out << "  " << kind << " not compared: " << why.get<std::string>() << "\n";
+  if (j.contains("placement") && j["placement"].contains("light"))
+    out << "  floor placed: " << j["placement"]["light"]["how"].get<std::string>() << "\n";
   if (j.contains("stored_run")) out << "  stored as run " << j["stored_run"].get<std::string>() << "\n";
   return out.str();
+}
+
+// The floor photograph's size: the floor-luminance run's photograph rows (P/…) all come from its one camera.
+std::optional<std::pair<int, int>> floor_photograph_size(const std::vector<json>& runs) {
+  for (const auto& run : runs) {
+    if (run.value("campaign", "") != "floor-luminance" || !run.contains("measurements")) continue;
+    for (const auto& m : run["measurements"]) {
+      if (m.value("step", "").rfind("P/", 0) != 0 || !m.contains("data") || !m["data"].is_object()) continue;
+      const json& d = m["data"];
+      if (d.contains("width") && d["width"].is_number() && d.contains("height") && d["height"].is_number())
+        return std::pair{d["width"].get<int>(), d["height"].get<int>()};
+    }
+  }
+  return std::nullopt;
+}
+
+// Where the light half's floor lies in the rendering: through the lens the floor was photographed with — --lens, or
+// the lab's stored calibration (GET /v1/lab/lenses) for the photograph's size — else as a pinhole, and said which
+// (`placement.light`, also stored). Nothing to place without a floor-luminance run: null.
+json place_light(client::ApiClient& api, const VerifyOptions& o, const std::vector<json>& runs, verify::RunsSceneOptions& so) {
+  const auto size = floor_photograph_size(runs);
+  if (!size) {
+    if (!o.lens.empty() || !o.lens_calibration.empty())
+      throw Error(ErrorClass::bad_parameter, "--lens and --lens-calibration place the floor photograph, and no floor-luminance run with a photograph was given",
+                  "give the floor-luminance run with --against");
+    return nullptr;
+  }
+  const auto [w, h] = *size;
+  const std::string frame = std::to_string(w) + " × " + std::to_string(h);
+  std::optional<verify::CameraIntrinsics> k = parse_lens(o.lens);
+  std::string name = k ? "given with --lens" : "", described = k ? "lens given with --lens" : "";
+  if (!k) {
+    const json answer = api.get("/v1/lab/lenses");
+    if (!answer.is_object() || !answer.contains("items") || !answer["items"].is_array())
+      throw Error(ErrorClass::bad_data, "GET /v1/lab/lenses: no items in the daemon's answer", "give the lens with --lens");
+    std::vector<verify::LensCalibration> lenses;
+    for (const auto& i : answer["items"]) lenses.push_back(verify::lens_from_json(i, "GET /v1/lab/lenses"));
+    if (const auto l = verify::choose_lens(lenses, o.lens_calibration, w, h)) {
+      if (l->width_px != w || l->height_px != h)
+        throw Error(ErrorClass::bad_parameter,
+                    "lens calibration \"" + l->name() + "\" holds for " + std::to_string(l->width_px) + " × " + std::to_string(l->height_px) +
+                        " photographs, the floor photograph is " + frame,
+                    "name the calibration of the floor camera (colorlab lens list)");
+      k = l->intrinsics;
+      name = l->name();
+      described = "lens calibration \"" + name + "\" (" + l->source + ", " + l->date + ")";
+    }
+  }
+  if (!k) {
+    const std::string why = "no lens calibration for " + frame +
+                            " photographs (GET /v1/lab/lenses): the floor photograph's corners taken as a pinhole camera's; "
+                            "a distorted lens misplaces spots towards the frame's edges";
+    return {{"light", {
+                          {"model", "pinhole"},
+                          {"lens", nullptr},
+                          {"how", why},
+                      }}};
+  }
+  so.lens = verify::PhotographLens{k->fx, k->fy, k->cx, k->cy, k->k1, k->k2, described};
+  const std::string how = "the floor photograph's corners undistorted through the " + described + "; the rendering taken as that camera's pinhole";
+  return {{"light", {
+                        {"model", "lens calibration"},
+                        {"lens", {
+                                     {"name", name},
+                                     {"width_px", w},
+                                     {"height_px", h},
+                                     {"fx", k->fx},
+                                     {"fy", k->fy},
+                                     {"cx", k->cx},
+                                     {"cy", k->cy},
+                                     {"k1", k->k1},
+                                     {"k2", k->k2},
+                                 }},
+                        {"how", how},
+                    }}};
 }
 
 int verify(const GlobalOptions& global, const VerifyOptions& o) {
@@ -112,6 +195,7 @@ int verify(const GlobalOptions& global, const VerifyOptions& o) {
       throw Error(ErrorClass::bad_parameter, "--lamp and --dimmer go together", "e.g. --lamp D65 --dimmer 100");
     scene_options.light = verify::LightSelection{o.lamp, *o.dimmer};
   }
+  const json placement = place_light(api, o, runs, scene_options);
 #ifdef COLORLAB_HAVE_VERIFY_COLOUR
   json colour;
   const auto scene = verify::measured_scene_from_runs(runs, rendering, scene_options, &colour);
@@ -128,6 +212,7 @@ int verify(const GlobalOptions& global, const VerifyOptions& o) {
   out["against"] = o.against;
   out["lamp"] = scene.lamp;
   out["exit_status"] = verify::exit_status(v);
+  if (!placement.is_null()) out["placement"] = placement;
 #ifdef COLORLAB_HAVE_VERIFY_COLOUR
   if (!colour.is_null()) out["colour"] = colour;
 #endif
@@ -136,7 +221,7 @@ int verify(const GlobalOptions& global, const VerifyOptions& o) {
     out["not_compared"]["colour_7_4"] = "the rendering is not spectral: §7.4 takes each band's radiance through the camera's "
                                         "sensitivities (render the bands, e.g. colorlab scene's --mode bands)";
   if (o.store) {
-    const json stored = api.post("/v1/verifications", verify::store_request(v, name, o.against, options));
+    const json stored = api.post("/v1/verifications", verify::store_request(v, name, o.against, options, placement));
     out["stored_run"] = stored.at("run_id");
   }
   GlobalOptions g = global;
@@ -169,6 +254,12 @@ void add_verify_command(CLI::App& app, GlobalOptions& global) {
                   "how well the floor's corners are known on the photograph, one σ in its pixels (the misregistration)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  cmd->add_option("--lens", o->lens,
+                  "the floor camera's lens fx,fy,cx,cy[,k1,k2] (OpenCV's model, pixels of the floor photograph): the floor is placed "
+                  "in the rendering through it; overrides the stored calibrations (default: the lab's [[lens]] for the floor "
+                  "photograph's size, else a pinhole, said in `placement`)");
+  cmd->add_option("--lens-calibration", o->lens_calibration,
+                  "the stored lens calibration to place the floor through, by name (colorlab lens list), when several fit");
   cmd->add_flag("--json", o->json, "print the whole result: summary, every comparison with its budget, floor_difference");
   cmd->add_flag("--store", o->store, "store the verification on the daemon as a `verify` run (POST /v1/verifications)");
   cmd->callback([&global, o] {

@@ -9,6 +9,12 @@ import pandas as pd
 from . import tables
 
 
+# GET /v1/lab/lenses' fields (docs/API.md), the columns of an empty lenses() frame.
+LENS_COLUMNS = ["name", "camera", "lens", "focal_length_mm", "focus", "width_px", "height_px", "fx", "fy", "cx", "cy", "k1",
+                "k2", "sigma.fx", "sigma.fy", "sigma.cx", "sigma.cy", "sigma.k1", "sigma.k2", "rms_px", "photographs",
+                "points", "source", "date"]
+
+
 def _item_id(item) -> str:
     return item if isinstance(item, str) else item["id"]
 
@@ -20,6 +26,20 @@ class LabMixin:
 
     def instruments(self) -> pd.DataFrame:
         return tables.items_frame(self.conn.get("/v1/instruments").get("items", []))
+
+    def lenses(self) -> pd.DataFrame:
+        """``GET /v1/lab/lenses``: the lab's lens calibrations, as colorlabd's configuration holds them (``[[lens]]``;
+        docs/verify.md "The lens calibration"), one row each — ``name``, ``camera``, ``lens``, ``focal_length_mm``,
+        ``focus``, ``width_px``, ``height_px``, ``fx``, ``fy``, ``cx``, ``cy``, ``k1``, ``k2`` (pixels, OpenCV's model),
+        their one-σ uncertainties as ``sigma.fx`` … ``sigma.k2``, ``rms_px``, ``photographs``, ``points``, ``source``,
+        ``date``. No calibration configured: an empty frame with those columns."""
+        items = self.conn.get("/v1/lab/lenses").get("items", [])
+        rows = []
+        for item in items:
+            row = {k: v for k, v in item.items() if k != "sigma"}
+            row.update(tables.flatten_data(item.get("sigma") or {}, "sigma"))
+            rows.append(row)
+        return pd.DataFrame(rows, columns=None if rows else LENS_COLUMNS)
 
     def campaigns(self) -> pd.DataFrame:
         """The campaigns the daemon can run (re-read on every call), with their parameter declarations."""

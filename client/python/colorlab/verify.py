@@ -32,13 +32,14 @@ class VerifyFailed(ColorlabError):
 
 class VerifyMixin:
     def verify(self, path: str | os.PathLike, against: Sequence, scale: float | None = None, *, store: bool = False,
-               lamp: str | None = None, dimmer: float | None = None) -> dict:
+               lamp: str | None = None, dimmer: float | None = None, lens_calibration: str | None = None) -> dict:
         """``colorlab verify PATH --against RUN… --json``: the rendering beside the runs' measured scene.
 
         Returns the result document — ``summary`` (``verdict`` "agrees"/"differs", per kind compared/agree/differ,
         ``scales`` given or fitted), ``comparisons``, ``floor_difference``, ``exit_status`` (0 agrees, 4 differs),
         ``stored_run`` with ``store=True``, ``colour`` and ``not_compared`` when a characterize-camera run is among
-        ``against`` — plus ``table``: the comparisons as a DataFrame (kind, where,
+        ``against``, ``placement`` (how the floor was placed: through the lab's lens calibration for the floor
+        photograph's size, ``lens_calibration`` naming one among several, or as a pinhole) — plus ``table``: the comparisons as a DataFrame (kind, where,
         difference, expanded, verdict, …). ``scale``: renderer unit → cd/m² (omitted: one factor fitted per kind,
         which cannot see a uniformly wrong level). Raises ``VerifyFailed`` when no verdict could be made."""
         from .report.analyze import colorlab_binary  # the one place that knows where the binary is
@@ -63,6 +64,8 @@ class VerifyMixin:
             cmd += ["--scale", repr(float(scale))]
         if lamp is not None or dimmer is not None:
             cmd += ["--lamp", str(lamp), "--dimmer", repr(float(dimmer))]
+        if lens_calibration is not None:
+            cmd += ["--lens-calibration", str(lens_calibration)]
         if store:
             cmd.append("--store")
         try:

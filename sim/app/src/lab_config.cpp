@@ -64,7 +64,11 @@ void load_dslr(const std::filesystem::path& file, const toml::table& t, DslrLabC
           else if (f == "shift_y") p.shift_y = *v;
           else if (f == "k1") p.k1 = *v;
           else if (f == "k2") p.k2 = *v;
-          else bad(file, pn, "unknown key dslr.pose." + f + " (rotation_deg, tilt_deg, swing_deg, distance_mm, shift_x, shift_y, k1, k2)");
+          else if (f == "principal_dx_px") p.principal_dx_px = *v;
+          else if (f == "principal_dy_px") p.principal_dy_px = *v;
+          else if (f == "fy_over_fx") p.fy_over_fx = *v;
+          else bad(file, pn, "unknown key dslr.pose." + f + " (rotation_deg, tilt_deg, swing_deg, distance_mm, shift_x, shift_y, k1, k2, "
+                                                            "principal_dx_px, principal_dy_px, fy_over_fx)");
         }
       } else {
         bad(file, sn, "dslr.pose must be \"seeded\", \"square\" or a table of ChartPose fields");

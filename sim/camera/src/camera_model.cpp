@@ -361,7 +361,7 @@ CameraModel::CameraModel(std::shared_ptr<const Scene> scene, CameraConfig config
     }
   }
   if (m.config.pose) m.pose.emplace(*m.config.pose, m.config.width, m.config.height, m.config.chart_height_fraction);
-  m.floor.emplace(m.config.width, m.config.height);
+  m.floor.emplace(m.config.width, m.config.height, m.config.floor_k1, m.config.floor_k2);
   for (const auto& p : m.scene->chart().patches) {
     if (m.pose) {
       // The largest axis-aligned rectangle centred on the patch inside its image (pixel centres at +0.5).
@@ -505,6 +505,16 @@ CameraModel::View CameraModel::view() const { return impl_->view.load(); }
 std::array<double, 2> CameraModel::floor_point_px(double x_mm, double y_mm) const {
   const auto [u, v] = impl_->floor->image_of(x_mm, y_mm);
   return {u - 0.5, v - 0.5};
+}
+
+std::array<double, 2> CameraModel::floor_point_pinhole_px(double x_mm, double y_mm) const {
+  const auto [u, v] = impl_->floor->pinhole_of(x_mm, y_mm);
+  return {u - 0.5, v - 0.5};
+}
+
+LensIntrinsics CameraModel::floor_lens() const {
+  const auto& f = *impl_->floor;
+  return {f.focal_px(), f.focal_px(), f.cx() - 0.5, f.cy() - 0.5, f.k1(), f.k2()};
 }
 
 std::array<std::array<double, 2>, 4> CameraModel::floor_corners_px() const {

@@ -18,7 +18,7 @@ class PoseGeometry {
 
  private:
   Eigen::Matrix3d h_, inv_;
-  double f_ = 0, cx_ = 0, cy_ = 0, k1_ = 0, k2_ = 0;
+  double f_ = 0, fy_ = 0, cx_ = 0, cy_ = 0, k1_ = 0, k2_ = 0;
 };
 
 }  // namespace colorlab::sim::camera::detail

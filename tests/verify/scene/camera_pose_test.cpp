@@ -18,6 +18,7 @@
 #include "colorlab/verify/scene_export.hpp"
 #include "located_chart_run.hpp"
 #include "raw_photo_view.hpp"
+#include "simulator_camera.hpp"
 #include "simulated_runs.hpp"
 
 namespace colorlab::verify {
@@ -35,29 +36,6 @@ ca::ChartReference reference_of(const sim::Scene& scene) {
   ca::ChartReference r;
   for (std::size_t k = 0; k < scene.chart().patches.size(); ++k) r.luminance.push_back(scene.patch_xyz(static_cast<int>(k))[1]);
   return r;
-}
-
-struct Truth {
-  Eigen::Vector3d position_mm, axis;
-};
-
-// Where the simulator's camera is (chart_pose.cpp's definition: chart point (X, Y) mm from the board's top-left →
-// camera R·(X − W/2, Y − H/2, 0) + t), carried to the cabinet by the simulator's own chart placement
-// (Scene::chart_to_floor_mm: x along the board's width, y against its rows, z up out of the floor).
-Truth truth_of(const cam::ChartPose& p, const cam::CameraConfig& cc, const sim::Scene& scene) {
-  const double deg = std::numbers::pi / 180;
-  const Eigen::Matrix3d R = (Eigen::AngleAxisd(p.rotation_deg * deg, Eigen::Vector3d::UnitZ()) *
-                             Eigen::AngleAxisd(p.tilt_deg * deg, Eigen::Vector3d::UnitX()) *
-                             Eigen::AngleAxisd(p.swing_deg * deg, Eigen::Vector3d::UnitY()))
-                                .toRotationMatrix();
-  const double f = cc.chart_height_fraction * cc.height * p.distance_mm / sim::chart_height_mm;
-  const Eigen::Vector3d t = R * Eigen::Vector3d(-sim::chart_width_mm / 2, -sim::chart_height_mm / 2, 0) +
-                            Eigen::Vector3d(p.shift_x * cc.width * p.distance_mm / f, p.shift_y * cc.height * p.distance_mm / f,
-                                            p.distance_mm);
-  const Eigen::Vector3d c = -R.transpose() * t;  // camera centre, board coordinates (z into the board)
-  const auto [fx, fy] = scene.chart_to_floor_mm(c.x(), c.y());
-  const Eigen::Vector3d a = R.transpose() * Eigen::Vector3d::UnitZ();
-  return {{fx, fy, -c.z()}, {a.x(), -a.y(), -a.z()}};
 }
 
 json characterize_run(const ca::ChartLocation& loc, int width, int height) {
@@ -94,7 +72,7 @@ TEST(SceneCameraPose, FromTheLocatedChartWhereTheSimulatorsCameraIs) {
     o.lens_source = "the simulator's lens";
     const std::vector<json> runs{testing::chart_read_run(*scene, 1), characterize_run(loc, cc.width, cc.height)};
     const json k = export_scene(default_cabinet(), runs, o)["camera"];
-    const Truth want = truth_of(pose, cc, *scene);
+    const auto want = testing::simulator_camera(pose, l.fx, l.fy, cc.width, cc.height, *scene);
 
     ASSERT_EQ(k["pose"]["source"], "located chart");
     EXPECT_FALSE(k["estimated"].get<bool>());
@@ -125,6 +103,59 @@ TEST(SceneCameraPose, FromTheLocatedChartWhereTheSimulatorsCameraIs) {
       outside = outside || std::abs(wp[i] * 1000 - want.position_mm[static_cast<Eigen::Index>(i)]) > kSigmas * sig[i] * 1000;
     EXPECT_TRUE(outside) << "seed " << seed << ": a lens 10 % off still agrees — the bound cannot tell";
   }
+}
+
+// The sign of the tilt and swing (camera_model.hpp: a positive tilt leans the chart's top edge — row 1, the back of
+// the cabinet — away from the camera, a positive swing its right edge): a lab camera stands at the cabinet's open
+// front, so the chart's top edge leans away from it, and a positive-tilt photograph must give a camera in front of
+// the chart (the simulator's sign was once the opposite: its camera came out behind the chart, at the back). A
+// positive swing puts the camera on the chart's left. Physics, not a derivation: only which side of the chart.
+TEST(SceneCameraPose, APositiveTiltPhotographsTheChartFromTheCabinetsFront) {
+  sim::SceneConfig sc;
+  sc.seed = 4;
+  sc.lamps_on_at_start = {sim::Lamp::d65};
+  auto scene = std::make_shared<sim::Scene>(sc, std::make_shared<sim::SimClock>());
+  cam::CameraConfig cc;
+  cc.width = 1752;
+  cc.height = 1168;
+  cc.chart_height_fraction = 0.55;
+  cam::ChartPose pose;  // the Blender daemon test's sighting (30° off the chart's normal, 600 mm), swung a little
+  pose.tilt_deg = 30, pose.swing_deg = 10, pose.distance_mm = 600;
+  cc.pose = pose;
+  const cam::CameraModel camera(scene, cc);
+  // The image itself: the top edge of the patch grid (A1–N1), farther away, is shorter than the bottom (A10–N10),
+  // and the right edge (N1–N10) shorter than the left (A1–A10).
+  const auto g = camera.patch_grid_corners_px();
+  const auto len = [](const std::array<double, 2>& a, const std::array<double, 2>& b) { return std::hypot(a[0] - b[0], a[1] - b[1]); };
+  EXPECT_LT(len(g[0], g[1]), len(g[3], g[2])) << "top edge not farther than the bottom";
+  EXPECT_LT(len(g[1], g[2]), len(g[0], g[3])) << "right edge not farther than the left";
+
+  cam::CameraSettings settings;
+  settings.shutter_s = 1.0 / 30;
+  const cam::RawFrame frame = camera.render(settings, 1);
+  ca::LocateOptions lo;
+  lo.reference = reference_of(*scene);
+  const ca::ChartLocation loc = ca::locate_chart(testing::raw_view(frame), ca::ChartType::sg140, lo);
+  const auto l = camera.lens();
+  SceneExportOptions o;
+  o.lamps = {"D65"};
+  o.lens = CameraIntrinsics{l.fx, l.fy, l.cx, l.cy, l.k1, l.k2};
+  const json k = export_scene(default_cabinet(), {testing::chart_read_run(*scene, 1), characterize_run(loc, cc.width, cc.height)}, o)["camera"];
+  const auto p = k["position_m"].get<std::vector<double>>();
+  const auto [chart_x, chart_y] = scene->chart_to_floor_mm(sim::chart_width_mm / 2, sim::chart_height_mm / 2);
+  const double front_edge_y = chart_y - sim::chart_height_mm / 2;
+  std::printf("[ tilt 30°, swing 10° ] exported camera at (%.1f, %.1f, %.1f) mm; chart centre (%.1f, %.1f), its front edge at y "
+              "= %.1f mm\n",
+              p[0] * 1000, p[1] * 1000, p[2] * 1000, chart_x, chart_y, front_edge_y);
+  EXPECT_LT(p[1] * 1000, front_edge_y) << "the camera is not in front of the chart";
+  EXPECT_LT(p[1], 0.0) << "a camera 600 mm from the chart at 30° stands outside the cabinet's open front (y < 0)";
+  EXPECT_LT(p[0] * 1000, chart_x) << "a positive swing must put the camera on the chart's left";
+  EXPECT_GT(p[2], 0.0);
+  // And where ChartPose's angles put it, within the export's own 4 σ.
+  const auto want = testing::simulator_camera(pose, l.fx, l.fy, cc.width, cc.height, *scene);
+  const auto sig = k["pose"]["position_sigma_m"].get<std::vector<double>>();
+  for (std::size_t i = 0; i < 3; ++i)
+    EXPECT_LE(std::abs(p[i] * 1000 - want.position_mm[static_cast<Eigen::Index>(i)]), kSigmas * sig[i] * 1000) << "axis " << i;
 }
 
 TEST(SceneCameraPose, WithoutALensCalibrationTheIntrinsicsSayTheyAreNominal) {

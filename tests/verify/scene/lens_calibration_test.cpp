@@ -26,6 +26,7 @@
 #include "colorlab/verify/scene_export.hpp"
 #include "located_chart_run.hpp"
 #include "raw_photo_view.hpp"
+#include "simulator_camera.hpp"
 #include "simulated_runs.hpp"
 
 namespace colorlab::verify {
@@ -41,17 +42,19 @@ constexpr double kSigmas = 3.0;
 constexpr int kWidth = 1752, kHeight = 1168;
 constexpr double kPitchMm = 19.0;  // the SG's patch pitch (the chart's known geometry; the scale does not enter the intrinsics)
 
-// The simulator's lens: a ~31 mm lens on the 22.5 mm sensor with barrel distortion. The simulator's posed chart
-// is seen through a pinhole at the frame's centre (fx = fy) whose focal length keeps the chart at
-// chart_height_fraction of the frame: f = fraction · height · distance / chart height. So one lens at several
-// poses is each pose's distance with the fraction that gives this f — no mechanism added to the simulator.
-constexpr double kF = 2450.0;
-cam::LensIntrinsics true_lens() { return {kF, kF, kWidth / 2.0 - 0.5, kHeight / 2.0 - 0.5, -0.09, 0.04}; }
+// The simulator's lens: a ~31 mm lens on the 22.5 mm sensor with barrel distortion, its principal point a few
+// pixels off the frame's centre and fy 0.1 % longer than fx, as a real lens and sensor have them (ChartPose's
+// principal_dx_px, principal_dy_px, fy_over_fx). The simulator's posed chart is seen through that pinhole with a
+// focal length that keeps the chart at chart_height_fraction of the frame: fx = fraction · height · distance / chart
+// height. So one lens at several poses is each pose's distance with the fraction that gives this fx.
+constexpr double kF = 2450.0, kAspect = 1.001, kDx = 3.5, kDy = -2.5;
+cam::LensIntrinsics true_lens() { return {kF, kF * kAspect, kWidth / 2.0 - 0.5 + kDx, kHeight / 2.0 - 0.5 + kDy, -0.09, 0.04}; }
 
 cam::ChartPose pose(double tilt, double swing, double rot, double sx, double sy, double distance) {
   cam::ChartPose p;
   p.tilt_deg = tilt, p.swing_deg = swing, p.rotation_deg = rot, p.shift_x = sx, p.shift_y = sy, p.distance_mm = distance;
   p.k1 = true_lens().k1, p.k2 = true_lens().k2;
+  p.principal_dx_px = kDx, p.principal_dy_px = kDy, p.fy_over_fx = kAspect;
   return p;
 }
 
@@ -87,8 +90,8 @@ ca::ChartLocation photograph_and_locate(const std::shared_ptr<sim::Scene>& scene
   const cam::LensIntrinsics l = camera.lens(), t = true_lens();  // the simulator's own statement of its lens
   EXPECT_NEAR(l.fx, t.fx, 1e-9);
   EXPECT_NEAR(l.fy, t.fy, 1e-9);
-  EXPECT_EQ(l.cx, t.cx);
-  EXPECT_EQ(l.cy, t.cy);
+  EXPECT_NEAR(l.cx, t.cx, 1e-9);
+  EXPECT_NEAR(l.cy, t.cy, 1e-9);
   EXPECT_EQ(l.k1, t.k1);
   EXPECT_EQ(l.k2, t.k2);
   cam::CameraSettings settings;
@@ -116,22 +119,6 @@ CalibrationView view_of(const ca::ChartLocation& loc) {
     v.chart_mm.push_back({layout.centre_x(k) * kPitchMm, layout.centre_y(k) * kPitchMm});
   }
   return v;
-}
-
-// Where the simulator's camera is in the cabinet (chart_pose.cpp's definition with the fixed lens, carried to the
-// floor by Scene::chart_to_floor_mm), as camera_pose_test.cpp derives it.
-Eigen::Vector3d true_position_mm(const cam::ChartPose& p, const sim::Scene& scene) {
-  const double deg = std::numbers::pi / 180;
-  const Eigen::Matrix3d R = (Eigen::AngleAxisd(p.rotation_deg * deg, Eigen::Vector3d::UnitZ()) *
-                             Eigen::AngleAxisd(p.tilt_deg * deg, Eigen::Vector3d::UnitX()) *
-                             Eigen::AngleAxisd(p.swing_deg * deg, Eigen::Vector3d::UnitY()))
-                                .toRotationMatrix();
-  const Eigen::Vector3d t = R * Eigen::Vector3d(-sim::chart_width_mm / 2, -sim::chart_height_mm / 2, 0) +
-                            Eigen::Vector3d(p.shift_x * kWidth * p.distance_mm / kF, p.shift_y * kHeight * p.distance_mm / kF,
-                                            p.distance_mm);
-  const Eigen::Vector3d c = -R.transpose() * t;
-  const auto [fx, fy] = scene.chart_to_floor_mm(c.x(), c.y());
-  return {fx, fy, -c.z()};
 }
 
 json characterize_run(const ca::ChartLocation& loc) {
@@ -215,7 +202,7 @@ TEST(LensCalibrationSim, RecoversTheSimulatorsLensWithinItsStatedUncertainty) {
   EXPECT_TRUE(nominal["estimated"].get<bool>());
   EXPECT_TRUE(nominal["lens_calibration"].is_null());
 
-  const Eigen::Vector3d want = true_position_mm(eval, *scene);
+  const Eigen::Vector3d want = testing::simulator_camera(eval, true_lens().fx, true_lens().fy, kWidth, kHeight, *scene).position_mm;
   const auto at = [](const json& k) -> Eigen::Vector3d {
     const auto p = k["position_m"].get<std::vector<double>>();
     return Eigen::Vector3d(p[0], p[1], p[2]) * 1000;

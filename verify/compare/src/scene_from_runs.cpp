@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 
 #include "colorlab/analysis/floor_luminance.hpp"
 #include "colorlab/core/error.hpp"
@@ -40,14 +41,10 @@ double number(const json& data, const char* key, const std::string& where) {
   return data[key].get<double>();
 }
 
-}  // namespace
-
-SpotRegion floor_spot_regions(const json& photograph, int width, int height, const FloorGeometry& floor) {
+// The photograph row's four floor corners, undistorted through the lens when one is given: they were measured on the
+// distorted photograph, and the rendering is the pinhole of the same camera.
+std::array<std::array<double, 2>, 4> pinhole_corners(const json& photograph, const std::optional<PhotographLens>& lens) {
   const std::string where = "the floor photograph row";
-  const double pw = number(photograph, "width", where), ph = number(photograph, "height", where);
-  const double spot_mm = number(photograph, "spot_mm", where);
-  if (!(pw > 0 && ph > 0 && spot_mm > 0) || width <= 0 || height <= 0)
-    throw Error(ErrorClass::bad_data, where + " or the rendering has no size");
   const json& c = photograph.contains("corners_px") ? photograph["corners_px"] : json();
   if (!c.is_array() || c.size() != 4)
     throw Error(ErrorClass::bad_data, where + " has no four corners_px", "re-run floor-luminance with this colorlab");
@@ -56,26 +53,50 @@ SpotRegion floor_spot_regions(const json& photograph, int width, int height, con
     if (!c[i].is_array() || c[i].size() != 2 || !c[i][0].is_number() || !c[i][1].is_number())
       throw Error(ErrorClass::bad_data, where + ": corner " + std::to_string(i) + " is not [x, y]");
     corners[i] = {c[i][0].get<double>(), c[i][1].get<double>()};
+    if (lens) corners[i] = undistort_px(*lens, corners[i]);
   }
-  const analysis::FloorMap map(corners, floor.width_mm, floor.depth_mm);
+  return corners;
+}
+
+}  // namespace
+
+FloorPlacement::FloorPlacement(const json& photograph, int width, int height, const FloorGeometry& floor,
+                               const std::optional<PhotographLens>& lens)
+    : map_(pinhole_corners(photograph, lens), floor.width_mm, floor.depth_mm), floor_(floor) {
+  const std::string where = "the floor photograph row";
+  const double pw = number(photograph, "width", where), ph = number(photograph, "height", where);
+  const double spot_mm = number(photograph, "spot_mm", where);
+  if (!(pw > 0 && ph > 0 && spot_mm > 0) || width <= 0 || height <= 0)
+    throw Error(ErrorClass::bad_data, where + " or the rendering has no size");
+  sx_ = width / pw, sy_ = height / ph, radius_mm_ = spot_mm / 2;
+}
+
+std::array<double, 2> FloorPlacement::rendering_px(double x_mm, double y_mm) const {
   // Pixel centres at integers on both sides: the photograph's pixel p covers the rendering's (p + ½)·s − ½.
-  const double sx = width / pw, sy = height / ph, r = spot_mm / 2;
-  return [=](int row, int col) {
-    const double x = (col + 0.5) * floor.pitch_x_mm, y = (row + 0.5) * floor.pitch_y_mm;
-    const auto p = map.pixel_of(x, y);
-    const double cx = (p[0] + 0.5) * sx - 0.5, cy = (p[1] + 0.5) * sy - 0.5;
-    // The disc's extent along each image axis, then the square inscribed in it: every sampled pixel lies on the spot.
-    const auto xl = map.pixel_of(x - r, y), xr = map.pixel_of(x + r, y);
-    const auto yf = map.pixel_of(x, y - r), yb = map.pixel_of(x, y + r);
-    const double hx = std::hypot(xr[0] - xl[0], xr[1] - xl[1]) / 2 * sx / std::sqrt(2.0);
-    const double hy = std::hypot(yb[0] - yf[0], yb[1] - yf[1]) / 2 * sy / std::sqrt(2.0);
-    PixelRect rect;
-    rect.w = std::max(1, static_cast<int>(std::lround(2 * hx)));
-    rect.h = std::max(1, static_cast<int>(std::lround(2 * hy)));
-    rect.x = static_cast<int>(std::lround(cx - (rect.w - 1) / 2.0));
-    rect.y = static_cast<int>(std::lround(cy - (rect.h - 1) / 2.0));
-    return rect;
-  };
+  const auto p = map_.pixel_of(x_mm, y_mm);
+  return {(p[0] + 0.5) * sx_ - 0.5, (p[1] + 0.5) * sy_ - 0.5};
+}
+
+PixelRect FloorPlacement::spot_region(int row, int col) const {
+  const double x = (col + 0.5) * floor_.pitch_x_mm, y = (row + 0.5) * floor_.pitch_y_mm, r = radius_mm_;
+  const auto c = rendering_px(x, y);
+  // The disc's extent along each image axis, then the square inscribed in it: every sampled pixel lies on the spot.
+  const auto xl = map_.pixel_of(x - r, y), xr = map_.pixel_of(x + r, y);
+  const auto yf = map_.pixel_of(x, y - r), yb = map_.pixel_of(x, y + r);
+  const double hx = std::hypot(xr[0] - xl[0], xr[1] - xl[1]) / 2 * sx_ / std::sqrt(2.0);
+  const double hy = std::hypot(yb[0] - yf[0], yb[1] - yf[1]) / 2 * sy_ / std::sqrt(2.0);
+  PixelRect rect;
+  rect.w = std::max(1, static_cast<int>(std::lround(2 * hx)));
+  rect.h = std::max(1, static_cast<int>(std::lround(2 * hy)));
+  rect.x = static_cast<int>(std::lround(c[0] - (rect.w - 1) / 2.0));
+  rect.y = static_cast<int>(std::lround(c[1] - (rect.h - 1) / 2.0));
+  return rect;
+}
+
+SpotRegion floor_spot_regions(const json& photograph, int width, int height, const FloorGeometry& floor,
+                              const std::optional<PhotographLens>& lens) {
+  const auto placement = std::make_shared<const FloorPlacement>(photograph, width, height, floor, lens);
+  return [placement](int row, int col) { return placement->spot_region(row, col); };
 }
 
 MeasuredScene scene_from_runs(const std::vector<json>& runs, int width, int height, const RunsSceneOptions& options) {
@@ -121,7 +142,7 @@ MeasuredScene scene_from_runs(const std::vector<json>& runs, int width, int heig
     if (chosen.lamp.empty()) throw Error(ErrorClass::bad_data, "the floor photograph row names no lamp");
     light = chosen;
   }
-  const SpotRegion region = floor_spot_regions(data, width, height, options.floor);
+  const SpotRegion region = floor_spot_regions(data, width, height, options.floor, options.lens);
 
   MeasuredScene scene;
   scene.runs.push_back(floor_run->value("id", ""));

@@ -3,7 +3,7 @@
 namespace colorlab::verify {
 
 StoredVerification to_store(const Verification& v, const std::string& rendering, const std::vector<std::string>& against,
-                            const CompareOptions& options) {
+                            const CompareOptions& options, const nlohmann::json& placement) {
   StoredVerification s;
   s.params = {
       {"rendering", rendering},
@@ -11,6 +11,7 @@ StoredVerification to_store(const Verification& v, const std::string& rendering,
       {"scale", options.scale ? nlohmann::json(*options.scale) : nlohmann::json(nullptr)},
       {"k", options.k},
   };
+  if (!placement.is_null()) s.params["placement"] = placement;
   const auto full = v.to_json();
   s.summary = full["summary"];
   s.summary["floor_difference"] = full["floor_difference"];

@@ -124,18 +124,26 @@ StoredVerification stored_from_request(const json& body) {
     if (!(*options.scale > 0)) throw bad("body.scale must be positive (renderer unit -> cd/m²) or null (fitted)");
   }
   if (body.contains("k")) options.k = num(body, "k", "body");
-  return to_store(verification_from_json(field(body, "result", "body")), rendering, runs, options);
+  json placement;
+  if (body.contains("placement") && !body["placement"].is_null()) {
+    placement = body["placement"];
+    if (!placement.is_object()) throw bad("body.placement is not an object");
+    if (placement.dump().size() > 4096) throw bad("body.placement is larger than 4 KiB");
+  }
+  return to_store(verification_from_json(field(body, "result", "body")), rendering, runs, options, placement);
 }
 
 json store_request(const Verification& v, const std::string& rendering, const std::vector<std::string>& against,
-                   const CompareOptions& options) {
-  return {
+                   const CompareOptions& options, const json& placement) {
+  json body{
       {"rendering", rendering},
       {"against", against},
       {"scale", options.scale ? json(*options.scale) : json(nullptr)},
       {"k", options.k},
       {"result", v.to_json()},
   };
+  if (!placement.is_null()) body["placement"] = placement;
+  return body;
 }
 
 }  // namespace colorlab::verify

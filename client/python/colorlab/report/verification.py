@@ -186,7 +186,8 @@ def photo_maps(run, kinds) -> list[str]:
         if svg:
             out.append(figure(f"{run.short}-fig-verify-chart-photo", svg,
                               f"Over the chart photograph (run {esc(p.run_id)}, frame {esc(p.blob[:12])}…, shown in grey): "
-                              "each patch's difference in false colour where the chart locator found the patch; "
+                              "each patch's difference in false colour where the chart locator found the patch, placed "
+                              f"{esc(overlay.chart_placement(p).how)}; "
                               "outlined in red where it differs beyond the measurement's k = 2 band, a dot where the "
                               "measurement cannot tell.", "verify-chart-photo"))
     if "floor" in shot:
@@ -196,7 +197,8 @@ def photo_maps(run, kinds) -> list[str]:
             out.append(figure(f"{run.short}-fig-verify-floor-photo", svg,
                               f"Over the floor photograph ({esc(p.what)} of run {esc(p.run_id)}, shown in grey): the "
                               "luminance ratio rendered / measured as a translucent layer on the floor map's cells, "
-                              "the LS-110's measuring discs opaque, placed through the floor's four corners; outlined "
+                              "the LS-110's measuring discs opaque, placed from the floor's four corners "
+                              f"{esc(overlay.floor_placement(p).how)}; outlined "
                               "in red where it differs beyond k = 2, a dot where the measurement cannot tell.",
                               "verify-floor-photo"))
     return out

@@ -1,11 +1,12 @@
 """The verification's maps over the photograph (issue 23's report): each patch's ΔE00 (§7.3; §7.4's relative
 difference beside it) in false colour at the patch's place on the chart photograph, where the chart locator found
 it; and the luminance ratio rendered / measured as a translucent false-colour layer over the floor photograph —
-the floor map's cells and the LS-110's measuring discs where the floor homography puts them. Red outline: differs
+the floor map's cells and the LS-110's measuring discs where the floor's corners put them. Red outline: differs
 beyond the k = 2 band; a black dot: the measurement cannot tell.
 
 Places come from the stored geometry only: the locator's four outer corners of the patch grid (chart_layout.hpp:
-A1's, N1's, N10's, A10's, patch pitch 1, patch side 15/19 of it) and the floor's four corners (1200 × 600 mm).
+A1's, N1's, N10's, A10's, patch pitch 1, patch side 15/19 of it) and the floor's four corners (1200 × 600 mm),
+through the photograph's lens calibration when one is known (verification_lens.py), else as a pinhole.
 """
 from __future__ import annotations
 
@@ -17,7 +18,8 @@ from matplotlib.patches import Polygon
 
 from . import verification_data as vd
 from .plots import subplots, to_svg
-from .verification_photo import FLOOR_MM, apply, homography
+from .verification_lens import Placement
+from .verification_photo import FLOOR_MM
 
 SG_COLUMNS, SG_ROWS, PATCH_SIDE = 14, 10, 15.0 / 19.0  # the SG's grid (chart_layout.cpp): 15 mm patches, 19 mm pitch
 RATIO_ALPHA = 0.6    # the ratio layer over the floor: the photograph shows through
@@ -35,20 +37,21 @@ def ratio_norm(ratios) -> TwoSlopeNorm:
     return TwoSlopeNorm(vcenter=1.0, vmin=1 - span, vmax=1 + span)
 
 
-def patch_quad(grid_to_px, row, col) -> np.ndarray:
-    """The patch's square (row, column 1-based) in photograph pixels."""
-    x, y = col - 1.0, row - 1.0
-    return apply(grid_to_px, [(x, y), (x + PATCH_SIDE, y), (x + PATCH_SIDE, y + PATCH_SIDE), (x, y + PATCH_SIDE)])
-
-
-def chart_homography(corners) -> np.ndarray:
+def chart_placement(photo) -> Placement:
+    """The SG's grid coordinates → the chart photograph's pixels."""
     gw, gh = SG_COLUMNS - 1 + PATCH_SIDE, SG_ROWS - 1 + PATCH_SIDE
-    return homography([(0, 0), (gw, 0), (gw, gh), (0, gh)], corners)
+    return Placement([(0, 0), (gw, 0), (gw, gh), (0, gh)], photo.corners, photo.lens)
 
 
-def floor_homography(corners) -> np.ndarray:
+def floor_placement(photo) -> Placement:
+    """Floor millimetres → the floor photograph's pixels."""
     w, d = FLOOR_MM
-    return homography([(0, 0), (w, 0), (w, d), (0, d)], corners)
+    return Placement([(0, 0), (w, 0), (w, d), (0, d)], photo.corners, photo.lens)
+
+
+def patch_outline(place, row, col) -> np.ndarray:
+    x, y = col - 1.0, row - 1.0
+    return place.polygon([(x, y), (x + PATCH_SIDE, y), (x + PATCH_SIDE, y + PATCH_SIDE), (x, y + PATCH_SIDE)])
 
 
 def _photo_axes(ax, photo, title):
@@ -73,7 +76,7 @@ def chart_figure(photo, items_by_kind):
     kinds = [k for k in ("colour_7_3", "colour_7_4") if any(vd.patch_rc(c["where"]) for c in items_by_kind.get(k, []))]
     if not kinds:
         return None, []
-    h = chart_homography(photo.corners)
+    place = chart_placement(photo)
     aspect = photo.height / photo.width
     fig, axes = subplots(len(kinds), width=5.2 * len(kinds), height=5.2 * aspect + 0.6)
     panels = []
@@ -85,10 +88,10 @@ def chart_figure(photo, items_by_kind):
         _photo_axes(ax, photo, "§7.3: ΔE00 over the photograph" if kind == "colour_7_3"
                     else "§7.4: |Δ| / |measured|, % over the photograph")
         for ((r, col), c), v in zip(placed, values):
-            quad = patch_quad(h, r, col)
+            outline = patch_outline(place, r, col)
             edge = DIFFERS if c["verdict"] == "differs" else dict(edgecolor="none")
-            ax.add_patch(Polygon(quad, closed=True, facecolor=cmap(norm(v)), **edge))
-            centre = quad.mean(axis=0)
+            ax.add_patch(Polygon(outline, closed=True, facecolor=cmap(norm(v)), **edge))
+            centre = place([(col - 1.0 + PATCH_SIDE / 2, r - 1.0 + PATCH_SIDE / 2)])[0]
             _mark(ax, c, *centre)
         sm = ScalarMappable(cmap=cmap, norm=norm)
         fig.colorbar(sm, ax=ax, shrink=0.8, label="ΔE00" if kind == "colour_7_3" else "%")
@@ -96,9 +99,9 @@ def chart_figure(photo, items_by_kind):
     return fig, panels
 
 
-def _disc(h, x_mm, y_mm, d_mm, n=32) -> np.ndarray:
+def _disc(place, x_mm, y_mm, d_mm, n=32) -> np.ndarray:
     t = np.linspace(0, 2 * np.pi, n, endpoint=False)
-    return apply(h, np.c_[x_mm + d_mm / 2 * np.cos(t), y_mm + d_mm / 2 * np.sin(t)])
+    return place(np.c_[x_mm + d_mm / 2 * np.cos(t), y_mm + d_mm / 2 * np.sin(t)])
 
 
 def floor_figure(photo, items_by_kind):
@@ -107,7 +110,7 @@ def floor_figure(photo, items_by_kind):
     kinds = [k for k in ("light_floor", "light_spot") if any(vd.spot_rc(c["where"]) for c in items_by_kind.get(k, []))]
     if not kinds:
         return None, []
-    h = floor_homography(photo.corners)
+    place = floor_placement(photo)
     px, py = vd.PITCH_MM
     spot_mm = photo.extra.get("spot_mm", 20.0)
     norm = ratio_norm([1 + c["difference"] for k in kinds for c in items_by_kind[k]])
@@ -127,12 +130,12 @@ def floor_figure(photo, items_by_kind):
             edge = DIFFERS if c["verdict"] == "differs" else dict(edgecolor="none")
             if kind == "light_floor":
                 x0, y0 = col * px, r * py
-                quad = apply(h, [(x0, y0), (x0 + px, y0), (x0 + px, y0 + py), (x0, y0 + py)])
-                ax.add_patch(Polygon(quad, closed=True, facecolor=colour[:3] + (RATIO_ALPHA,), **edge))
+                outline = place.polygon([(x0, y0), (x0 + px, y0), (x0 + px, y0 + py), (x0, y0 + py)])
+                ax.add_patch(Polygon(outline, closed=True, facecolor=colour[:3] + (RATIO_ALPHA,), **edge))
             else:
-                ax.add_patch(Polygon(_disc(h, (col + 0.5) * px, (r + 0.5) * py, spot_mm), closed=True,
+                ax.add_patch(Polygon(_disc(place, (col + 0.5) * px, (r + 0.5) * py, spot_mm), closed=True,
                                      facecolor=colour, **edge))
-            centre = apply(h, [((col + 0.5) * px, (r + 0.5) * py)])[0]
+            centre = place([((col + 0.5) * px, (r + 0.5) * py)])[0]
             _mark(ax, c, *centre)
         sm = ScalarMappable(cmap=cmap, norm=norm)
         fig.colorbar(sm, ax=ax, shrink=0.8, label="luminance ratio rendered / measured")

@@ -30,6 +30,7 @@ class Photo:
     blob: str                   # sha256 of the kept frame shown
     what: str = ""              # "chart/raw" or "P/D65/D100"
     extra: dict = field(default_factory=dict)
+    lens: dict | None = None    # the lens it was taken through (verification_lens.lens_dict), None: placed as a pinhole
 
 
 def homography(src, dst) -> np.ndarray:
@@ -166,10 +167,31 @@ def load(client, run, items_by_kind) -> dict:
     """{"chart": Photo, "floor": Photo} for the runs the verification names in ``against`` (each missing when the
     run, its geometry or its kept frame is not there). A photograph that cannot be had leaves its map out; it never
     stops the report."""
+    from . import verification_lens as lenses  # it builds on this module's homography
+
     out = {}
     if client is None:
         return out
-    against = [str(a) for a in (run.doc.get("params") or {}).get("against") or []]
+    params = run.doc.get("params") or {}
+    against = [str(a) for a in params.get("against") or []]
+    light = (params.get("placement") or {}).get("light") or {}
+    stored_lens = light.get("lens") if light.get("model") == "lens calibration" else None
+    calibrations = None
+
+    def lens_for(photo, stored=None):
+        nonlocal calibrations
+        if calibrations is None:
+            try:
+                calibrations = client.lenses().to_dict("records")
+            except Exception:  # noqa: BLE001 — a daemon without the route, a fake: the photograph as a pinhole
+                calibrations = []
+        lens = lenses.choose(photo.width, photo.height, stored, calibrations)
+        try:
+            lenses.undistort(lens, photo.corners)
+        except ValueError:  # corners the lens cannot take (not this photograph's lens): placed as a pinhole
+            return None
+        return lens
+
     for rid in against:
         try:
             doc = dict(client.run(rid))
@@ -181,11 +203,13 @@ def load(client, run, items_by_kind) -> dict:
                     "colour_7_3" in items_by_kind or "colour_7_4" in items_by_kind):
                 photo = chart_photo(client, rid)
                 if photo is not None:
+                    photo.lens = lens_for(photo)
                     out["chart"] = photo
             elif kind == "floor-luminance" and "floor" not in out and (
                     "light_floor" in items_by_kind or "light_spot" in items_by_kind):
                 photo = floor_photo(client, rid, items_by_kind.get("light_floor", []))
                 if photo is not None:
+                    photo.lens = lens_for(photo, stored_lens)
                     out["floor"] = photo
         except Exception:  # noqa: BLE001 — the maps on the chart's and floor's own coordinates still stand
             continue

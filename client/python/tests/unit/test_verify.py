@@ -65,6 +65,9 @@ class VerifyTest(unittest.TestCase):
         self.assertNotIn("clk_secret", " ".join(called["argv"]))
         self.assertEqual(called["key"], "clk_secret")
         self.assertNotIn("--scale", called["argv"])
+        self.assertNotIn("--lens-calibration", called["argv"])
+        lab.verify("box.exr", against=["a1"], lens_calibration="EOS 20D / EF 50mm")
+        self.assertEqual(self.called()["argv"][-2:], ["--lens-calibration", "EOS 20D / EF 50mm"])
 
     def test_no_verdict_raises_with_colorlabs_message(self):
         for code, err in ((1, "colorlab: bad.exr: not an image\n  hint: …\n"), (2, "colorlab: 404 Not Found: no run 'x'\n")):

@@ -23,13 +23,19 @@ namespace colorlab::sim::camera {
 // Where the chart sits in front of the camera (issue 14). Unset in CameraConfig: the chart square to the sensor,
 // centred, filling chart_height_fraction of the frame height, no lens distortion (the original behaviour).
 struct ChartPose {
-  double rotation_deg = 0;    // in the image plane, clockwise
-  double tilt_deg = 0;        // about the chart's horizontal axis (positive: its top edge leans away)
-  double swing_deg = 0;       // about its vertical axis (positive: its right edge leans away)
+  double rotation_deg = 0;  // in the image plane, clockwise
+  // Positive tilt: the chart's top edge (row 1) leans away from the camera, as a chart on the cabinet floor (row 1
+  // at the back) leans for a camera at the open front. Positive swing: its right edge leans away.
+  double tilt_deg = 0;        // about the chart's horizontal axis
+  double swing_deg = 0;       // about its vertical axis
   double distance_mm = 1200;  // camera to chart centre; the focal length keeps the chart at chart_height_fraction
   // chart centre offset as a fraction of the frame width / height
   double shift_x = 0, shift_y = 0;
   double k1 = 0, k2 = 0;  // radial lens distortion (OpenCV's model, coordinates normalised by the focal length)
+  // The lens's principal point off the frame's centre (px, +x right, +y down) and fy / fx (square pixels: 1). A real
+  // lens has both (a few px, ~0.1 %); opt-in, so no seeded pose's photograph moves (docs/verify.md, the simulated lens).
+  double principal_dx_px = 0, principal_dy_px = 0;
+  double fy_over_fx = 1;
 };
 // A plausible bench pose for a seed: a few degrees of rotation and tilt, some shift, mild barrel distortion.
 ChartPose random_chart_pose(std::uint64_t seed);
@@ -48,6 +54,10 @@ struct CameraConfig {
   bool force_parametric_sensitivities = false;
   double chart_height_fraction = 0.8;  // of the frame height the chart fills
   std::optional<ChartPose> pose;       // unset: square to the sensor, centred, no distortion
+  // The floor view's radial distortion (OpenCV's k1, k2 about the frame's centre). Default none: the floor
+  // photographs, and the campaigns' figures read from them, stay as they were; a test of a lens-aware placement
+  // turns it on.
+  double floor_k1 = 0, floor_k2 = 0;
   // Sensor (EOS-20D-like): DN per electron at ISO 100, full well, read noise, dark current.
   double gain_dn_per_e_iso100 = 0.09;
   double read_noise_e = 9.0;
@@ -135,6 +145,10 @@ class CameraModel {
   // back-left — which is what a bench measures on its own photograph to map the floor.
   std::array<double, 2> floor_point_px(double x_mm, double y_mm) const;
   std::array<std::array<double, 2>, 4> floor_corners_px() const;
+  // Where the same camera without its distortion (a pinhole of the same intrinsics and pose: a renderer's view of
+  // it) sees a floor point, pixel centres at integers; and the floor view's lens, OpenCV's model.
+  std::array<double, 2> floor_point_pinhole_px(double x_mm, double y_mm) const;
+  LensIntrinsics floor_lens() const;
   // The relative illumination the optics give a pixel in a view (1 = none lost): the lens's vignetting at this
   // f-number, times the cos⁴ fall-off in the floor view. Pixel centres at integers.
   double relative_illumination(double x_px, double y_px, double f_number, View view) const;

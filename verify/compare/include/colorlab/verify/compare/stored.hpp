@@ -16,13 +16,15 @@ namespace colorlab::verify {
 inline constexpr const char* kVerifyCampaign = "verify";
 
 struct StoredVerification {
-  nlohmann::json params;                           // {rendering, against: [run ids], scale (null: fitted), k}
+  nlohmann::json params;                           // {rendering, against: [run ids], scale (null: fitted), k[, placement]}
   nlohmann::json summary;                          // Verification::summary() plus floor_difference
   std::vector<records::Measurement> measurements;  // step "<kind>/<where>", value = the difference
 };
 
+// `placement`: how the comparison placed the measurement in the rendering (the CLI's `placement`: the floor through
+// the lens calibration or as a pinhole), kept in params when given so the stored verification says which.
 StoredVerification to_store(const Verification& v, const std::string& rendering, const std::vector<std::string>& against,
-                            const CompareOptions& options);
+                            const CompareOptions& options, const nlohmann::json& placement = nullptr);
 
 // The exit status a renderer's CI gates on: 0 every comparison agrees, 4 some differ beyond the measurement's
 // uncertainty. colorlab's other codes keep their meaning (docs/ARCHITECTURE.md: 1 local error, 2 API refused), so a

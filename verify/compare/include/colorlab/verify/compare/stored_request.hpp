@@ -1,7 +1,8 @@
 #pragma once
 // POST /v1/verifications' body read back into a stored verification (docs/API.md): the comparison is made where the
 // rendering is (the CLI, the Python client), and the daemon stores its result like a run. The body is
-//   {"rendering": name, "against": [run ids], "scale": number|null, "k": number, "result": Verification::to_json()}
+//   {"rendering": name, "against": [run ids], "scale": number|null, "k": number, "result": Verification::to_json(),
+//    "placement": {...} (optional: how the light was placed in the rendering, kept in the run's params)}
 // and the summary is recomputed here from the comparisons, so a stored verdict always matches its rows.
 #include <nlohmann/json.hpp>
 
@@ -18,6 +19,6 @@ StoredVerification stored_from_request(const nlohmann::json& body);
 
 // The request body for a verification made here (the inverse of stored_from_request).
 nlohmann::json store_request(const Verification& v, const std::string& rendering, const std::vector<std::string>& against,
-                             const CompareOptions& options);
+                             const CompareOptions& options, const nlohmann::json& placement = nullptr);
 
 }  // namespace colorlab::verify
