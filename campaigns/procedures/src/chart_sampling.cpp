@@ -161,6 +161,11 @@ json locate_and_sample(const AveragedPhoto& a, const SamplingOptions& options) {
                       {"values", values},
                       {"detected", detected},
                       {"notes", loc.notes}});
+  if (options.centres) {
+    json observed = json::array();
+    for (const auto& p : loc.patches) observed.push_back(p.detected ? json{p.observed.x, p.observed.y} : json());
+    located["observed_px"] = std::move(observed);
+  }
   return located;
 }
 
