@@ -30,7 +30,7 @@ json photograph(double tilt_deg, double swing_deg, double distance, double dx = 
     const double x1 = std::cos(b) * X, z1 = -std::sin(b) * X;
     const double y2 = std::cos(a) * Y - std::sin(a) * z1, z2 = std::sin(a) * Y + std::cos(a) * z1;
     const double z = z2 + distance;
-    observed.push_back({kCx + kF * (x1 + dx) / z, kCy + kF * (y2 + dy) / z});
+    observed.push_back({{"id", layout.ids[static_cast<std::size_t>(k)]}, {"x", kCx + kF * (x1 + dx) / z}, {"y", kCy + kF * (y2 + dy) / z}});
   }
   return {{"chart", "sg"}, {"width", kWidth}, {"height", kHeight}, {"observed_px", observed}};
 }
@@ -71,14 +71,14 @@ TEST(CalibrateLensCall, RecoversTheTestsPinholeAndWritesTheLensTable) {
 
 TEST(CalibrateLensCall, UndetectedPatchesAreLeftOutAndBadArgumentsRefused) {
   json poses = four_poses();
-  for (int k = 0; k < 30; ++k) poses[0]["observed_px"][k] = nullptr;  // not detected
+  poses[0]["observed_px"].erase(poses[0]["observed_px"].begin(), poses[0]["observed_px"].begin() + 30);  // not detected
   EXPECT_EQ(campaigns::calibrate_lens(poses, kWho)["points"], 4 * 140 - 30);
 
   json two = json::array({poses[0], poses[1]});
   EXPECT_EQ(class_of(two, kWho), ErrorClass::bad_parameter);  // fewer than 3 photographs
-  json short_list = four_poses();
-  short_list[2]["observed_px"].erase(0);
-  EXPECT_EQ(class_of(short_list, kWho), ErrorClass::bad_parameter);  // not the SG's 140
+  json unknown = four_poses();
+  unknown[2]["observed_px"][0]["id"] = "Z99";
+  EXPECT_EQ(class_of(unknown, kWho), ErrorClass::script_error);  // not an SG patch
   json other_size = four_poses();
   other_size[1]["width"] = 800;
   EXPECT_EQ(class_of(other_size, kWho), ErrorClass::bad_parameter);  // one calibration, one size
@@ -87,6 +87,6 @@ TEST(CalibrateLensCall, UndetectedPatchesAreLeftOutAndBadArgumentsRefused) {
   EXPECT_EQ(class_of(four_poses(), nameless), ErrorClass::script_error);
   EXPECT_EQ(class_of(json::object(), kWho), ErrorClass::script_error);
   json garbled = four_poses();
-  garbled[3]["observed_px"][5] = "here";
+  garbled[3]["observed_px"][5] = json::array({1, 2});
   EXPECT_EQ(class_of(garbled, kWho), ErrorClass::script_error);
 }

@@ -35,7 +35,9 @@ json dry_chart_centres(const json& placement, const std::string& chart) {
     const double X = layout.centre_x(k) - W / 2, Y = layout.centre_y(k) - H / 2;
     double c[3];
     for (int i = 0; i < 3; ++i) c[i] = R[i][0] * X + R[i][1] * Y + t[i];
-    observed.push_back({f * c[0] / c[2] + (kDryPhotoWidth - 1) / 2.0, f * c[1] / c[2] + (kDryPhotoHeight - 1) / 2.0});
+    observed.push_back({{"id", layout.ids[static_cast<std::size_t>(k)]},
+                        {"x", f * c[0] / c[2] + (kDryPhotoWidth - 1) / 2.0},
+                        {"y", f * c[1] / c[2] + (kDryPhotoHeight - 1) / 2.0}});
   }
   return observed;
 }

@@ -7,7 +7,7 @@
 
 namespace colorlab::campaigns::detail {
 
-// The dry photograph's size, and observed_px (layout order) of the `chart` ("sg", "cc24") at `placement` — the last
+// The dry photograph's size, and observed_px ([{id, x, y}, …], every patch) of the `chart` ("sg", "cc24") at `placement` — the last
 // place_chart request's details {tilt_deg, swing_deg, rotation_deg, fill, shift_x, shift_y}; missing keys: square
 // to the camera, centred, filling 0.8 of the frame's height.
 constexpr int kDryPhotoWidth = 3504, kDryPhotoHeight = 2336;

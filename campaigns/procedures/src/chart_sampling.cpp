@@ -163,7 +163,8 @@ json locate_and_sample(const AveragedPhoto& a, const SamplingOptions& options) {
                       {"notes", loc.notes}});
   if (options.centres) {
     json observed = json::array();
-    for (const auto& p : loc.patches) observed.push_back(p.detected ? json{p.observed.x, p.observed.y} : json());
+    for (const auto& p : loc.patches)
+      if (p.detected) observed.push_back({{"id", p.id}, {"x", p.observed.x}, {"y", p.observed.y}});
     located["observed_px"] = std::move(observed);
   }
   return located;

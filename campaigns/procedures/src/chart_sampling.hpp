@@ -57,7 +57,8 @@ std::map<std::string, AveragedPhoto> average_tiffs(const std::vector<std::filesy
 // Locates the chart (colorlab_chart_locate, as `colorlab analyze locate-chart`) and samples every
 // patch: {format, frames, files, width, height, bits, black_subtracted, confidence, rotation_deg,
 // corners, patches_detected, reprojection_rms_px, check, ids, values = [[r, g, b], …]}, with `centres` also
-// observed_px = [[x, y] or null (not detected), …] in the ids' order (pixel centres at integers).
+// observed_px = [{id, x, y}, …] of the detected patches (pixel centres at integers; a list without holes, which a
+// Lua table could not carry).
 // With corners for the format, the locator starts from them (from_corners). Throws the locator's typed Error, with
 // the format named — or, with return_refusals, returns {format, frames, files, width, height, bits, chart,
 // from_corners, refused = {error, message, hint}} for a refusal.

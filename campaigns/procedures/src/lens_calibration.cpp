@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "colorlab/analysis/chart_layout.hpp"
 #include "colorlab/core/error.hpp"
 #include "colorlab/verify/lens_calibration.hpp"
 
@@ -48,15 +49,16 @@ json calibrate_lens(const json& photographs, const json& options) {
                   "lab.analysis.calibrate_lens: " + which + " is " + std::to_string(w) + " × " + std::to_string(h) + ", the first " +
                       std::to_string(width) + " × " + std::to_string(height),
                   "one calibration holds for one photograph size: keep the camera's settings throughout");
-    verify::ObservedCentres observed;
+    // By patch id into the layout's order (patches not detected stay empty).
+    const analysis::ChartLayout& layout = analysis::chart_layout(analysis::chart_type_from_string(c));
+    verify::ObservedCentres observed(static_cast<std::size_t>(layout.size()));
     for (const auto& at : p["observed_px"]) {
-      if (at.is_null()) {
-        observed.emplace_back();
-      } else if (at.is_array() && at.size() == 2 && at[0].is_number() && at[1].is_number()) {
-        observed.push_back(std::array{at[0].get<double>(), at[1].get<double>()});
-      } else {
-        throw bad(which + ": observed_px holds [x, y] or null per patch");
-      }
+      if (!at.is_object() || !at.contains("id") || !at["id"].is_string() || !at.contains("x") || !at["x"].is_number() ||
+          !at.contains("y") || !at["y"].is_number())
+        throw bad(which + ": observed_px holds {id, x, y} per detected patch");
+      const auto k = layout.index_of(at["id"].get<std::string>());
+      if (!k) throw bad(which + ": the " + layout.name + " has no patch " + at["id"].get<std::string>());
+      observed[static_cast<std::size_t>(*k)] = std::array{at["x"].get<double>(), at["y"].get<double>()};
     }
     centres.push_back(std::move(observed));
   }
