@@ -167,8 +167,14 @@ struct Lab::Impl {
     const auto l = m.lens();
     json placed = "configured";
     if (const auto p = m.chart_placement()) {
-      placed = {{"rotation_deg", p->rotation_deg}, {"tilt_deg", p->tilt_deg}, {"swing_deg", p->swing_deg},
-                {"fill", p->fill},                 {"shift_x", p->shift_x},   {"shift_y", p->shift_y}};
+      placed = {
+          {"rotation_deg", p->rotation_deg},
+          {"tilt_deg", p->tilt_deg},
+          {"swing_deg", p->swing_deg},
+          {"fill", p->fill},
+          {"shift_x", p->shift_x},
+          {"shift_y", p->shift_y},
+      };
     }
     return {{"placement", placed}, {"lens", {{"fx", l.fx}, {"fy", l.fy}, {"cx", l.cx}, {"cy", l.cy}, {"k1", l.k1}, {"k2", l.k2}}}};
   }
