@@ -1,10 +1,12 @@
 #include "lens_commands.hpp"
 
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <ctime>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -46,12 +48,11 @@ ca::CfaPattern cfa_of(const std::string& s) {
 }
 
 // Each photograph located as `colorlab analyze locate-chart` locates it (no lens: the lens is what is being
-// calibrated); its detected patch centres, as photographed, are the calibration points. The chart's scale does
-// not enter the intrinsics, so the layout's grid units stand for the chart's plane.
+// calibrated); its detected patch centres, as photographed, are the calibration points (calibrate_lens_from_chart,
+// which the lens-calibration campaign shares).
 verify::LensCalibration calibrate(const CalibrateOptions& o) {
   const ca::ChartType type = ca::chart_type_from_string(o.chart);
-  const ca::ChartLayout& layout = ca::chart_layout(type);
-  std::vector<verify::CalibrationView> views;
+  std::vector<verify::ObservedCentres> photographs;
   int width = 0, height = 0;
   for (const auto& path : o.photos) {
     const ca::Photo photo = ca::read_photo(path);
@@ -73,22 +74,13 @@ verify::LensCalibration calibrate(const CalibrateOptions& o) {
     } catch (const Error& e) {
       throw Error(e.cls(), path + ": " + e.what(), e.hint());
     }
-    verify::CalibrationView v;
-    for (int k = 0; k < layout.size(); ++k) {
-      const auto& s = loc.patches[static_cast<std::size_t>(k)];
-      if (!s.detected) continue;
-      v.image_px.push_back({s.observed.x, s.observed.y});
-      v.chart_mm.push_back({layout.centre_x(k), layout.centre_y(k)});
-    }
-    views.push_back(std::move(v));
+    verify::ObservedCentres observed;
+    for (const auto& s : loc.patches) observed.push_back(s.detected ? std::optional(std::array{s.observed.x, s.observed.y}) : std::nullopt);
+    photographs.push_back(std::move(observed));
   }
-  verify::LensCalibration l = verify::calibrate_lens(views, width, height);
-  l.camera = o.camera, l.lens = o.lens, l.focus = o.focus;
-  if (o.focal_length_mm > 0) l.focal_length_mm = o.focal_length_mm;
-  l.source = "colorlab lens calibrate: OpenCV calibrateCamera over " + std::to_string(views.size()) + " photographs of the " +
-             layout.name + " (detected patch centres)";
-  l.date = o.date.empty() ? today() : o.date;
-  return l;
+  verify::LensIdentity who{o.camera, o.lens, o.focus, o.date.empty() ? today() : o.date, std::nullopt};
+  if (o.focal_length_mm > 0) who.focal_length_mm = o.focal_length_mm;
+  return verify::calibrate_lens_from_chart(o.chart, photographs, width, height, who, "colorlab lens calibrate");
 }
 
 }  // namespace
@@ -118,6 +110,29 @@ void add_lens_commands(CLI::App& app, GlobalOptions& global) {
       ->capture_default_str();
   cal->callback([&global, o] {
     const verify::LensCalibration l = calibrate(*o);
+    if (global.json) std::cout << verify::lens_to_json(l).dump(2) << "\n";
+    else std::cout << verify::lens_to_toml(l);
+  });
+
+  auto run = std::make_shared<std::string>();
+  auto* from_run = lens->add_subcommand(
+      "from-run", "The calibration a lens-calibration run made (GET /v1/runs/RUN): its [[lens]] table for colorlabd.toml "
+                  "(--json: the calibration as GET /v1/lab/lenses gives it)");
+  from_run->add_option("RUN", *run, "the lens-calibration run's id")->required();
+  from_run->callback([&global, run] {
+    check_id(*run, "a run id", "colorlab runs lists them");
+    const json r = json::parse(fetch_bytes(global, "/v1/runs/" + *run).body);
+    const std::string campaign = r.value("campaign", std::string());
+    const json* lens = nullptr;
+    if (r.contains("summary") && r["summary"].is_object() && r["summary"].contains("script") && r["summary"]["script"].is_object() &&
+        r["summary"]["script"].contains("lens"))
+      lens = &r["summary"]["script"]["lens"];
+    if (!lens)
+      throw Error(ErrorClass::bad_parameter,
+                  "run " + *run + " (" + (campaign.empty() ? "?" : campaign) + ", " + r.value("status", std::string("?")) +
+                      ") holds no lens calibration",
+                  "give a lens-calibration run that finished (colorlab runs lists them)");
+    const verify::LensCalibration l = verify::lens_from_json(*lens, "run " + *run);
     if (global.json) std::cout << verify::lens_to_json(l).dump(2) << "\n";
     else std::cout << verify::lens_to_toml(l);
   });

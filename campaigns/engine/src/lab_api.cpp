@@ -13,6 +13,7 @@
 #include "colorlab/campaigns/characterize.hpp"
 #include "colorlab/campaigns/chart_plan.hpp"
 #include "colorlab/campaigns/floor_photograph.hpp"
+#include "colorlab/campaigns/lens_calibration.hpp"
 #include "colorlab/campaigns/lua_value.hpp"
 #include "colorlab/core/error.hpp"
 
@@ -312,6 +313,15 @@ int analysis_floor_luminance(lua_State* L) {
   });
 }
 
+// lab.analysis.calibrate_lens(photographs, {camera =, lens =, …}) → the lab's lens calibration (lens_calibration.hpp).
+int analysis_calibrate_lens(lua_State* L) {
+  return computed(L, "lab.analysis.calibrate_lens", [L]() -> std::function<json()> {
+    json photographs = to_json(L, 1, "lab.analysis.calibrate_lens's photographs");
+    json options = lua_gettop(L) >= 2 && !lua_isnil(L, 2) ? to_json(L, 2, "lab.analysis.calibrate_lens's options") : json::object();
+    return [photographs = std::move(photographs), options = std::move(options)] { return calibrate_lens(photographs, options); };
+  });
+}
+
 // lab.chart.plan{chart=, first_x_mm=, first_y_mm=, pitch_mm=} → the chart's patches on the table in visiting order.
 int chart_plan_fn(lua_State* L) {
   guarded(L, [&] {
@@ -374,6 +384,7 @@ void install_lab_api(lua_State* L, LabCallSink* sink) {
   lua_setfield(L, -2, "compare_lamps");
   set_function(L, "characterize", analysis_characterize, sink);  // the sink may compute them off this thread
   set_function(L, "floor_luminance", analysis_floor_luminance, sink);
+  set_function(L, "calibrate_lens", analysis_calibrate_lens, sink);
   lua_setfield(L, -2, "analysis");
   lua_newtable(L);
   lua_pushcfunction(L, chart_plan_fn);

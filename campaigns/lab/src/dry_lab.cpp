@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "colorlab/campaigns/floor_photograph.hpp"
+#include "dry_chart_centres.hpp"
 #include "colorlab/campaigns/operator_desk.hpp"
 #include "colorlab/core/error.hpp"
 #include "colorlab/core/ids.hpp"
@@ -255,6 +256,11 @@ json DryLab::call_camera_photograph_chart(const json& args, DryContext&) {
         {"values", values},
         {"detected", std::vector<bool>(ids.size(), true)},
     };
+    if (o.value("centres", false)) {
+      // The chart where the last place_chart request put it, through an ideal lens (dry_chart_centres.hpp).
+      out["formats"][format]["width"] = detail::kDryPhotoWidth, out["formats"][format]["height"] = detail::kDryPhotoHeight;
+      out["formats"][format]["observed_px"] = detail::dry_chart_centres(chart_placed_, o.value("chart", std::string("sg")));
+    }
   }
   return out;
 }
@@ -268,6 +274,7 @@ json DryLab::call_runs_chart_reference(const json& args, DryContext&) {
 
 json DryLab::call_operator_request(const json& args, DryContext&) {
   OperatorRequest r = parse_operator_request(args[0]);
+  if (r.action == "place_chart") chart_placed_ = r.details;
   // The first option is the one that says the action was done: the night as planned.
   return json{{"answer", r.options.front()}, {"by", "dry run"}, {"action", r.action}, {"details", r.details}};
 }

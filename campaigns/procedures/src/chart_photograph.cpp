@@ -85,6 +85,10 @@ PhotographOptions parse(const json& o) {
     if (o["on_refusal"] != "error" && o["on_refusal"] != "return") throw bad("on_refusal must be \"error\" or \"return\"");
     p.sampling.return_refusals = o["on_refusal"] == "return";
   }
+  if (o.contains("centres")) {
+    if (!o["centres"].is_boolean()) throw bad("centres must be true or false");
+    p.sampling.centres = o["centres"].get<bool>();
+  }
   fraction("sample_fraction", p.sampling.sample_fraction);
   fraction("min_confidence", p.sampling.min_confidence);
   if (o.contains("reference")) {

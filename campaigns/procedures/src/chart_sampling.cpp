@@ -161,6 +161,12 @@ json locate_and_sample(const AveragedPhoto& a, const SamplingOptions& options) {
                       {"values", values},
                       {"detected", detected},
                       {"notes", loc.notes}});
+  if (options.centres) {
+    json observed = json::array();
+    for (const auto& p : loc.patches)
+      if (p.detected) observed.push_back({{"id", p.id}, {"x", p.observed.x}, {"y", p.observed.y}});
+    located["observed_px"] = std::move(observed);
+  }
   return located;
 }
 

@@ -44,6 +44,8 @@ struct SamplingOptions {
   // The locator's refusal (not_found, needs_operator, corners it cannot use) comes back as {format, refused = {…}}
   // instead of failing the call, so the frames are kept and the script can tell the operator which to look at.
   bool return_refusals = false;
+  // Each detected patch's centroid as photographed (observed_px): a lens calibration's points (lens-calibration).
+  bool centres = false;
 };
 
 // Sums of the camera's own processed files (JPEG, TIFF) of one format; throws Error(bad_data) when
@@ -54,7 +56,9 @@ std::map<std::string, AveragedPhoto> average_tiffs(const std::vector<std::filesy
 
 // Locates the chart (colorlab_chart_locate, as `colorlab analyze locate-chart`) and samples every
 // patch: {format, frames, files, width, height, bits, black_subtracted, confidence, rotation_deg,
-// corners, patches_detected, reprojection_rms_px, check, ids, values = [[r, g, b], …]}.
+// corners, patches_detected, reprojection_rms_px, check, ids, values = [[r, g, b], …]}, with `centres` also
+// observed_px = [{id, x, y}, …] of the detected patches (pixel centres at integers; a list without holes, which a
+// Lua table could not carry).
 // With corners for the format, the locator starts from them (from_corners). Throws the locator's typed Error, with
 // the format named — or, with return_refusals, returns {format, frames, files, width, height, bits, chart,
 // from_corners, refused = {error, message, hint}} for a refusal.

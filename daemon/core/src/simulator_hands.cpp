@@ -77,6 +77,26 @@ asio::awaitable<std::optional<json>> SimulatorHands::perform(const std::string& 
     co_await command(cmd);
     co_return json{{"camera_view", view}};
   }
+  if (action == "place_chart") {
+    // lens-calibration: the chart at the pose the details describe (in the simulator's own terms: rotation_deg, tilt_deg,
+    // swing_deg, fill, shift_x, shift_y), or back at its measuring place (pose = "measurement"). The pose's number and
+    // the chart's name are for the record, not the simulator.
+    if (!details.is_object()) throw Error(ErrorClass::script_error, "place_chart needs details = {pose = k, tilt_deg = …} on the simulated lab");
+    json placement = json::object();
+    if (details.value("pose", json()) == "measurement") {
+      placement = "configured";
+    } else {
+      for (const char* key : {"rotation_deg", "tilt_deg", "swing_deg", "fill", "shift_x", "shift_y"})
+        if (details.contains(key)) placement[key] = details[key];
+      if (placement.empty())
+        throw Error(ErrorClass::script_error,
+                    "place_chart on the simulated lab needs the pose in numbers (details = {fill, tilt_deg, swing_deg, rotation_deg, "
+                    "shift_x, shift_y}) or details = {pose = \"measurement\"}");
+    }
+    json cmd{{"cmd", "place_chart"}, {"placement", placement}};
+    co_await command(cmd);
+    co_return json{{"chart_placed", placement}};
+  }
   if (action == "white_tile") {
     json cmd{{"cmd", "place"}, {"target", "white_tile"}};
     co_await command(cmd);

@@ -161,6 +161,40 @@ struct Lab::Impl {
     return 4.0;  // scene_camera_options' default: a machine-vision lens at f/4
   }
 
+  // {placement = {rotation_deg, tilt_deg, swing_deg, fill, shift_x, shift_y} | "configured", lens = {fx, fy, cx, cy,
+  // k1, k2}}: where the operator put the chart, and the camera's lens in OpenCV's conventions.
+  static json placement_json(const camera::CameraModel& m) {
+    const auto l = m.lens();
+    json placed = "configured";
+    if (const auto p = m.chart_placement()) {
+      placed = {
+          {"rotation_deg", p->rotation_deg},
+          {"tilt_deg", p->tilt_deg},
+          {"swing_deg", p->swing_deg},
+          {"fill", p->fill},
+          {"shift_x", p->shift_x},
+          {"shift_y", p->shift_y},
+      };
+    }
+    return {{"placement", placed}, {"lens", {{"fx", l.fx}, {"fy", l.fy}, {"cx", l.cx}, {"cy", l.cy}, {"k1", l.k1}, {"k2", l.k2}}}};
+  }
+
+  static camera::ChartPlacement placement_from(const json& spec) {
+    const char* keys = "rotation_deg, tilt_deg, swing_deg, fill, shift_x, shift_y";
+    if (!spec.is_object())
+      throw Error(ErrorClass::bad_parameter, "place_chart: placement must be \"configured\" or a table", std::string("keys: ") + keys);
+    camera::ChartPlacement p;
+    for (const auto& [key, value] : spec.items()) {
+      double* field = key == "rotation_deg" ? &p.rotation_deg : key == "tilt_deg" ? &p.tilt_deg : key == "swing_deg" ? &p.swing_deg
+                    : key == "fill"         ? &p.fill         : key == "shift_x"  ? &p.shift_x  : key == "shift_y"   ? &p.shift_y
+                                                                                                                      : nullptr;
+      if (!field) throw Error(ErrorClass::bad_parameter, "place_chart: unknown placement key '" + key + "'", std::string("keys: ") + keys);
+      if (!value.is_number()) throw Error(ErrorClass::bad_parameter, "place_chart: placement." + key + " must be a number");
+      *field = value.get<double>();
+    }
+    return p;
+  }
+
   static json corners_json(const camera::CameraModel& m) {
     json c = json::array();
     for (const auto& p : m.floor_corners_px()) c.push_back({p[0], p[1]});
@@ -585,6 +619,7 @@ json Lab::control(const json& command) {
       std::optional<std::string> file;
       if (command.contains("file")) file = command["file"].get<std::string>();
       json t = d.dslr->shot_truth(file);
+      t.update(Impl::placement_json(*d.dslr_model));  // the lens a calibration must find, and where the chart is now
       t["ok"] = true;
       return t;
     }
@@ -606,6 +641,19 @@ json Lab::control(const json& command) {
       }
       return {{"ok", true}, {"view", view}, {"cameras", cams}};
     }
+    if (cmd == "place_chart") {
+      // The operator's "place_chart" (the lens-calibration campaign): the chart at another pose before the cameras, or
+      // back where the configuration put it ("configured"). The lens stays each camera's.
+      const json& spec = command.contains("placement") ? command["placement"] : json();
+      std::optional<camera::ChartPlacement> placement;
+      if (!(spec.is_string() && spec.get<std::string>() == "configured")) placement = Impl::placement_from(spec);
+      json cams = json::object();
+      for (auto& [name, m] : d.cameras(command.value("instrument", std::string()))) {
+        m->place_chart(placement);
+        cams[name] = Impl::placement_json(*m);
+      }
+      return {{"ok", true}, {"cameras", cams}};
+    }
     if (cmd == "floor_truth") return d.floor_truth(command.value("instrument", std::string()));
     if (cmd == "lamp") {
       d.scene->set_lamp(lamp_from_string(command.value("lamp", std::string())), command.value("on", true));
@@ -616,7 +664,7 @@ json Lab::control(const json& command) {
       return {{"ok", true}};
     }
     throw Error(ErrorClass::bad_parameter, "unknown control command '" + cmd + "'",
-                "commands: announce, truth, camera_truth, floor_truth, camera_view, fault, place, aim, lamp, dimmer");
+                "commands: announce, truth, camera_truth, floor_truth, camera_view, place_chart, fault, place, aim, lamp, dimmer");
   } catch (const Error& e) {
     return {{"ok", false}, {"error", to_string(e.cls())}, {"message", e.info().message}, {"hint", e.hint()}};
   } catch (const json::exception& e) {

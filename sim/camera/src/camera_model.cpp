@@ -64,7 +64,10 @@ struct CameraModel::Impl {
   std::uint64_t seed = 0;
   detail::Sensitivities sens;
   double px_per_mm = 0, origin_x = 0, origin_y = 0;  // chart top-left in pixels
-  std::optional<detail::PoseGeometry> pose;          // set: the chart at a pose instead
+  // The chart's geometry: set, the chart at a pose instead. With `regions` and `placement`, replaced by place_chart
+  // under cache_mutex (the frame cache is built under it too); the public accessors read them under it.
+  std::optional<detail::PoseGeometry> pose;
+  std::optional<ChartPlacement> placement;  // the operator's, when not where the configuration put it
   std::optional<detail::FloorGeometry> floor;        // the floor view's geometry
   std::atomic<View> view{View::chart};
   std::vector<Spectrum> material_reflectance;  // material_count
@@ -144,6 +147,8 @@ struct CameraModel::Impl {
 
   double gain_dn_per_e(const CameraSettings& s) const { return config.gain_dn_per_e_iso100 * s.iso / 100.0; }
 
+  // Each patch's pixel rectangle for a chart geometry (nullopt: the unposed chart).
+  std::vector<PatchRegion> regions_for(const std::optional<detail::PoseGeometry>& g) const;
   std::shared_ptr<const Precomputed> precomputed(const CameraSettings& settings) const;
   std::shared_ptr<const Precomputed> build(const CameraSettings& settings, std::uint64_t version) const;
   void place_defects_and_dust();
@@ -293,6 +298,36 @@ std::shared_ptr<const CameraModel::Impl::Moments> CameraModel::Impl::moments_for
   return moments;
 }
 
+std::vector<PatchRegion> CameraModel::Impl::regions_for(const std::optional<detail::PoseGeometry>& g) const {
+  std::vector<PatchRegion> out;
+  for (const auto& p : scene->chart().patches) {
+    if (g) {
+      // The largest axis-aligned rectangle centred on the patch inside its image (pixel centres at +0.5).
+      const auto c = g->image_of(p.x_mm + p.size_mm / 2, p.y_mm + p.size_mm / 2);
+      const double corners[4][2] = {{p.x_mm, p.y_mm}, {p.x_mm + p.size_mm, p.y_mm}, {p.x_mm + p.size_mm, p.y_mm + p.size_mm}, {p.x_mm, p.y_mm + p.size_mm}};
+      double h = 1e300;
+      for (int i = 0; i < 4; ++i) {
+        const auto a = g->image_of(corners[i][0], corners[i][1]), b = g->image_of(corners[(i + 1) % 4][0], corners[(i + 1) % 4][1]);
+        const double ex = b.first - a.first, ey = b.second - a.second, len = std::hypot(ex, ey);
+        const double nx = -ey / len, ny = ex / len;
+        h = std::min(h, std::abs(nx * (c.first - a.first) + ny * (c.second - a.second)) / (std::abs(nx) + std::abs(ny)));
+      }
+      h *= 0.95;  // the distorted edges bow a little
+      const int x0 = static_cast<int>(std::ceil(c.first - h - 0.5)), x1 = static_cast<int>(std::floor(c.first + h - 0.5));
+      const int y0 = static_cast<int>(std::ceil(c.second - h - 0.5)), y1 = static_cast<int>(std::floor(c.second + h - 0.5));
+      out.push_back({x0, y0, std::max(1, x1 - x0 + 1), std::max(1, y1 - y0 + 1)});
+      continue;
+    }
+    // Pixels whose centres lie inside the patch square.
+    const int x0 = static_cast<int>(std::ceil(origin_x + p.x_mm * px_per_mm - 0.5));
+    const int x1 = static_cast<int>(std::ceil(origin_x + (p.x_mm + p.size_mm) * px_per_mm - 0.5));
+    const int y0 = static_cast<int>(std::ceil(origin_y + p.y_mm * px_per_mm - 0.5));
+    const int y1 = static_cast<int>(std::ceil(origin_y + (p.y_mm + p.size_mm) * px_per_mm - 0.5));
+    out.push_back({x0, y0, x1 - x0, y1 - y0});
+  }
+  return out;
+}
+
 void CameraModel::Impl::place_defects_and_dust() {
   std::mt19937_64 rng(detail::splitmix64(seed ^ 0x4445'4645'4354ull));
   const int W = config.width, H = config.height;
@@ -362,31 +397,7 @@ CameraModel::CameraModel(std::shared_ptr<const Scene> scene, CameraConfig config
   }
   if (m.config.pose) m.pose.emplace(*m.config.pose, m.config.width, m.config.height, m.config.chart_height_fraction);
   m.floor.emplace(m.config.width, m.config.height, m.config.floor_k1, m.config.floor_k2);
-  for (const auto& p : m.scene->chart().patches) {
-    if (m.pose) {
-      // The largest axis-aligned rectangle centred on the patch inside its image (pixel centres at +0.5).
-      const auto c = m.image_of(p.x_mm + p.size_mm / 2, p.y_mm + p.size_mm / 2);
-      const double corners[4][2] = {{p.x_mm, p.y_mm}, {p.x_mm + p.size_mm, p.y_mm}, {p.x_mm + p.size_mm, p.y_mm + p.size_mm}, {p.x_mm, p.y_mm + p.size_mm}};
-      double h = 1e300;
-      for (int i = 0; i < 4; ++i) {
-        const auto a = m.image_of(corners[i][0], corners[i][1]), b = m.image_of(corners[(i + 1) % 4][0], corners[(i + 1) % 4][1]);
-        const double ex = b.first - a.first, ey = b.second - a.second, len = std::hypot(ex, ey);
-        const double nx = -ey / len, ny = ex / len;
-        h = std::min(h, std::abs(nx * (c.first - a.first) + ny * (c.second - a.second)) / (std::abs(nx) + std::abs(ny)));
-      }
-      h *= 0.95;  // the distorted edges bow a little
-      const int x0 = static_cast<int>(std::ceil(c.first - h - 0.5)), x1 = static_cast<int>(std::floor(c.first + h - 0.5));
-      const int y0 = static_cast<int>(std::ceil(c.second - h - 0.5)), y1 = static_cast<int>(std::floor(c.second + h - 0.5));
-      m.regions.push_back({x0, y0, std::max(1, x1 - x0 + 1), std::max(1, y1 - y0 + 1)});
-      continue;
-    }
-    // Pixels whose centres lie inside the patch square.
-    const int x0 = static_cast<int>(std::ceil(m.origin_x + p.x_mm * m.px_per_mm - 0.5));
-    const int x1 = static_cast<int>(std::ceil(m.origin_x + (p.x_mm + p.size_mm) * m.px_per_mm - 0.5));
-    const int y0 = static_cast<int>(std::ceil(m.origin_y + p.y_mm * m.px_per_mm - 0.5));
-    const int y1 = static_cast<int>(std::ceil(m.origin_y + (p.y_mm + p.size_mm) * m.px_per_mm - 0.5));
-    m.regions.push_back({x0, y0, x1 - x0, y1 - y0});
-  }
+  m.regions = m.regions_for(m.pose);
   m.place_defects_and_dust();
 }
 
@@ -449,6 +460,7 @@ void CameraModel::render_into(RawFrame& out, const CameraSettings& settings, std
 PatchRegion CameraModel::patch_region(int patch_index) const {
   if (patch_index < 0 || patch_index >= chart_patch_count)
     throw Error(ErrorClass::bad_parameter, "patch index " + std::to_string(patch_index) + " is outside 0..139");
+  std::lock_guard lock(impl_->cache_mutex);
   return impl_->regions[static_cast<std::size_t>(patch_index)];
 }
 
@@ -456,6 +468,7 @@ std::array<double, 2> CameraModel::patch_centre_px(int patch_index) const {
   if (patch_index < 0 || patch_index >= chart_patch_count)
     throw Error(ErrorClass::bad_parameter, "patch index " + std::to_string(patch_index) + " is outside 0..139");
   const auto& p = impl_->scene->chart().patches[static_cast<std::size_t>(patch_index)];
+  std::lock_guard lock(impl_->cache_mutex);
   const auto c = impl_->image_of(p.x_mm + p.size_mm / 2, p.y_mm + p.size_mm / 2);
   return {c.first - 0.5, c.second - 0.5};
 }
@@ -467,6 +480,7 @@ std::array<std::array<double, 2>, 4> CameraModel::patch_grid_corners_px() const 
   const double x0 = a1.x_mm, y0 = a1.y_mm, x1 = n10.x_mm + n10.size_mm, y1 = n10.y_mm + n10.size_mm;
   std::array<std::array<double, 2>, 4> out{};
   const double pts[4][2] = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
+  std::lock_guard lock(impl_->cache_mutex);
   for (std::size_t i = 0; i < 4; ++i) {
     const auto c = impl_->image_of(pts[i][0], pts[i][1]);
     out[i] = {c.first - 0.5, c.second - 0.5};
@@ -475,6 +489,7 @@ std::array<std::array<double, 2>, 4> CameraModel::patch_grid_corners_px() const 
 }
 
 LensIntrinsics CameraModel::lens() const {
+  std::lock_guard lock(impl_->cache_mutex);
   if (impl_->pose) return impl_->pose->intrinsics();
   const double f = impl_->px_per_mm * 1200.0;  // nominal: the chart 1.2 m away
   return {f, f, impl_->config.width / 2.0 - 0.5, impl_->config.height / 2.0 - 0.5, 0, 0};
@@ -497,6 +512,40 @@ std::vector<std::array<double, 3>> CameraModel::ground_truth(const CameraSetting
       out[static_cast<std::size_t>(m)][c] = std::min(256.0 + pre->gain * e, 4095.0);
     }
   return out;
+}
+
+void CameraModel::place_chart(const std::optional<ChartPlacement>& placement) {
+  auto& m = *impl_;
+  std::optional<ChartPose> pose = m.config.pose;
+  double fraction = m.config.chart_height_fraction;
+  if (placement) {
+    const auto& q = *placement;
+    if (!(q.fill > 0.1 && q.fill <= 1.0)) throw Error(ErrorClass::bad_parameter, "a chart placement's fill must be within (0.1, 1]");
+    if (!(std::abs(q.shift_x) <= 0.5 && std::abs(q.shift_y) <= 0.5))
+      throw Error(ErrorClass::bad_parameter, "a chart placement's shift_x and shift_y must be within ±0.5 (fractions of the frame)");
+    // The configured lens: a pose's focal length is fraction · height · distance / chart height; the square chart's
+    // nominal lens (lens()) stands 1.2 m away. Its distortion (and whatever else the pose says of the lens) is kept.
+    const double f = pose ? fraction * m.config.height * pose->distance_mm / chart_height_mm : m.px_per_mm * 1200.0;
+    ChartPose p = pose.value_or(ChartPose{});
+    p.rotation_deg = q.rotation_deg, p.tilt_deg = q.tilt_deg, p.swing_deg = q.swing_deg;
+    p.shift_x = q.shift_x, p.shift_y = q.shift_y;
+    p.distance_mm = f * chart_height_mm / (q.fill * m.config.height);
+    pose = p;
+    fraction = q.fill;
+  }
+  std::optional<detail::PoseGeometry> geometry;
+  if (pose) geometry.emplace(*pose, m.config.width, m.config.height, fraction);  // throws for what it refuses
+  std::vector<PatchRegion> regions = m.regions_for(geometry);
+  std::lock_guard lock(m.cache_mutex);
+  m.pose = std::move(geometry);
+  m.regions = std::move(regions);
+  m.placement = placement;
+  m.cache.reset();
+}
+
+std::optional<ChartPlacement> CameraModel::chart_placement() const {
+  std::lock_guard lock(impl_->cache_mutex);
+  return impl_->placement;
 }
 
 void CameraModel::set_view(View view) { impl_->view.store(view); }

@@ -8,6 +8,7 @@
 
 #include <opencv2/calib3d.hpp>
 
+#include "colorlab/analysis/chart_layout.hpp"
 #include "colorlab/core/error.hpp"
 
 namespace colorlab::verify {
@@ -96,6 +97,33 @@ LensCalibration calibrate_lens(const std::vector<CalibrationView>& views, int wi
   if (const std::string p = problem(l); !p.empty())
     throw Error(ErrorClass::bad_data, "lens calibration gave no usable lens: " + p,
                 "use more photographs, with the chart tilted and reaching the frame's corners");
+  return l;
+}
+
+LensCalibration calibrate_lens_from_chart(const std::string& chart, const std::vector<ObservedCentres>& photographs, int width_px,
+                                          int height_px, const LensIdentity& who, const std::string& by) {
+  const analysis::ChartLayout& layout = analysis::chart_layout(analysis::chart_type_from_string(chart));
+  std::vector<CalibrationView> views;
+  for (std::size_t v = 0; v < photographs.size(); ++v) {
+    const auto& observed = photographs[v];
+    if (observed.size() != static_cast<std::size_t>(layout.size()))
+      throw Error(ErrorClass::bad_parameter, "lens calibration: photograph " + std::to_string(v + 1) + " has " +
+                                                 std::to_string(observed.size()) + " patch centres, the " + layout.name + " has " +
+                                                 std::to_string(layout.size()) + " patches");
+    CalibrationView view;
+    for (int k = 0; k < layout.size(); ++k) {
+      const auto& at = observed[static_cast<std::size_t>(k)];
+      if (!at) continue;
+      view.image_px.push_back(*at);
+      view.chart_mm.push_back({layout.centre_x(k), layout.centre_y(k)});
+    }
+    views.push_back(std::move(view));
+  }
+  LensCalibration l = calibrate_lens(views, width_px, height_px);
+  l.camera = who.camera, l.lens = who.lens, l.focus = who.focus, l.date = who.date;
+  l.focal_length_mm = who.focal_length_mm;
+  l.source = by + ": OpenCV calibrateCamera over " + std::to_string(views.size()) + " photographs of the " + layout.name +
+             " (detected patch centres)";
   return l;
 }
 

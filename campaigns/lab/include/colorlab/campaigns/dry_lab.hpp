@@ -70,6 +70,7 @@ class DryLab {
   RunReader* runs_;
   LabState state_;
   double start_unix_s_ = 0;
+  nlohmann::json chart_placed_ = nlohmann::json::object();  // the last place_chart request's details
 };
 
 }  // namespace colorlab::campaigns

@@ -23,7 +23,8 @@ namespace colorlab::campaigns {
 // sample_fraction = 0.6, min_confidence = 0.6, camera = id (used by the caller to choose),
 // keep = {"average", "raw", "preview"} (of average, raw, tiff16, tiff8, jpeg, preview: what goes into
 // the keeper once every photograph was sampled — the averaged raw as a float array, the first raw as
-// captured, the first frame's processed files, a PNG preview of the average)}.
+// captured, the first frame's processed files, a PNG preview of the average), centres = false (true: each
+// format's observed_px, the detected patches' centroids as photographed, for a lens calibration)}.
 // Returns {instrument, chart, frames, formats = {<format> = {confidence, rotation_deg, corners,
 // patches_detected, reprojection_rms_px, check, ids, values = [[r, g, b], …], …}}, blobs = [kept blob
 // references]}.

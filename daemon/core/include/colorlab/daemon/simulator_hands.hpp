@@ -14,7 +14,8 @@ class SimulatorHands final : public campaigns::OperatorHands {
  public:
   SimulatorHands(boost::asio::any_io_executor executor, std::filesystem::path control_socket);
   bool can_perform(const std::string& action) const override {
-    return action == "aim_meter" || action == "load_chart" || action == "white_tile" || action == "aim_camera";
+    return action == "aim_meter" || action == "load_chart" || action == "white_tile" || action == "aim_camera" ||
+           action == "place_chart";
   }
   boost::asio::awaitable<std::optional<nlohmann::json>> perform(const std::string& action,
                                                                 const nlohmann::json& details) override;

@@ -44,6 +44,26 @@ struct CalibrationView {
 // and Error(bad_data) when the solution is not a lens (focal lengths ≤ 0, principal point outside the frame).
 LensCalibration calibrate_lens(const std::vector<CalibrationView>& views, int width_px, int height_px);
 
+// What the operator states of a calibration: the body, the lens, its settings, the day (`colorlab lens calibrate
+// --camera …`, the lens-calibration campaign's parameters).
+struct LensIdentity {
+  std::string camera, lens, focus, date;
+  std::optional<double> focal_length_mm;
+};
+
+// One located photograph of the chart: each patch's centroid as photographed (the locator's observed centre), in the
+// chart layout's order; nullopt where the patch was not detected.
+using ObservedCentres = std::vector<std::optional<std::array<double, 2>>>;
+
+// The lab's calibration from located chart photographs, as `colorlab lens calibrate` and the lens-calibration campaign
+// make it: each photograph's detected centroids against the patches' centres on the chart's plane (the layout's grid
+// units: the chart's scale does not enter the intrinsics), calibrate_lens over them, named and dated by `who`, its
+// source "<by>: OpenCV calibrateCamera over N photographs of the <chart's name> (detected patch centres)". `chart`:
+// "sg" or "cc24". Throws as calibrate_lens; Error(bad_parameter) for a photograph whose list is not the chart's
+// length, or an unknown chart.
+LensCalibration calibrate_lens_from_chart(const std::string& chart, const std::vector<ObservedCentres>& photographs, int width_px,
+                                          int height_px, const LensIdentity& who, const std::string& by);
+
 // The [[lens]] tables of a lab file (none: empty); lens_toml.hpp says what they hold and refuse.
 std::vector<LensCalibration> lenses_from_file(const std::string& path);
 std::string lens_to_toml(const LensCalibration& l);  // one [[lens]] table, to paste into the lab configuration

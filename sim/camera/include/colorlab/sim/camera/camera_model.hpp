@@ -45,6 +45,15 @@ struct LensIntrinsics {
   double fx = 0, fy = 0, cx = 0, cy = 0, k1 = 0, k2 = 0;
 };
 
+// Where an operator puts the chart in front of the camera (the lens-calibration campaign's poses; docs/simulator.md,
+// "place_chart"): its attitude and where it sits in the frame. The lens is the camera's, so the distance is whatever
+// makes the chart `fill` that share of the frame's height.
+struct ChartPlacement {
+  double rotation_deg = 0, tilt_deg = 0, swing_deg = 0;  // as ChartPose's
+  double fill = 0.5;                                     // of the frame height the chart's height fills square-on
+  double shift_x = 0, shift_y = 0;                       // chart centre offset as a fraction of the frame width / height
+};
+
 struct CameraConfig {
   int width = 3504;                   // even
   int height = 2336;                  // even
@@ -136,6 +145,14 @@ class CameraModel {
   // Fixed per camera seed.
   const std::vector<PixelDefect>& defects() const;
   const std::vector<DustSpeck>& dust() const;
+
+  // The operator places the chart (thread-safe; frames rendered from now on show it there), seen through this camera's
+  // lens: its focal length and distortion stay as configured, which is what makes photographs at several placements
+  // a lens calibration's. nullopt: back where the configuration put it (bit-exact: every figure made at the
+  // configured pose is unchanged). Dust stays where it is on the sensor. Throws Error(bad_parameter) for a placement
+  // the geometry refuses (fill outside (0.1, 1], a shift beyond ±0.5, tilt or swing of 70° or more).
+  void place_chart(const std::optional<ChartPlacement>& placement);
+  std::optional<ChartPlacement> chart_placement() const;  // nullopt: where the configuration put it
 
   // Aims the camera (thread-safe; frames rendered from now on show the new view).
   void set_view(View view);
