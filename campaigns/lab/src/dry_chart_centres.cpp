@@ -16,9 +16,11 @@ json dry_chart_centres(const json& placement, const std::string& chart) {
     return placement.is_object() && placement.contains(key) && placement[key].is_number() ? placement[key].get<double>() : fallback;
   };
   const double deg = std::numbers::pi / 180;
-  const double rz = number("rotation_deg", 0) * deg, rx = number("tilt_deg", 0) * deg, ry = number("swing_deg", 0) * deg;
+  // Negated as the simulator's chart_pose.cpp does: a positive tilt leans the top edge away, a positive swing the right
+  // edge (camera coordinates: y down, z along the view).
+  const double rz = number("rotation_deg", 0) * deg, rx = -number("tilt_deg", 0) * deg, ry = -number("swing_deg", 0) * deg;
   const double fill = std::clamp(number("fill", 0.8), 0.05, 1.0);
-  // R = Rz · Rx · Ry, as the simulator poses its chart (rotation in the image plane, tilt, swing).
+  // R = Rz · Rx(−tilt) · Ry(−swing), as the simulator poses its chart (rotation in the image plane, tilt, swing).
   const double cz = std::cos(rz), sz = std::sin(rz), cx = std::cos(rx), sx = std::sin(rx), cy = std::cos(ry), sy = std::sin(ry);
   const double Rzx[3][3] = {{cz, -sz * cx, sz * sx}, {sz, cz * cx, -cz * sx}, {0, sx, cx}};
   const double Ry[3][3] = {{cy, 0, sy}, {0, 1, 0}, {-sy, 0, cy}};

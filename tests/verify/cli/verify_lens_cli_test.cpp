@@ -5,8 +5,10 @@
 // placement does (the same comparisons, bit for bit), while a distorted one moves the sampled regions; two
 // calibrations of the photograph's size ask for a name, a name for another size or an unknown one is refused.
 // (Where a distorted lens's spots must land is verify_floor_lens_test's, on the simulator's distorted floor view.)
+#include <filesystem>
 #include <fstream>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -68,6 +70,22 @@ source = "test"
 date = "2026-11-29"
 )";
 
+// The embedded simulator's capture folder outlives the daemon (the machine's /tmp is shared): removed when the test
+// ends, passed or failed. Declared before the daemon, so the daemon and its simulator are gone first.
+struct SimulatorCaptureFolder {
+  std::filesystem::path path;
+  void note(const DaemonProcess& daemon) {
+    const auto endpoint = nlohmann::json::parse(std::ifstream(daemon.state_dir() / "colorlabd.endpoint"));
+    if (endpoint.contains("simulator_pid"))
+      path = std::filesystem::temp_directory_path() /
+             ("colorlab-sim-" + std::to_string(endpoint["simulator_pid"].get<long>()) + "-dslr");
+  }
+  ~SimulatorCaptureFolder() {
+    std::error_code ignored;
+    if (!path.empty()) std::filesystem::remove_all(path, ignored);
+  }
+};
+
 json control(const DaemonProcess& daemon, const json& command) {
   json endpoint = json::parse(std::ifstream(daemon.state_dir() / "colorlabd.endpoint"));
   return sim::send_control_command(endpoint.at("simulator_control").get<std::string>(), command);
@@ -99,7 +117,9 @@ std::vector<double> rendered(const json& result) {
 TEST(VerifyLensCli, TheFloorIsPlacedThroughTheNamedCalibrationAndSaysSo) {
   TempDir dir;
   const auto config = write_daemon_config(dir.path(), 200, 11, kLenses);
+  SimulatorCaptureFolder capture;
   DaemonProcess daemon(dir.path() / "state", config);
+  capture.note(daemon);
   auto api = api_for(daemon);
   const json t = control(daemon, {{"cmd", "floor_truth"}, {"instrument", "dslr"}});
   json corners = json::array();
@@ -126,7 +146,7 @@ TEST(VerifyLensCli, TheFloorIsPlacedThroughTheNamedCalibrationAndSaysSo) {
     std::vector<std::string> argv{bin_path("colorlab"), "--socket", daemon.unix_socket(), "verify",
                                   (dir.path() / "ramp.exr").string(), "--against", floor, "--json", "--scale", "1"};
     argv.insert(argv.end(), extra.begin(), extra.end());
-    return run_command(argv, std::chrono::seconds(60));
+    return run_command(argv, std::chrono::seconds(30));
   };
 
   // Two calibrations hold for 3504 × 2336: a name is needed.
