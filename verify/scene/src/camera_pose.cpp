@@ -57,8 +57,8 @@ cv::Vec3d optical_axis(const Solved& s) { return cv::Vec3d(s.r(2, 0), s.r(2, 1),
 CameraPose pose_from_chart(const ChartSighting& sighting, const CameraIntrinsics& lens, const CameraIntrinsics& lens_sigma) {
   if (!(lens.fx > 0 && lens.fy > 0))
     throw Error(ErrorClass::bad_parameter, "camera pose: the lens needs positive focal lengths fx, fy (pixels)");
-  double CameraIntrinsics::* const params[] = {&CameraIntrinsics::fx, &CameraIntrinsics::fy, &CameraIntrinsics::cx,
-                                               &CameraIntrinsics::cy, &CameraIntrinsics::k1, &CameraIntrinsics::k2};
+  double CameraIntrinsics::*const params[] = {&CameraIntrinsics::fx, &CameraIntrinsics::fy, &CameraIntrinsics::cx,
+                                              &CameraIntrinsics::cy, &CameraIntrinsics::k1, &CameraIntrinsics::k2};
   for (auto m : params)
     if (!(lens_sigma.*m >= 0))
       throw Error(ErrorClass::bad_parameter, "camera pose: the lens calibration's uncertainties must be ≥ 0",
