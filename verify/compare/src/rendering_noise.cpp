@@ -5,8 +5,15 @@
 #include <map>
 #include <utility>
 
+#include "rendering_sample.hpp"
+
 namespace colorlab::verify::detail {
 namespace {
+
+// The noise is read in each region's central window of at most kWindow × kWindow pixels (576 pixels say its level
+// well enough; a floor cell of a full-size rendering would otherwise cost a model of every size it comes in), and a
+// region's mean gets the variance of its whole w × h.
+constexpr int kWindow = 24;
 
 struct Lag {
   int dx = 0, dy = 0;
@@ -62,12 +69,14 @@ Window window(int w, int h, const std::vector<Lag>& lags) {
   m.g = (m.x.transpose() * m.x).inverse();
   const auto n = static_cast<Eigen::Index>(lags.size());
   m.k.resize(n, n);
+  std::vector<Eigen::MatrixXd> b_x;
+  for (const Lag& ld : lags) b_x.push_back(both_ways(m.x, w, h, ld));
   for (Eigen::Index e = 0; e < n; ++e) {
     const Lag& le = lags[static_cast<std::size_t>(e)];
     const Eigen::MatrixXd ae_x = shift(m.x, w, h, le.dx, le.dy);
     for (Eigen::Index d = 0; d < n; ++d) {
       const Lag& ld = lags[static_cast<std::size_t>(d)];
-      const Eigen::MatrixXd bd_x = both_ways(m.x, w, h, ld);
+      const Eigen::MatrixXd& bd_x = b_x[static_cast<std::size_t>(d)];
       double t = le == ld ? pairs(le, w, h) : 0.0;                                     // tr(A_e B_d)
       t -= (m.g * (m.x.transpose() * both_ways(ae_x, w, h, ld))).trace();              // tr(A_e H B_d)
       t -= (m.g * (m.x.transpose() * shift(bd_x, w, h, le.dx, le.dy))).trace();        // tr(A_e B_d H)
@@ -94,9 +103,13 @@ RenderingNoise rendering_noise(const Rendering& r, const std::vector<PixelRect>&
   if (regions.empty()) return out;
   const auto dim = to.rows();
   const int channels = r.channels();
+  auto estimated_in = [](const PixelRect& g) {
+    const int w = std::min(g.w, kWindow), h = std::min(g.h, kWindow);
+    return PixelRect{g.x + (g.w - w) / 2, g.y + (g.h - h) / 2, w, h};
+  };
   bool any = false, all_large = true;
-  for (const auto& g : regions)
-    if (g.w >= 2 && g.h >= 2 && g.w * g.h >= 8) {
+  for (const auto& full : regions)
+    if (const PixelRect g = estimated_in(full); g.w >= 2 && g.h >= 2 && g.w * g.h >= 8) {
       any = true;
       all_large = all_large && g.w >= 6 && g.h >= 6;
     }
@@ -113,7 +126,7 @@ RenderingNoise rendering_noise(const Rendering& r, const std::vector<PixelRect>&
   Eigen::VectorXd q_total = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(lags.size()));
   Eigen::MatrixXd k_total = Eigen::MatrixXd::Zero(q_total.size(), q_total.size());
   for (std::size_t i = 0; i < regions.size(); ++i) {
-    const PixelRect& g = regions[i];
+    const PixelRect g = estimated_in(regions[i]);
     auto& st = stats[i];
     st.cx = g.x + 0.5 * g.w;
     st.cy = g.y + 0.5 * g.h;
@@ -159,7 +172,10 @@ RenderingNoise rendering_noise(const Rendering& r, const std::vector<PixelRect>&
   // variance of a mean of w × h correlated pixels per unit variance, in the region's own scale.
   std::vector<double> expected(regions.size(), 0.0);
   for (std::size_t i = 0; i < regions.size(); ++i)
-    if (stats[i].usable) expected[i] = window_of(regions[i].w, regions[i].h).k.row(0).transpose().dot(rho);
+    if (stats[i].usable) {
+      const PixelRect g = estimated_in(regions[i]);
+      expected[i] = window_of(g.w, g.h).k.row(0).transpose().dot(rho);
+    }
   std::vector<std::size_t> pooled;
   for (std::size_t j = 0; j < regions.size(); ++j)
     if (stats[j].usable && expected[j] > 0) pooled.push_back(j);
@@ -184,7 +200,12 @@ RenderingNoise rendering_noise(const Rendering& r, const std::vector<PixelRect>&
     // Never below white noise's 1/N: a negative correlation estimated from few pixels is not a reason to believe the
     // mean better than independent pixels would make it.
     v = std::max(v, n) / (n * n);
-    out.covariance[i] = st.scale.asDiagonal() * (s / e) * st.scale.asDiagonal() * v;
+    Eigen::VectorXd scale = st.scale;  // relative to the whole region's mean, where the window is only its centre
+    if (g.w > kWindow || g.h > kWindow) {
+      const Eigen::VectorXd whole = to * region_mean(r, g);
+      scale = whole.cwiseAbs().cwiseMax(1e-3 * whole.norm());
+    }
+    out.covariance[i] = scale.asDiagonal() * (s / e) * scale.asDiagonal() * v;
   }
   return out;
 }

@@ -2,7 +2,7 @@
 // The rendering's own noise as an uncertainty source (issue 23, docs/verify.md "The uncertainty, source by
 // source"): a Monte-Carlo renderer's region mean is itself an estimate, with a standard error the rendering shows.
 // Estimated from the rendering alone, per kind of region (chart patches, LS-110 spots, floor cells):
-//  - inside each region a plane is fitted per coordinate (the illumination's gradient is the scene, not noise) and
+//  - inside each region (its central 24 × 24 pixels at most) a plane is fitted per coordinate (the illumination's gradient is the scene, not noise) and
 //    the residuals are the noise;
 //  - the noise's spatial correlation (a pixel filter wider than a pixel, a denoiser, upsampling) from lag products of
 //    the residuals pooled over every region, by the method of moments that accounts for what the plane removed
