@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 
 #include "colorlab/core/error.hpp"
 #include "colorlab/verify/compare/stored.hpp"
@@ -83,6 +84,58 @@ TEST(VerifyCompare, SaysWhichScaleItUsed) {
   const auto j = v.to_json();
   EXPECT_EQ(j["summary"]["verdict"], "agrees");
   EXPECT_EQ(j["summary"]["scales"][0]["how"], "fitted");
+}
+
+// A (4·side)² XYZ rendering of Y = 100 with relative noise `sd` per pixel (white, or a 2 × 2 block filter: unit
+// variance, neighbours correlated 0.5, diagonals 0.25) and a linear ramp of `ramp` per pixel, and 16 spots of
+// side × side pixels on it, each read exactly.
+double stated_rendering_noise(double sd, bool correlated, double ramp, int side = 10) {
+  const int n = 4 * side;
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> n01(0, 1);
+  std::vector<double> white(static_cast<std::size_t>((n + 1) * (n + 1)));
+  for (auto& x : white) x = n01(rng);
+  Rendering r = flat_xyz(0);
+  r.width = r.height = n;
+  r.pixels.assign(static_cast<std::size_t>(n * n * 3), 0.0f);
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      const auto at = [&](int dx, int dy) { return white[static_cast<std::size_t>((y + dy) * (n + 1) + x + dx)]; };
+      const double e = correlated ? 0.5 * (at(0, 0) + at(1, 0) + at(0, 1) + at(1, 1)) : at(0, 0);
+      const double v = 100 * (1 + ramp * x) * (1 + sd * e);
+      for (int c = 0; c < 3; ++c) r.pixels[static_cast<std::size_t>((y * n + x) * 3 + c)] = static_cast<float>(v);
+    }
+  MeasuredScene m;
+  for (int i = 0; i < 16; ++i) {
+    SpotMeasurement s;
+    s.row = i / 4;
+    s.col = i % 4;
+    s.rendering_region = {side * s.col, side * s.row, side, side};
+    s.luminance_cd_m2 = 100 * (1 + ramp * (side * s.col + 0.5 * (side - 1)));
+    s.reading_sd = 1e-6;
+    m.spots.push_back(s);
+  }
+  CompareOptions o;
+  o.scale = 1.0;
+  const auto v = compare(r, m, o);
+  double sum = 0;  // the stated standard uncertainty of each spot's mean, relative, averaged over the spots
+  for (const auto& c : v.comparisons)
+    for (const auto& [source, u] : c.budget)
+      if (source == "rendering noise") sum += u;  // the budget is relative for light: u / measured
+  return sum / static_cast<double>(v.comparisons.size());
+}
+
+TEST(VerifyCompare, TheRenderingsOwnNoiseIsStatedFromItsPixels) {
+  // White: σ / √100. The 2 × 2 filter: the variance of a 10 × 10 mean is (100 + 2·(0.5·90·2 + 0.25·81·2)) / 100² of a
+  // pixel's, i.e. σ · 0.19 — not σ / 10. Bounds: ±12 % for white (the pooled variance of 8 × 97 residuals has a
+  // relative σ of 2.5 %, its square root 1.3 %: ±12 % is far outside chance), ±20 % correlated (the correlation's
+  // own estimate adds to it). A ramp without noise is the scene, not noise: nothing stated.
+  EXPECT_NEAR(stated_rendering_noise(0.02, false, 0) / 0.002, 1.0, 0.12);
+  EXPECT_NEAR(stated_rendering_noise(0.02, true, 0) / (0.02 * 0.19), 1.0, 0.20);
+  EXPECT_LT(stated_rendering_noise(0, false, 0.01), 1e-6);
+  EXPECT_NEAR(stated_rendering_noise(0.02, false, 0.01) / 0.002, 1.0, 0.12);
+  // 40 × 40 spots: the noise is read in each one's central 24 × 24, the mean's σ is of all 1600 pixels (σ/40).
+  EXPECT_NEAR(stated_rendering_noise(0.02, false, 0, 40) / 0.0005, 1.0, 0.12);
 }
 
 TEST(VerifyCompare, BadInputsAreTypedErrors) {

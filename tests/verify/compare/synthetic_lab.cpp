@@ -33,6 +33,29 @@ analysis::Lab lab_of(const Eigen::Vector3d& xyz, const analysis::Xyz& white) {
 
 }  // namespace
 
+Rendering with_render_noise(const Rendering& r, std::mt19937_64& rng, double sd, bool correlated, bool per_band) {
+  std::normal_distribution<double> N(0, 1);
+  if (per_band) {
+    Rendering out = r;
+    const auto chart_values = static_cast<std::size_t>(10 + 10 * 10) * static_cast<std::size_t>(r.width * r.channels());
+    for (std::size_t i = 0; i < chart_values && i < out.pixels.size(); ++i) out.pixels[i] = static_cast<float>(out.pixels[i] * (1 + sd * N(rng)));
+    return out;
+  }
+  const auto w = static_cast<std::size_t>(r.width) + 1, h = static_cast<std::size_t>(r.height) + 1;
+  std::vector<double> white(w * h);
+  for (auto& x : white) x = N(rng);
+  Rendering out = r;
+  const auto n = static_cast<std::size_t>(r.channels());
+  for (std::size_t y = 0; y + 1 < h; ++y)
+    for (std::size_t x = 0; x + 1 < w; ++x) {
+      const double e = correlated ? 0.5 * (white[y * w + x] + white[y * w + x + 1] + white[(y + 1) * w + x] + white[(y + 1) * w + x + 1])
+                                  : white[y * w + x];
+      float* p = out.pixels.data() + (y * (w - 1) + x) * n;
+      for (std::size_t c = 0; c < n; ++c) p[c] = static_cast<float>(p[c] * (1 + sd * e));
+    }
+  return out;
+}
+
 SyntheticLab::SyntheticLab() {
   for (double w = 400; w <= 700.5; w += kStep) wl_.push_back(w);
   const auto n = static_cast<Eigen::Index>(wl_.size());

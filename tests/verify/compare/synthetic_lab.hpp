@@ -24,6 +24,14 @@ struct Sources {  // which noises the draw makes (and the engine is told of)
   bool characterization = true;  // false: §7.3/§7.4 mappings are exact (the true curves)
 };
 
+// A Monte-Carlo renderer's own noise on a rendering: each pixel's spectrum × (1 + sd · n), n standard normal and the
+// same in every band (one seed renders every band, as the Blender tests do: the sampled paths are the same in each),
+// white or, `correlated`, the sum of a 2 × 2 block of white noise over 2 (unit variance; neighbours correlated 0.5,
+// diagonals 0.25: a pixel filter two pixels wide). `per_band`: each band its own white noise instead (a renderer
+// that samples each wavelength with its own paths), on the chart's rows only (what §7.4 reads; a million normal
+// draws per rendering otherwise).
+Rendering with_render_noise(const Rendering& r, std::mt19937_64& rng, double sd, bool correlated, bool per_band = false);
+
 struct Defects {
   int patch = -1;  // this patch's reflectance scaled so it is ~3 ΔE00 off under the lamp
   double patch_factor = 1.0;

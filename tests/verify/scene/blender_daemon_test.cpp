@@ -7,20 +7,20 @@
 // spectral OpenEXR (the JCGT layout verify reads) and, for the planted defect, scales them by linearity.
 //
 // Truth and bounds: the simulator photographed its true chart (the SG's spectra) lit by the emitters' form factors;
-// Blender renders the Spectrolino's reading of it lit by Cycles' path tracing of the same emitters. The issue asks a
-// faithful rendering to agree on >= 95 % of the patches "where the render's noise allows". Here it does not quite:
-// two differences between rendering and photograph are in no budget the measurement states — Cycles' own noise
-// (16 samples per pixel in each band, a patch's region ~80 pixels at 480 × 320) and the exported spectra being the
-// Spectrolino's noisy reading while the photograph saw the true chart — on top of the ~3.5 % a faithful rendering is
-// flagged in the in-process calibration (compare_defects_test). So the bound here is >= 90 % per kind (at most 14 of
-// 140 flagged): 2.5 times the calibration's false-flag rate, and far from what a wrong renderer gives — the same
-// bands lit by CIE A instead of D65 (exact by linearity: each band image is linear in that band's emission; the
-// issue's "wrong lamp spectrum" defect) must be flagged on >= 90 % of the patches in §7.3 (compare_defects_test's
-// detection bound) with exit 4.
+// Blender renders the Spectrolino's reading of it lit by Cycles' path tracing of the same emitters. A faithful
+// rendering must agree on >= 95 % of the patches per kind (issue 23). Cycles' own noise (16 samples per pixel in
+// each band, a patch's region ~80 pixels at 480 × 320) is a stated source now (`rendering noise`, estimated from the
+// rendering itself: docs/verify.md), so the band covers it; before it was, this rendering agreed on 132 and 129 of
+// 140 and the bound here was 90 %. What is still in no budget: the exported spectra are the Spectrolino's reading
+// while the photograph saw the true chart (the chart-read run states no repeatability to budget it with; printed
+// below as ΔE00 against the simulator's chart). A wrong renderer is still seen: the same bands lit by CIE A instead
+// of D65 (exact by linearity: each band image is linear in that band's emission; the issue's "wrong lamp spectrum"
+// defect) must be flagged on >= 90 % of the patches in §7.3 (compare_defects_test's detection bound) with exit 4.
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
@@ -34,6 +34,8 @@
 #include <string>
 #include <vector>
 
+#include "colorlab/analysis/color_difference.hpp"
+#include "colorlab/analysis/colorimetry.hpp"
 #include "colorlab/analysis/standard_data.hpp"
 #include "colorlab/sim/camera/camera_model.hpp"
 #include "colorlab/sim/clock.hpp"
@@ -171,6 +173,29 @@ TEST(BlenderDaemon, TheDaemonsExportedSceneRenderedByBlenderIsVerifiedThroughThe
   ASSERT_EQ(exported["camera"]["pose"]["source"], "located chart") << exported["camera"].dump(1);
   std::cout << "exported camera at " << exported["camera"]["position_m"].dump() << " m\n";
   const double step_nm = exported["bands"]["step_nm"].get<double>();
+  {
+    // What the renderer was given beside what the camera saw: the exported (Spectrolino-read) spectra against the
+    // simulator's true chart, ΔE00 under D65 — the chart-read run states no repeatability to budget this with.
+    const sim::Scene truth(sim::SceneConfig{}, std::make_shared<sim::SimClock>(1.0));
+    std::vector<double> grid;
+    for (std::size_t k = 0; k < 36; ++k) grid.push_back(380 + 10.0 * static_cast<double>(k));
+    const analysis::ReflectanceIntegrator integ(analysis::load_illuminant("D65"), analysis::load_observer(analysis::Observer::cie1931_2deg), grid);
+    std::vector<double> de;
+    for (const auto& p : exported["chart"]["patches"]) {
+      const auto idx = truth.chart().index_of(p["id"].get<std::string>());
+      const auto read = p["reflectance"]["values"].get<std::vector<double>>();
+      if (!idx || read.size() != grid.size()) continue;
+      const std::vector<double> real = truth.chart().patches[static_cast<std::size_t>(*idx)].reflectance.resampled(380, 10, grid.size()).values;
+      const auto lab = [&](const std::vector<double>& r) {
+        return analysis::xyz_to_lab(integ.xyz(Eigen::Map<const Eigen::RowVectorXd>(r.data(), static_cast<Eigen::Index>(r.size()))), integ.white());
+      };
+      de.push_back(analysis::delta_e2000(lab(read), lab(real)));
+    }
+    std::sort(de.begin(), de.end());
+    if (!de.empty())
+      std::cout << "exported spectra against the simulator's true chart (" << de.size() << " patches): ΔE00 median " << de[de.size() / 2]
+                << ", max " << de.back() << "\n";
+  }
 
   // Every band once (Blender's own seed); bounded: a hung Blender is killed and its log shown.
   const fs::path renders = dir.path() / "renders";
@@ -195,7 +220,7 @@ TEST(BlenderDaemon, TheDaemonsExportedSceneRenderedByBlenderIsVerifiedThroughThe
     return std::pair{r.exit_code, j};
   };
   {
-    SCOPED_TRACE("Blender's rendering of the exported scene agrees with the measurement on >= 90 % of the patches");
+    SCOPED_TRACE("Blender's rendering of the exported scene agrees with the measurement on >= 95 % of the patches");
     const auto [rc, result] = verify(faithful);
     ASSERT_TRUE(result.contains("comparisons")) << result.dump().substr(0, 2000);
     const auto k = tally(result);
@@ -206,8 +231,22 @@ TEST(BlenderDaemon, TheDaemonsExportedSceneRenderedByBlenderIsVerifiedThroughThe
       std::cout << kind << ": " << t.compared - t.differ << "/" << t.compared << " agree; differ at";
       for (const auto& w : t.at) std::cout << " " << w;
       std::cout << "\n";
-      EXPECT_GE(1.0 - static_cast<double>(t.differ) / t.compared, 0.90) << kind << "\n"
+      EXPECT_GE(1.0 - static_cast<double>(t.differ) / t.compared, 0.95) << kind << "\n"
                                                                         << result["summary"][kind].dump(1);
+    }
+    // What the rendering's own noise (Cycles at 16 samples) adds to each band, beside the whole band: medians.
+    for (const char* kind : {"colour_7_3", "colour_7_4"}) {
+      std::vector<double> noise, band;
+      for (const auto& c : result["comparisons"])
+        if (c["kind"] == kind) {
+          noise.push_back(c["budget"].value("rendering noise", 0.0));
+          band.push_back(c["expanded"].get<double>() / 2);
+        }
+      std::sort(noise.begin(), noise.end());
+      std::sort(band.begin(), band.end());
+      if (!noise.empty())
+        std::cout << kind << ": rendering noise along the difference, median " << noise[noise.size() / 2] << " (max "
+                  << noise.back() << "), against a whole band's u median " << band[band.size() / 2] << "\n";
     }
     // The exit status is the verdict: 0 exactly when nothing differs.
     const bool any = k.at("colour_7_3").differ + k.at("colour_7_4").differ > 0;

@@ -212,6 +212,16 @@ TEST(LensCalibrationSim, RecoversTheSimulatorsLensWithinItsStatedUncertainty) {
               "(simulator at %.1f, %.1f, %.1f mm)\n",
               off_cal, off_nom, want.x(), want.y(), want.z());
   EXPECT_LT(off_cal, off_nom);
+  // The pose's σ now carries the calibration's own σ beside the corners': the simulator's camera within 4 of it on
+  // each axis (the position bound of verify_scene_camera_pose_test).
+  const auto sd = calibrated["pose"]["position_sigma_m"].get<std::vector<double>>();
+  const auto from_lens = calibrated["pose"]["sigma_sources"]["lens_calibration"]["position_m"].get<std::vector<double>>();
+  for (int i = 0; i < 3; ++i) {
+    std::printf("[ pose ] axis %d: %.1f mm off, σ %.1f mm (lens calibration %.1f mm)\n", i, std::abs(at(calibrated)[i] - want[i]),
+                sd[static_cast<std::size_t>(i)] * 1000, from_lens[static_cast<std::size_t>(i)] * 1000);
+    EXPECT_GT(from_lens[static_cast<std::size_t>(i)], 0) << i;
+    EXPECT_LE(std::abs(at(calibrated)[i] - want[i]), 4 * sd[static_cast<std::size_t>(i)] * 1000) << i;
+  }
 }
 
 // --- the [[lens]] table -------------------------------------------------------------------------------------

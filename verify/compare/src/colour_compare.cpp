@@ -7,6 +7,7 @@
 #include "colorlab/analysis/color_difference.hpp"
 #include "colorlab/core/error.hpp"
 #include "comparisons.hpp"
+#include "rendering_noise.hpp"
 #include "rendering_sample.hpp"
 
 namespace colorlab::verify::detail {
@@ -57,6 +58,13 @@ Eigen::Matrix3d regional_covariance(const std::vector<Eigen::Vector3d>& points, 
 Eigen::Matrix3d beyond(const Eigen::Matrix3d& held_out, const Eigen::Matrix3d& frame_noise) {
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(held_out - frame_noise);
   return es.eigenvectors() * es.eigenvalues().cwiseMax(0.0).asDiagonal() * es.eigenvectors().transpose();
+}
+
+std::vector<PixelRect> regions_of(const std::vector<PatchMeasurement>& patches) {
+  std::vector<PixelRect> out;
+  out.reserve(patches.size());
+  for (const auto& p : patches) out.push_back(p.rendering_region);
+  return out;
 }
 
 }  // namespace
@@ -122,6 +130,8 @@ void compare_colour_73(const Rendering& r, const MeasuredScene& s, const Compare
   }
   const double drift_sd = s.lamp_drift_bound / std::sqrt(3.0);  // a bound read as a rectangular distribution
   const double a = s.locator_accuracy_px;
+  const RenderingNoise noise = o.rendering_noise ? rendering_noise(r, regions_of(s.patches), tx.matrix(), o.noise_neighbours)
+                                                 : RenderingNoise{};
 
   for (std::size_t i = 0; i < s.patches.size(); ++i) {
     const auto& p = s.patches[i];
@@ -150,6 +160,18 @@ void compare_colour_73(const Rendering& r, const MeasuredScene& s, const Compare
       }
       if (s.white_relative_sd > 0)
         b.add_vector("ls110 repeatability", z * (rend_lab(rendered[i], sc.factor * (1 + s.white_relative_sd)) - lr));
+    }
+    if (!noise.covariance.empty()) {
+      // The rendered XYZ's covariance carried to the ΔE00 coordinates through the Jacobian of its L*a*b*.
+      Eigen::Matrix3d jac;
+      const Eigen::Vector3d x0(rendered[i].X, rendered[i].Y, rendered[i].Z);
+      for (int c = 0; c < 3; ++c) {
+        const double h = 1e-4 * std::max(x0.norm(), 1e-12);
+        Eigen::Vector3d up = x0, down = x0;
+        up[c] += h, down[c] -= h;
+        jac.col(c) = (rend_lab({up[0], up[1], up[2]}, sc.factor) - rend_lab({down[0], down[1], down[2]}, sc.factor)) / (2 * h);
+      }
+      b.add("rendering noise", z * jac * noise.covariance[i] * jac.transpose() * z.transpose());
     }
     if (a > 0)
       for (auto [dx, dy] : {std::pair{1, 0}, std::pair{0, 1}}) {
@@ -217,6 +239,7 @@ void compare_colour_74(const Rendering& r, const MeasuredScene& s, const Compare
     throw Error(ErrorClass::bad_data, "the black box's cross-validated residuals are missing or do not match their patches");
 
   const double a = s.locator_accuracy_px;
+  const RenderingNoise noise = o.rendering_noise ? rendering_noise(r, regions_of(s.patches), m, o.noise_neighbours) : RenderingNoise{};
   for (std::size_t i = 0; i < s.patches.size(); ++i) {
     const auto& p = s.patches[i];
     const Eigen::Vector3d meas(p.camera[0], p.camera[1], p.camera[2]);
@@ -227,6 +250,7 @@ void compare_colour_74(const Rendering& r, const MeasuredScene& s, const Compare
                                       .asDiagonal();
     b.add("black box", beyond(regional_covariance(cv_points, cv_res, meas / full, o.cv_neighbours), frame));
     b.add("frame noise", frame);
+    if (!noise.covariance.empty()) b.add("rendering noise", sc.factor * sc.factor * noise.covariance[i]);
     if (a > 0)
       for (auto [dx, dy] : {std::pair{1, 0}, std::pair{0, 1}}) {
         const Eigen::Vector3d d = m * (shifted_mean(r, p.rendering_region, dx, dy) - shifted_mean(r, p.rendering_region, -dx, -dy));

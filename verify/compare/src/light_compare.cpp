@@ -5,6 +5,7 @@
 
 #include "colorlab/core/error.hpp"
 #include "comparisons.hpp"
+#include "rendering_noise.hpp"
 #include "rendering_sample.hpp"
 
 namespace colorlab::verify::detail {
@@ -36,6 +37,12 @@ void compare_sites(const Rendering& r, const std::vector<Site>& sites, const cha
   }
   v.scales.push_back(sc);
   const double drift_sd = s.lamp_drift_bound / std::sqrt(3.0);
+  RenderingNoise noise;
+  if (o.rendering_noise) {
+    std::vector<PixelRect> regions;
+    for (const auto& site : sites) regions.push_back(site.region);
+    noise = rendering_noise(r, regions, tx.matrix().row(1), o.noise_neighbours);
+  }
   for (std::size_t i = 0; i < sites.size(); ++i) {
     const auto& site = sites[i];
     if (!(site.measured > 0))
@@ -43,6 +50,7 @@ void compare_sites(const Rendering& r, const std::vector<Site>& sites, const cha
     const double lr = rendered[i] * sc.factor;
     Budget b;
     b.add_vector(site.own_name, Eigen::VectorXd::Constant(1, site.own_sd));
+    if (!noise.covariance.empty()) b.add("rendering noise", sc.factor * sc.factor * noise.covariance[i]);
     if (sc.how == "given" && drift_sd > 0) b.add_vector("lamp drift", Eigen::VectorXd::Constant(1, site.measured * drift_sd));
     if (accuracy_px > 0)
       for (auto [dx, dy] : {std::pair{1, 0}, std::pair{0, 1}}) {

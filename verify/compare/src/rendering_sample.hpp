@@ -20,6 +20,7 @@ class ToXyz {
  public:
   explicit ToXyz(const Rendering& r);
   analysis::Xyz operator()(const Eigen::VectorXd& channels) const;
+  const Eigen::Matrix3Xd& matrix() const { return m_; }
 
  private:
   Eigen::Matrix3Xd m_;  // 3 × channels

@@ -1,6 +1,9 @@
 #include "colorlab/verify/compare/uncertainty.hpp"
 
 #include <cmath>
+#include <map>
+#include <mutex>
+#include <utility>
 
 #include "colorlab/core/error.hpp"
 
@@ -27,11 +30,20 @@ double gamma_p(double a, double x) {
 double chi_square_quantile(double p, int dof) {
   if (dof < 1 || !(p > 0 && p < 1))
     throw Error(ErrorClass::bad_parameter, "chi-square quantile needs dof >= 1 and 0 < p < 1");
+  // Every verdict asks for the same few (k = 2 in 1 and 3 dimensions): remembered, not bisected again each time.
+  static std::mutex mutex;
+  static std::map<std::pair<double, int>, double> known;
+  {
+    const std::lock_guard lock(mutex);
+    if (const auto it = known.find({p, dof}); it != known.end()) return it->second;
+  }
   double lo = 0, hi = 10.0 * dof + 100.0;
   for (int i = 0; i < 200; ++i) {
     const double mid = 0.5 * (lo + hi);
     (gamma_p(0.5 * dof, 0.5 * mid) < p ? lo : hi) = mid;
   }
+  const std::lock_guard lock(mutex);
+  if (known.size() < 64) known[{p, dof}] = 0.5 * (lo + hi);
   return 0.5 * (lo + hi);
 }
 

@@ -54,9 +54,15 @@ cv::Vec3d optical_axis(const Solved& s) { return cv::Vec3d(s.r(2, 0), s.r(2, 1),
 
 }  // namespace
 
-CameraPose pose_from_chart(const ChartSighting& sighting, const CameraIntrinsics& lens) {
+CameraPose pose_from_chart(const ChartSighting& sighting, const CameraIntrinsics& lens, const CameraIntrinsics& lens_sigma) {
   if (!(lens.fx > 0 && lens.fy > 0))
     throw Error(ErrorClass::bad_parameter, "camera pose: the lens needs positive focal lengths fx, fy (pixels)");
+  double CameraIntrinsics::*const params[] = {&CameraIntrinsics::fx, &CameraIntrinsics::fy, &CameraIntrinsics::cx,
+                                              &CameraIntrinsics::cy, &CameraIntrinsics::k1, &CameraIntrinsics::k2};
+  for (auto m : params)
+    if (!(lens_sigma.*m >= 0))
+      throw Error(ErrorClass::bad_parameter, "camera pose: the lens calibration's uncertainties must be ≥ 0",
+                  "a [[lens]] table's sigma states one standard uncertainty of each parameter");
   if (!(sighting.accuracy_px >= 0))
     throw Error(ErrorClass::bad_parameter, "camera pose: the corners' accuracy must be ≥ 0 px");
   const Solved s = solve(sighting.corners_px, sighting.corners_mm, lens);
@@ -81,9 +87,32 @@ CameraPose pose_from_chart(const ChartSighting& sighting, const CameraIntrinsics
       for (int i = 0; i < 3; ++i) var_pos[i] += dp[i] * dp[i];
       var_axis += da.dot(da);
     }
-  const double sd = sighting.accuracy_px;
-  for (int i = 0; i < 3; ++i) p.position_sigma_mm[static_cast<std::size_t>(i)] = sd * std::sqrt(var_pos[i]);
-  p.axis_sigma_deg = sd * std::sqrt(var_axis) * 180.0 / std::numbers::pi;
+  const double sd = sighting.accuracy_px, deg = 180.0 / std::numbers::pi;
+  for (int i = 0; i < 3; ++i) p.position_sigma_corners_mm[static_cast<std::size_t>(i)] = sd * std::sqrt(var_pos[i]);
+  p.axis_sigma_corners_deg = sd * std::sqrt(var_axis) * deg;
+
+  // The lens calibration's σ: each parameter moved by a tenth of its σ either way (small enough to stay linear, the
+  // same solution branch), the change scaled to one σ.
+  cv::Vec3d lens_pos(0, 0, 0);
+  double lens_axis = 0;
+  for (auto m : params) {
+    const double u = lens_sigma.*m;
+    if (!(u > 0)) continue;
+    CameraIntrinsics plus = lens, minus = lens;
+    plus.*m += 0.1 * u, minus.*m -= 0.1 * u;
+    const Solved sp = solve(sighting.corners_px, sighting.corners_mm, plus), sm = solve(sighting.corners_px, sighting.corners_mm, minus);
+    const cv::Vec3d dp = (sp.centre - sm.centre) / 0.2;
+    const cv::Vec3d da = (optical_axis(sp) - optical_axis(sm)) / 0.2;
+    for (int i = 0; i < 3; ++i) lens_pos[i] += dp[i] * dp[i];
+    lens_axis += da.dot(da);
+  }
+  for (int i = 0; i < 3; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    p.position_sigma_lens_mm[k] = std::sqrt(lens_pos[i]);
+    p.position_sigma_mm[k] = std::hypot(p.position_sigma_corners_mm[k], p.position_sigma_lens_mm[k]);
+  }
+  p.axis_sigma_lens_deg = std::sqrt(lens_axis) * deg;
+  p.axis_sigma_deg = std::hypot(p.axis_sigma_corners_deg, p.axis_sigma_lens_deg);
   return p;
 }
 

@@ -333,7 +333,7 @@ json camera_part(const CabinetGeometry& cab, const json& chart_doc, const json* 
     source = "nominal: an assumed 50 mm lens on the EOS 20D's 22.5 mm-wide sensor (no lens calibration given; no "
              "run stores the photograph's EXIF focal length)";
   }
-  const CameraPose p = pose_from_chart(s, k);
+  const CameraPose p = pose_from_chart(s, k, stored ? stored->sigma : CameraIntrinsics{});
   const auto& z = p.axes[2];
   // Where the optical axis meets the floor (z = 0), for renderers that aim by a target.
   const double t = z[2] < 0 ? -p.position_mm[2] / z[2] : 1000.0;
@@ -359,10 +359,13 @@ json camera_part(const CabinetGeometry& cab, const json& chart_doc, const json* 
           {"pose", {{"source", "located chart"}, {"run", id}, {"format", format}, {"corners_px", corners},
                     {"corner_accuracy_px", s.accuracy_px}, {"reprojection_px", p.reprojection_px},
                     {"position_sigma_m", {p.position_sigma_mm[0] * mm, p.position_sigma_mm[1] * mm, p.position_sigma_mm[2] * mm}},
-                    {"axis_sigma_deg", p.axis_sigma_deg}}},
+                    {"axis_sigma_deg", p.axis_sigma_deg},
+                    {"sigma_sources", {{"corners", {{"position_m", {p.position_sigma_corners_mm[0] * mm, p.position_sigma_corners_mm[1] * mm, p.position_sigma_corners_mm[2] * mm}}, {"axis_deg", p.axis_sigma_corners_deg}}},
+                                       {"lens_calibration", {{"position_m", {p.position_sigma_lens_mm[0] * mm, p.position_sigma_lens_mm[1] * mm, p.position_sigma_lens_mm[2] * mm}}, {"axis_deg", p.axis_sigma_lens_deg}}}}}}},
           {"how", "solvePnP (OpenCV, IPPE) of the chart locator's four outer grid corners on the " + format +
                       " photograph against the chart's geometry where the cabinet puts it, with the intrinsics above; "
-                      "σ from the corners' stated accuracy through the solution's Jacobian"}};
+                      "σ from the corners' stated accuracy and the lens calibration's own σ (none for --lens or a nominal "
+                      "lens) through the solution's Jacobian"}};
   // clang-format on
 }
 

@@ -26,13 +26,19 @@ struct CameraPose {
   std::array<double, 3> position_mm{};
   // Columns: the camera's x (image right), y (image down) and z (optical axis) in the cabinet's frame.
   std::array<std::array<double, 3>, 3> axes{};
-  std::array<double, 3> position_sigma_mm{};  // one σ per cabinet axis, from accuracy_px
+  std::array<double, 3> position_sigma_mm{};  // one σ per cabinet axis: both parts below in quadrature
   double axis_sigma_deg = 0;                  // one σ of the optical axis' direction
   double reprojection_px = 0;                 // RMS of the corners against the solved pose
+  // The two parts: the corners' stated accuracy, and the lens calibration's own σ of fx, fy, cx, cy, k1, k2.
+  std::array<double, 3> position_sigma_corners_mm{}, position_sigma_lens_mm{};
+  double axis_sigma_corners_deg = 0, axis_sigma_lens_deg = 0;
 };
 
-// Throws Error(bad_parameter) for intrinsics without a focal length, Error(bad_data) for corners that give no
-// pose in front of the camera (a degenerate or mirrored quadrilateral).
-CameraPose pose_from_chart(const ChartSighting& sighting, const CameraIntrinsics& lens);
+// `lens_sigma`: one standard uncertainty of each intrinsic (a stored lens calibration's `sigma`; zeros for a lens
+// taken as exact), carried through the same numerical Jacobian as the corners, the parameters taken as independent
+// (the calibration states no covariance). Throws Error(bad_parameter) for intrinsics without a focal length or a
+// negative σ, Error(bad_data) for corners that give no pose in front of the camera (a degenerate or mirrored
+// quadrilateral).
+CameraPose pose_from_chart(const ChartSighting& sighting, const CameraIntrinsics& lens, const CameraIntrinsics& lens_sigma = {});
 
 }  // namespace colorlab::verify

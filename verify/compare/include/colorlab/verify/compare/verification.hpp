@@ -100,6 +100,11 @@ struct CompareOptions {
   // Expanded uncertainties above these mean the measurement cannot tell a renderer error of that size there.
   double cannot_tell_de00 = 2.0;
   double cannot_tell_relative = 0.02;
+  // The rendering's own noise (a Monte-Carlo renderer's region mean is an estimate too), estimated from the
+  // rendering: its per-pixel spread in each region, pooled over the `noise_neighbours` nearest regions of the same
+  // kind, with the noise's spatial correlation (docs/verify.md). Off only for a renderer that states it is exact.
+  bool rendering_noise = true;
+  int noise_neighbours = 8;
 };
 
 enum class Verdict {
