@@ -127,15 +127,17 @@ double stated_rendering_noise(double sd, bool correlated, double ramp, int side 
 
 TEST(VerifyCompare, TheRenderingsOwnNoiseIsStatedFromItsPixels) {
   // White: σ / √100. The 2 × 2 filter: the variance of a 10 × 10 mean is (100 + 2·(0.5·90·2 + 0.25·81·2)) / 100² of a
-  // pixel's, i.e. σ · 0.19 — not σ / 10. Bounds: ±12 % for white (the pooled variance of 8 × 97 residuals has a
-  // relative σ of 2.5 %, its square root 1.3 %: ±12 % is far outside chance), ±20 % correlated (the correlation's
-  // own estimate adds to it). A ramp without noise is the scene, not noise: nothing stated.
-  EXPECT_NEAR(stated_rendering_noise(0.02, false, 0) / 0.002, 1.0, 0.12);
-  EXPECT_NEAR(stated_rendering_noise(0.02, true, 0) / (0.02 * 0.19), 1.0, 0.20);
+  // pixel's, i.e. σ · 0.19 — not σ / 10. Bounds, from the estimator's spread over seeds (a review's simulation of
+  // this setup: stated / true σ has mean 1.04 and sd 0.064 for white noise — the pooled variance of 8 × 97
+  // residuals alone has a relative σ of 5 %, the neighbour correlations' own estimates add the rest — and sd 0.085
+  // for the filtered noise): ±25 % and ±30 %, about 3.3σ, so the check holds for any seed, not only this one.
+  // A ramp without noise is the scene, not noise: nothing stated.
+  EXPECT_NEAR(stated_rendering_noise(0.02, false, 0) / 0.002, 1.0, 0.25);
+  EXPECT_NEAR(stated_rendering_noise(0.02, true, 0) / (0.02 * 0.19), 1.0, 0.30);
   EXPECT_LT(stated_rendering_noise(0, false, 0.01), 1e-6);
-  EXPECT_NEAR(stated_rendering_noise(0.02, false, 0.01) / 0.002, 1.0, 0.12);
+  EXPECT_NEAR(stated_rendering_noise(0.02, false, 0.01) / 0.002, 1.0, 0.25);
   // 40 × 40 spots: the noise is read in each one's central 24 × 24, the mean's σ is of all 1600 pixels (σ/40).
-  EXPECT_NEAR(stated_rendering_noise(0.02, false, 0, 40) / 0.0005, 1.0, 0.12);
+  EXPECT_NEAR(stated_rendering_noise(0.02, false, 0, 40) / 0.0005, 1.0, 0.25);
 }
 
 TEST(VerifyCompare, BadInputsAreTypedErrors) {
