@@ -1,5 +1,6 @@
 #include "format.hpp"
 
+#include <cmath>
 #include <cstdio>
 #include <sstream>
 
@@ -24,7 +25,7 @@ std::string number(double v, int decimals = 2) {
 // 5430 s → "1 h 30 min 30 s"; short durations keep a decimal.
 std::string duration(double s) {
   if (s < 60) return number(s, s < 10 ? 1 : 0) + " s";
-  long t = static_cast<long>(s + 0.5);
+  const long t = std::lround(s);
   std::string out;
   if (t >= 3600) out += std::to_string(t / 3600) + " h ";
   if (t >= 60) out += std::to_string((t % 3600) / 60) + " min ";

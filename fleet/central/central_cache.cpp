@@ -1,19 +1,10 @@
 #include "colorlab/fleet/central_cache.hpp"
 
-#include <cstdio>
+#include "colorlab/fleet/s3.hpp"
 
 namespace colorlab::fleet {
 
-std::string body_etag(const std::string& body) {
-  std::uint64_t h = 14695981039346656037ULL;
-  for (unsigned char c : body) {
-    h ^= c;
-    h *= 1099511628211ULL;
-  }
-  char out[24];
-  std::snprintf(out, sizeof out, "\"%016llx\"", static_cast<unsigned long long>(h));
-  return out;
-}
+std::string body_etag(const std::string& body) { return "\"" + sha256_hex(body) + "\""; }
 
 std::optional<AnswerCache::Answer> AnswerCache::find(const std::string& key, const std::string& validator) {
   std::lock_guard lock(mutex_);

@@ -430,7 +430,7 @@ TEST(Store, ASecondWriterCommitsWholeStepsInEventOrderAndAReadSnapshotKeepsItsVi
   step.step = "reading/0";
   const std::int64_t before = store.last_event_seq();
   {
-    Store::ReadSnapshot view(store);
+    const auto view = store.read_snapshot();
     EXPECT_EQ(store.last_event_seq(), before);
     second.commit_step(e, step);
     // Committed and durable on the other connection, not seen inside the snapshot.
@@ -450,4 +450,23 @@ TEST(Store, ASecondWriterCommitsWholeStepsInEventOrderAndAReadSnapshotKeepsItsVi
   // A repeated step is refused whole there too.
   EXPECT_THROW(second.commit_step(e, step), colorlab::Error);
   EXPECT_EQ(store.measurements(e.run_id).size(), 1u);
+}
+
+// The one read-transaction type (store::ReadTransaction, also Store::read_snapshot): inside a caller's transaction
+// it joins it — no nested BEGIN, which SQLite refuses, and no COMMIT of the caller's writes when it ends.
+TEST(Store, AReadTransactionInsideACallersTransactionJoinsIt) {
+  TempDir dir;
+  colorlab::store::Database db((dir / "t.db").string(), false);
+  db.exec("CREATE TABLE t(x INTEGER)");
+  colorlab::store::Transaction tx(db);
+  db.exec("INSERT INTO t VALUES (1)");
+  {
+    colorlab::store::ReadTransaction read(db);
+    auto st = db.prepare("SELECT count(*) FROM t");
+    ASSERT_TRUE(st.step());
+    EXPECT_EQ(st.int64(0), 1) << "the read does not see its caller's own write";
+  }
+  EXPECT_EQ(sqlite3_get_autocommit(db.handle()), 0) << "the read transaction ended its caller's transaction";
+  tx.commit();
+  EXPECT_NE(sqlite3_get_autocommit(db.handle()), 0);
 }

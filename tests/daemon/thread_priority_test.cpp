@@ -23,12 +23,14 @@
 #include "colorlab/daemon/report_service.hpp"
 #include "colorlab/daemon/worker_pool.hpp"
 #include "colorlab/testing/temp_dir.hpp"
+#include "run_until.hpp"
 
 namespace colorlab::daemon {
 namespace {
 
 namespace asio = boost::asio;
 using nlohmann::json;
+using testing::run_until;
 using testing::TempDir;
 
 int lowered(int steps) { return std::min(19, core::thread_nice() + steps); }
@@ -38,17 +40,6 @@ std::string thread_name() {
   std::string name;
   std::getline(in, name);
   return name;
-}
-
-// Runs the io_context until `done` holds; a bound, not a measurement.
-template <class Pred>
-void run_until(asio::io_context& io, Pred done, const char* what) {
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-  while (!done()) {
-    ASSERT_LT(std::chrono::steady_clock::now(), deadline) << "timed out waiting for " << what;
-    io.restart();
-    io.run_one_for(std::chrono::milliseconds(50));
-  }
 }
 
 TEST(ThreadPriority, WorkerPoolThreadsRunAtTheConfiguredNiceAndTheCommitterAsTheDaemon) {

@@ -13,23 +13,14 @@
 #include <boost/asio/use_future.hpp>
 
 #include "colorlab/daemon/worker_pool.hpp"
+#include "run_until.hpp"
 
 namespace colorlab::daemon {
 namespace {
 
 namespace asio = boost::asio;
 using nlohmann::json;
-
-// Runs the io_context's handlers until `done` holds; a bound, not a measurement.
-template <class Pred>
-void run_until(asio::io_context& io, Pred done, const char* what) {
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-  while (!done()) {
-    ASSERT_LT(std::chrono::steady_clock::now(), deadline) << "timed out waiting for " << what;
-    io.restart();
-    io.run_one_for(std::chrono::milliseconds(50));
-  }
-}
+using testing::run_until;
 
 struct Outcome {
   std::optional<json> result;

@@ -5,6 +5,7 @@
 #include <chrono>
 
 #include "colorlab/core/error.hpp"
+#include "colorlab/core/log.hpp"
 #include "colorlab/store/writer_wait.hpp"
 
 namespace colorlab::store {
@@ -145,6 +146,21 @@ class WriterWaitTimer {
 }  // namespace
 
 std::int64_t writer_wait_us_this_thread() { return writer_wait_us; }
+
+ReadTransaction::ReadTransaction(Database& db) : db_(db) {
+  if (sqlite3_get_autocommit(db_.handle()) == 0) return;
+  db_.exec("BEGIN DEFERRED");
+  open_ = true;
+}
+
+ReadTransaction::~ReadTransaction() {
+  if (!open_) return;
+  try {
+    db_.exec("COMMIT");
+  } catch (const Error& e) {
+    log::warning("store", std::string("cannot end a read transaction: ") + e.what());
+  }
+}
 
 Transaction::Transaction(Database& db) : db_(db) {
   WriterWaitTimer timed;

@@ -150,22 +150,6 @@ Store::Store(const fs::path& database_path, SecondWriter) {
   db_.exec("PRAGMA temp_store = MEMORY");
 }
 
-Store::ReadSnapshot::ReadSnapshot(Store& store) : db_(store.db_) {
-  // Inside a transaction already (a caller's): its snapshot is the one read.
-  if (sqlite3_get_autocommit(db_.handle()) == 0) return;
-  db_.exec("BEGIN DEFERRED");
-  open_ = true;
-}
-
-Store::ReadSnapshot::~ReadSnapshot() {
-  if (!open_) return;
-  try {
-    db_.exec("COMMIT");
-  } catch (const Error& e) {
-    log::warning("store", std::string("cannot end a read snapshot: ") + e.what());
-  }
-}
-
 Store::Created Store::create_execution(const NewRun& run) {
   if (run.idempotency_key) {
     auto st = db_.prepare("SELECT id FROM executions WHERE idempotency_key = ?1");

@@ -230,10 +230,12 @@ LabConfig load_lab_config(const std::filesystem::path& file) {
       auto& sc = c.spectrolino;
       for (const auto& [sk, sn] : *t) {
         std::string s(sk.str());
-        auto pair = [&](const char* what) {
-          auto a = sn.as_array();
+        // The binding is captured through a reference of its own: clang before 16 (clang-tidy 14) cannot capture a
+        // structured binding.
+        auto pair = [&, &value = sn](const char* what) {
+          auto a = value.as_array();
           if (!a || a->size() != 2 || !(*a)[0].is_number() || !(*a)[1].is_number()) {
-            bad(file, sn, std::string(what) + " must be [x_mm, y_mm]");
+            bad(file, value, std::string(what) + " must be [x_mm, y_mm]");
           }
           return std::make_pair((*a)[0].value<double>().value_or(0), (*a)[1].value<double>().value_or(0));
         };

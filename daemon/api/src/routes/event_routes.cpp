@@ -93,7 +93,7 @@ HttpResponse get_event_stream(ApiContext& ctx, const HttpRequest& req, const Pat
     // meanwhile on the committer's thread (step_committer.hpp) come after `after`, as events.
     json state;
     {
-      store::Store::ReadSnapshot one_view(ctx.store);
+      const auto one_view = ctx.store.read_snapshot();
       after = ctx.store.last_event_seq();
       state = snapshot(ctx, after);
     }

@@ -62,8 +62,8 @@ class AnswerCache {
   std::unordered_map<std::string, Checked> runs_;
 };
 
-// The entity tag of a body: a quoted 64-bit FNV-1a of its bytes (the same bytes give the same tag in every
-// process and version, so a client's tag survives a restart).
+// The entity tag of a body: the quoted SHA-256 (hex) of its bytes, the same form as the bench's and central's
+// blob tags (the same bytes give the same tag in every process and version, so a client's tag survives a restart).
 std::string body_etag(const std::string& body);
 
 }  // namespace colorlab::fleet

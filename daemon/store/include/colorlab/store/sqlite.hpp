@@ -69,23 +69,21 @@ class Statement {
   sqlite3_stmt* stmt_;
 };
 
-// BEGIN DEFERRED ... COMMIT around reads, so they all come from one snapshot of the WAL (a reader beside colorlabd's
-// writer: the shipping agent, the bench's own shipping lag). Ending a read-only transaction cannot lose anything, so
-// a failed COMMIT in the destructor is ignored.
+// BEGIN DEFERRED ... COMMIT around reads, so they all come from one snapshot of the database until it is dropped:
+// what another connection commits meanwhile is not seen (a reader beside colorlabd's writer: the shipping agent, the
+// bench's own shipping lag; an event stream's snapshot and its seq, through Store::read_snapshot). Inside a
+// transaction already (a caller's), it joins it: that transaction's snapshot is the one read. Ending a read-only
+// transaction cannot lose anything, so a failed COMMIT in the destructor is logged, not thrown.
 class ReadTransaction {
  public:
-  explicit ReadTransaction(Database& db) : db_(db) { db_.exec("BEGIN DEFERRED"); }
-  ~ReadTransaction() {
-    try {
-      db_.exec("COMMIT");
-    } catch (...) {
-    }
-  }
+  explicit ReadTransaction(Database& db);
+  ~ReadTransaction();
   ReadTransaction(const ReadTransaction&) = delete;
   ReadTransaction& operator=(const ReadTransaction&) = delete;
 
  private:
   Database& db_;
+  bool open_ = false;
 };
 
 // BEGIN IMMEDIATE ... COMMIT, rolled back unless commit() was called.

@@ -227,19 +227,9 @@ class Store {
                                     std::int64_t after_seq, unsigned limit);
   std::int64_t measurement_count(const std::string& run_id);
   std::int64_t last_event_seq();
-  // Reads in one snapshot of the database until it is dropped (a deferred transaction): what a second
-  // writer commits meanwhile is not seen, so e.g. an event stream's snapshot and its seq agree.
-  class ReadSnapshot {
-   public:
-    explicit ReadSnapshot(Store& store);
-    ~ReadSnapshot();
-    ReadSnapshot(const ReadSnapshot&) = delete;
-    ReadSnapshot& operator=(const ReadSnapshot&) = delete;
-
-   private:
-    Database& db_;
-    bool open_ = false;
-  };
+  // Reads on this connection in one snapshot of the database until it is dropped (sqlite.hpp's ReadTransaction):
+  // what a second writer commits meanwhile is not seen, so e.g. an event stream's snapshot and its seq agree.
+  [[nodiscard]] ReadTransaction read_snapshot() { return ReadTransaction(db_); }
   // Newest first; `cursor` is the opaque next_cursor of the previous page. A listed run's summary leaves
   // out "script" (the campaign's own result, unbounded in size); run(id) has the whole summary.
   RunPage runs(unsigned limit, const std::optional<std::string>& cursor, const RunFilter& filter = {});
