@@ -4,6 +4,8 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <string_view>
+#include <utility>
 
 #include "colorlab/core/error.hpp"
 #include <boost/asio/steady_timer.hpp>
@@ -185,9 +187,17 @@ struct Lab::Impl {
       throw Error(ErrorClass::bad_parameter, "place_chart: placement must be \"configured\" or a table", std::string("keys: ") + keys);
     camera::ChartPlacement p;
     for (const auto& [key, value] : spec.items()) {
-      double* field = key == "rotation_deg" ? &p.rotation_deg : key == "tilt_deg" ? &p.tilt_deg : key == "swing_deg" ? &p.swing_deg
-                    : key == "fill"         ? &p.fill         : key == "shift_x"  ? &p.shift_x  : key == "shift_y"   ? &p.shift_y
-                                                                                                                      : nullptr;
+      static constexpr std::pair<std::string_view, double camera::ChartPlacement::*> kFields[] = {
+          {"rotation_deg", &camera::ChartPlacement::rotation_deg},
+          {"tilt_deg", &camera::ChartPlacement::tilt_deg},
+          {"swing_deg", &camera::ChartPlacement::swing_deg},
+          {"fill", &camera::ChartPlacement::fill},
+          {"shift_x", &camera::ChartPlacement::shift_x},
+          {"shift_y", &camera::ChartPlacement::shift_y},
+      };
+      double* field = nullptr;
+      for (const auto& [name, member] : kFields)
+        if (key == name) field = &(p.*member);
       if (!field) throw Error(ErrorClass::bad_parameter, "place_chart: unknown placement key '" + key + "'", std::string("keys: ") + keys);
       if (!value.is_number()) throw Error(ErrorClass::bad_parameter, "place_chart: placement." + key + " must be a number");
       *field = value.get<double>();

@@ -67,8 +67,8 @@ struct CameraModel::Impl {
   // The chart's geometry: set, the chart at a pose instead. With `regions` and `placement`, replaced by place_chart
   // under cache_mutex (the frame cache is built under it too); the public accessors read them under it.
   std::optional<detail::PoseGeometry> pose;
-  std::optional<ChartPlacement> placement;  // the operator's, when not where the configuration put it
-  std::optional<detail::FloorGeometry> floor;        // the floor view's geometry
+  std::optional<ChartPlacement> placement;     // the operator's, when not where the configuration put it
+  std::optional<detail::FloorGeometry> floor;  // the floor view's geometry
   std::atomic<View> view{View::chart};
   std::vector<Spectrum> material_reflectance;  // material_count
   // response[lamp][material][channel]: green-normalised exposure per cd/m² of floor luminance.

@@ -237,7 +237,8 @@ TEST(BlenderDaemon, TheDaemonsExportedSceneRenderedByBlenderIsVerifiedThroughThe
       std::cout << "\n";
       // Binomial(140, 0.05)'s 99.9 % quantile (see the top): more would say the band is too narrow.
       constexpr int kMostFalseFlags = 16;
-      EXPECT_LE(t.differ, kMostFalseFlags) << kind << "\n" << result["summary"][kind].dump(1);
+      EXPECT_LE(t.differ, kMostFalseFlags) << kind << "\n"
+                                           << result["summary"][kind].dump(1);
       std::cout << kind << ": " << (t.differ <= 7 ? "at or above" : "below") << " the issue's 95 % in this rendering\n";
     }
     // What the rendering's own noise (Cycles at 16 samples) adds to each band, beside the whole band: medians.
