@@ -5,7 +5,7 @@
 # start (a daemon stopped by a report can fail its test in a way that does not say why; the report files do). Not part
 # of CI (the whole tree is about 500 compilations under the sanitizers).
 #   scripts/asan.sh [--integration] [--target T]... [--no-build] [CTEST ARGS...]    e.g. --repeat until-fail:2
-# --integration: the integration label too, without the Blender renders (verify_*blender*), the Debian package
+# --integration: the integration label too, without the Blender renders (programs verify_*blender*), the Debian package
 # (packaging.*: an mmdebstrap chroot) and the soak. --target: build only the named targets (repeatable; the test
 # programs build what they link) and run only their tests; the tests of programs not built are left out, not
 # failed. --no-build: run what build-asan/ holds (e.g. while another shell builds the rest).
@@ -34,10 +34,11 @@ fi
 mapfile -t select < <(ctest --test-dir build-asan --show-only=json-v1 | python3 -c '
 import json, os, re, sys
 programs = set(sys.argv[1:])
-skip = re.compile(r"_NOT_BUILT$|blender|^packaging\.|^soak\.")
+skip = re.compile(r"_NOT_BUILT$|^packaging\.|^soak\.")
 def runs(t):
-    return (not skip.search(t["name"]) and t.get("command") and os.path.exists(t["command"][0])
-            and (not programs or os.path.basename(t["command"][0]) in programs))
+    program = t.get("command") and t["command"][0]
+    return (not skip.search(t["name"]) and program and os.path.exists(program) and "blender" not in program
+            and (not programs or os.path.basename(program) in programs))
 tests = json.load(sys.stdin)["tests"]
 names = [t["name"] for t in tests if runs(t) == bool(programs)]
 print("-R" if programs else "-E")
