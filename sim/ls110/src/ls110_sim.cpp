@@ -85,8 +85,10 @@ void Ls110Sim::handle_line(const std::string& line, std::size_t wire_bytes) {
       return;
     }
     Ls110Truth t = truth_();
-    std::normal_distribution<double> noise(0.0, t.noise_sigma);
-    double value = std::max(0.0, t.luminance + noise(rng_));
+    // σ times a standard normal, not normal_distribution(0, σ): that one requires σ > 0 and a noiseless meter
+    // (σ = 0, the default) broke it (_GLIBCXX_ASSERTIONS, the asan preset). Same draws and values as before.
+    std::normal_distribution<double> n01(0.0, 1.0);
+    double value = std::max(0.0, t.luminance + t.noise_sigma * n01(rng_));
     ++readings_;
     answer(wire::ls110::format_ok(value, 0), kMeasureSeconds, wire_bytes);
   } else if (line.rfind("MDS", 0) == 0) {

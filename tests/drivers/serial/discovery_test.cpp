@@ -87,9 +87,10 @@ TEST(DiscoveryTest, ComeAndGoAreReportedToSubscribers) {
 
 TEST(DiscoveryTest, ExplicitPortOverrideWorksForPtys) {
   sim::Pty pty;
+  FakeBus bus;  // outlives d: its sources capture the bus (a temporary's were read after its end, ASan)
   Discovery d({DiscoveryRule{"sim-spectro", "spectrolino", pty.slave_path(), std::nullopt, std::nullopt, ""},
                DiscoveryRule{"gone", "ls110", "/dev/does-not-exist", std::nullopt, std::nullopt, ""}},
-              FakeBus{}.sources());
+              bus.sources());
   auto found = d.scan();
   ASSERT_EQ(found.size(), 1u);
   EXPECT_EQ(found[0].id, "sim-spectro");
