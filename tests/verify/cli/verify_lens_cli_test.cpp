@@ -16,6 +16,7 @@
 #include "colorlab/client/runs.hpp"
 #include "colorlab/sim/control_channel.hpp"
 #include "colorlab/verify/rendering.hpp"
+#include "colorlab/testing/simulator_capture.hpp"
 #include "resume_support.hpp"
 
 using namespace colorlab;
@@ -69,22 +70,6 @@ sigma = { fx = 4.0, fy = 4.0, cx = 2.0, cy = 2.0, k1 = 0.001, k2 = 0.01 }
 source = "test"
 date = "2026-11-29"
 )";
-
-// The embedded simulator's capture folder outlives the daemon (the machine's /tmp is shared): removed when the test
-// ends, passed or failed. Declared before the daemon, so the daemon and its simulator are gone first.
-struct SimulatorCaptureFolder {
-  std::filesystem::path path;
-  void note(const DaemonProcess& daemon) {
-    const auto endpoint = nlohmann::json::parse(std::ifstream(daemon.state_dir() / "colorlabd.endpoint"));
-    if (endpoint.contains("simulator_pid"))
-      path = std::filesystem::temp_directory_path() /
-             ("colorlab-sim-" + std::to_string(endpoint["simulator_pid"].get<long>()) + "-dslr");
-  }
-  ~SimulatorCaptureFolder() {
-    std::error_code ignored;
-    if (!path.empty()) std::filesystem::remove_all(path, ignored);
-  }
-};
 
 json control(const DaemonProcess& daemon, const json& command) {
   json endpoint = json::parse(std::ifstream(daemon.state_dir() / "colorlabd.endpoint"));

@@ -21,6 +21,7 @@
 
 #include "colorlab/sim/control_channel.hpp"
 #include "colorlab/testing/process.hpp"
+#include "colorlab/testing/simulator_capture.hpp"
 #include "colorlab/verify/lens_calibration.hpp"
 #include "resume_support.hpp"
 
@@ -44,22 +45,6 @@ json control(const DaemonProcess& daemon, const json& command) {
   const json endpoint = json::parse(std::ifstream(daemon.state_dir() / "colorlabd.endpoint"));
   return sim::send_control_command(endpoint.at("simulator_control").get<std::string>(), command);
 }
-
-// The embedded simulator's capture folder outlives the daemon (the machine's /tmp is shared): removed when the test
-// ends, passed or failed. Declared before the daemon, so the daemon and its simulator are gone first.
-struct SimulatorCaptureFolder {
-  std::filesystem::path path;
-  void note(const DaemonProcess& daemon) {
-    const auto endpoint = nlohmann::json::parse(std::ifstream(daemon.state_dir() / "colorlabd.endpoint"));
-    if (endpoint.contains("simulator_pid"))
-      path = std::filesystem::temp_directory_path() /
-             ("colorlab-sim-" + std::to_string(endpoint["simulator_pid"].get<long>()) + "-dslr");
-  }
-  ~SimulatorCaptureFolder() {
-    std::error_code ignored;
-    if (!path.empty()) std::filesystem::remove_all(path, ignored);
-  }
-};
 
 // The locator is given no chart-read reference here (it would cost a chart-read run): the simulated SG's L2–M3 block
 // has no edges of its own, which drops the locator's confidence to about 0.1 without one (docs/verify.md), so the
