@@ -12,6 +12,7 @@
 #include <memory>
 #include <numbers>
 #include <random>
+#include <vector>
 
 #include "colorlab/analysis/chart_locate.hpp"
 #include "colorlab/core/error.hpp"
@@ -47,35 +48,54 @@ json characterize_run(const ca::ChartLocation& loc, int width, int height) {
   return testing::located_chart_run(corners, loc.confidence, width, height, loc.reprojection_rms_px);
 }
 
+// The simulator photographs its chart at `pose` through its fixed lens (the seed-4 scene under D65, 1752 × 1168),
+// the locator finds it as characterize-camera does, and the export is given the simulator's lens as the lab's
+// calibration: what each pose test exports from.
+struct Sighting {
+  std::shared_ptr<sim::Scene> scene;
+  cam::CameraConfig config;
+  std::unique_ptr<cam::CameraModel> camera;
+  ca::ChartLocation located;
+  std::vector<json> runs;      // the chart-read and the characterize-camera run
+  SceneExportOptions options;  // D65, the simulator's lens
+};
+
+Sighting sight_chart(const cam::ChartPose& pose, double chart_height_fraction) {
+  Sighting s;
+  sim::SceneConfig sc;
+  sc.seed = 4;
+  sc.lamps_on_at_start = {sim::Lamp::d65};
+  s.scene = std::make_shared<sim::Scene>(sc, std::make_shared<sim::SimClock>());
+  s.config.width = 1752;
+  s.config.height = 1168;
+  s.config.chart_height_fraction = chart_height_fraction;
+  s.config.pose = pose;
+  s.camera = std::make_unique<cam::CameraModel>(s.scene, s.config);
+  cam::CameraSettings settings;
+  settings.shutter_s = 1.0 / 30;
+  const cam::RawFrame frame = s.camera->render(settings, 1);
+  ca::LocateOptions lo;
+  lo.reference = reference_of(*s.scene);
+  s.located = ca::locate_chart(testing::raw_view(frame), ca::ChartType::sg140, lo);
+  s.runs = {testing::chart_read_run(*s.scene, 1), characterize_run(s.located, s.config.width, s.config.height)};
+  const auto l = s.camera->lens();
+  s.options.lamps = {"D65"};
+  s.options.lens = CameraIntrinsics{l.fx, l.fy, l.cx, l.cy, l.k1, l.k2};
+  s.options.lens_source = "the simulator's lens";
+  return s;
+}
+
 TEST(SceneCameraPose, FromTheLocatedChartWhereTheSimulatorsCameraIs) {
   for (std::uint64_t seed : {3u, 11u}) {
-    sim::SceneConfig sc;
-    sc.seed = 4;
-    sc.lamps_on_at_start = {sim::Lamp::d65};
-    auto scene = std::make_shared<sim::Scene>(sc, std::make_shared<sim::SimClock>());
-    cam::CameraConfig cc;
-    cc.width = 1752;
-    cc.height = 1168;
-    cc.chart_height_fraction = 0.62;
     cam::ChartPose pose = cam::random_chart_pose(seed);
     pose.k1 = pose.k2 = 0;  // characterize-camera's locator is given no lens: a distortion-free bench lens
-    cc.pose = pose;
-    const cam::CameraModel camera(scene, cc);
-    cam::CameraSettings settings;
-    settings.shutter_s = 1.0 / 30;
-    const cam::RawFrame frame = camera.render(settings, 1);
-    ca::LocateOptions lo;
-    lo.reference = reference_of(*scene);
-    const ca::ChartLocation loc = ca::locate_chart(testing::raw_view(frame), ca::ChartType::sg140, lo);
-
-    const auto l = camera.lens();  // the lab's lens calibration: the simulator's lens
-    SceneExportOptions o;
-    o.lamps = {"D65"};
-    o.lens = CameraIntrinsics{l.fx, l.fy, l.cx, l.cy, l.k1, l.k2};
-    o.lens_source = "the simulator's lens";
-    const std::vector<json> runs{testing::chart_read_run(*scene, 1), characterize_run(loc, cc.width, cc.height)};
+    Sighting s = sight_chart(pose, 0.62);
+    const ca::ChartLocation& loc = s.located;
+    SceneExportOptions& o = s.options;
+    const std::vector<json>& runs = s.runs;
     const json k = export_scene(default_cabinet(), runs, o)["camera"];
-    const auto want = testing::simulator_camera(pose, l.fx, l.fy, cc.width, cc.height, *scene);
+    const auto l = s.camera->lens();
+    const auto want = testing::simulator_camera(pose, l.fx, l.fy, s.config.width, s.config.height, *s.scene);
 
     ASSERT_EQ(k["pose"]["source"], "located chart");
     EXPECT_FALSE(k["estimated"].get<bool>());
@@ -114,38 +134,19 @@ TEST(SceneCameraPose, FromTheLocatedChartWhereTheSimulatorsCameraIs) {
 // the chart (the simulator's sign was once the opposite: its camera came out behind the chart, at the back). A
 // positive swing puts the camera on the chart's left. Physics, not a derivation: only which side of the chart.
 TEST(SceneCameraPose, APositiveTiltPhotographsTheChartFromTheCabinetsFront) {
-  sim::SceneConfig sc;
-  sc.seed = 4;
-  sc.lamps_on_at_start = {sim::Lamp::d65};
-  auto scene = std::make_shared<sim::Scene>(sc, std::make_shared<sim::SimClock>());
-  cam::CameraConfig cc;
-  cc.width = 1752;
-  cc.height = 1168;
-  cc.chart_height_fraction = 0.55;
   cam::ChartPose pose;  // the Blender daemon test's sighting (30° off the chart's normal, 600 mm), swung a little
   pose.tilt_deg = 30, pose.swing_deg = 10, pose.distance_mm = 600;
-  cc.pose = pose;
-  const cam::CameraModel camera(scene, cc);
+  const Sighting s = sight_chart(pose, 0.55);
   // The image itself: the top edge of the patch grid (A1–N1), farther away, is shorter than the bottom (A10–N10),
   // and the right edge (N1–N10) shorter than the left (A1–A10).
-  const auto g = camera.patch_grid_corners_px();
+  const auto g = s.camera->patch_grid_corners_px();
   const auto len = [](const std::array<double, 2>& a, const std::array<double, 2>& b) { return std::hypot(a[0] - b[0], a[1] - b[1]); };
   EXPECT_LT(len(g[0], g[1]), len(g[3], g[2])) << "top edge not farther than the bottom";
   EXPECT_LT(len(g[1], g[2]), len(g[0], g[3])) << "right edge not farther than the left";
 
-  cam::CameraSettings settings;
-  settings.shutter_s = 1.0 / 30;
-  const cam::RawFrame frame = camera.render(settings, 1);
-  ca::LocateOptions lo;
-  lo.reference = reference_of(*scene);
-  const ca::ChartLocation loc = ca::locate_chart(testing::raw_view(frame), ca::ChartType::sg140, lo);
-  const auto l = camera.lens();
-  SceneExportOptions o;
-  o.lamps = {"D65"};
-  o.lens = CameraIntrinsics{l.fx, l.fy, l.cx, l.cy, l.k1, l.k2};
-  const json k = export_scene(default_cabinet(), {testing::chart_read_run(*scene, 1), characterize_run(loc, cc.width, cc.height)}, o)["camera"];
+  const json k = export_scene(default_cabinet(), s.runs, s.options)["camera"];
   const auto p = k["position_m"].get<std::vector<double>>();
-  const auto [chart_x, chart_y] = scene->chart_to_floor_mm(sim::chart_width_mm / 2, sim::chart_height_mm / 2);
+  const auto [chart_x, chart_y] = s.scene->chart_to_floor_mm(sim::chart_width_mm / 2, sim::chart_height_mm / 2);
   const double front_edge_y = chart_y - sim::chart_height_mm / 2;
   std::printf("[ tilt 30°, swing 10° ] exported camera at (%.1f, %.1f, %.1f) mm; chart centre (%.1f, %.1f), its front edge at y "
               "= %.1f mm\n",
@@ -155,7 +156,8 @@ TEST(SceneCameraPose, APositiveTiltPhotographsTheChartFromTheCabinetsFront) {
   EXPECT_LT(p[0] * 1000, chart_x) << "a positive swing must put the camera on the chart's left";
   EXPECT_GT(p[2], 0.0);
   // And where ChartPose's angles put it, within the export's own 4 σ.
-  const auto want = testing::simulator_camera(pose, l.fx, l.fy, cc.width, cc.height, *scene);
+  const auto l = s.camera->lens();
+  const auto want = testing::simulator_camera(pose, l.fx, l.fy, s.config.width, s.config.height, *s.scene);
   const auto sig = k["pose"]["position_sigma_m"].get<std::vector<double>>();
   for (std::size_t i = 0; i < 3; ++i)
     EXPECT_LE(std::abs(p[i] * 1000 - want.position_mm[static_cast<Eigen::Index>(i)]), kSigmas * sig[i] * 1000) << "axis " << i;
