@@ -45,6 +45,7 @@
 #include "colorlab/sim/clock.hpp"
 #include "colorlab/sim/scene.hpp"
 #include "colorlab/testing/process.hpp"
+#include "colorlab/testing/simulator_capture.hpp"
 #include "colorlab/verify/rendering.hpp"
 #include "resume_support.hpp"
 
@@ -148,7 +149,9 @@ TEST(BlenderDaemon, TheDaemonsExportedSceneRenderedByBlenderIsVerifiedThroughThe
   TempDir dir;
   auto config = write_daemon_config(dir.path(), 1000, kSeed);
   std::ofstream(dir.path() / "lab.toml") << lab_toml();
+  SimulatorCaptureFolder capture;
   auto daemon = std::make_unique<DaemonProcess>(dir.path() / "state", config);
+  capture.note(*daemon);
   const auto api = api_for(*daemon);
   auto cli = [&](std::vector<std::string> args, std::chrono::seconds timeout = std::chrono::seconds(120)) {
     std::vector<std::string> argv{bin_path("colorlab"), "--socket", daemon->unix_socket()};
@@ -274,11 +277,6 @@ TEST(BlenderDaemon, TheDaemonsExportedSceneRenderedByBlenderIsVerifiedThroughThe
     EXPECT_EQ(result["summary"]["verdict"], "differs");
   }
   std::cout << "wall " << seconds() << " s\n";
-  // The embedded simulator's capture folder outlives the daemon; the machine's /tmp is shared.
-  const json endpoint = json::parse(read_file(daemon->state_dir() / "colorlabd.endpoint"));
-  daemon.reset();
-  if (endpoint.contains("simulator_pid"))
-    fs::remove_all(fs::temp_directory_path() / ("colorlab-sim-" + std::to_string(endpoint["simulator_pid"].get<long>()) + "-dslr"));
 }
 
 }  // namespace
