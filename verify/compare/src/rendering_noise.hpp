@@ -9,7 +9,10 @@
 //    (lags up to 1 px, or 2 px when every region is at least 6 × 6);
 //  - the noise's level relative to the value (a path tracer's estimate of direct light is the albedo times a sampled
 //    form factor, so its spread scales with the value), pooled over the `neighbours` nearest regions in the image —
-//    one region's few pixels give too uncertain a variance for a k = 2 band.
+//    one region's few pixels give too uncertain a variance for a k = 2 band;
+//  - robustly: a region whose level the median of its (at least 8) nearest regions' cannot explain — a texture, an
+//    edge, a firefly: residuals that are not the noise its neighbours share — is left out of the correlation and of
+//    every other region's pool, and judged by its own spread.
 #include <Eigen/Dense>
 #include <vector>
 
@@ -22,8 +25,10 @@ struct RenderingNoise {
   // region has pixels enough to say (each needs at least 2 × 2 and more than 3 pixels beyond the plane).
   std::vector<Eigen::MatrixXd> covariance;
   double lag1_correlation = 0;  // the pooled correlation of horizontally adjacent pixels (for the record)
+  std::vector<bool> left_out;   // per region: its residuals not its neighbours' noise, so not pooled into theirs
 };
 
+// Throws Error(bad_parameter) for `neighbours` < 1.
 RenderingNoise rendering_noise(const Rendering& r, const std::vector<PixelRect>& regions, const Eigen::MatrixXd& to,
                                int neighbours);
 

@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <string>
 
 #include "colorlab/core/error.hpp"
 #include "comparisons.hpp"
@@ -9,12 +10,21 @@ namespace colorlab::verify {
 
 std::string_view to_string(Verdict v) { return v == Verdict::agrees ? "agrees" : "differs"; }
 
-Verification compare(const Rendering& rendering, const MeasuredScene& scene, const CompareOptions& options) {
-  if (rendering.width <= 0 || rendering.height <= 0 || rendering.pixels.empty())
-    throw Error(ErrorClass::bad_data, "the rendering has no pixels");
+void check_options(const CompareOptions& options) {
   if (options.scale && !(*options.scale > 0))
     throw Error(ErrorClass::bad_parameter, "a given scale must be a positive number (renderer unit -> cd/m²)");
   if (!(options.k > 0)) throw Error(ErrorClass::bad_parameter, "the coverage factor k must be positive");
+  if (options.noise_neighbours < 1)
+    throw Error(ErrorClass::bad_parameter,
+                "noise_neighbours must be at least 1 (got " + std::to_string(options.noise_neighbours) + ")",
+                "the rendering's noise level is pooled over that many nearest regions of a kind (default 8); to leave the "
+                "rendering's noise out of the budget, turn it off (--no-rendering-noise, \"rendering_noise\": false)");
+}
+
+Verification compare(const Rendering& rendering, const MeasuredScene& scene, const CompareOptions& options) {
+  if (rendering.width <= 0 || rendering.height <= 0 || rendering.pixels.empty())
+    throw Error(ErrorClass::bad_data, "the rendering has no pixels");
+  check_options(options);
   Verification v;
   bool any = false;
   if (scene.characterization && !scene.patches.empty()) {

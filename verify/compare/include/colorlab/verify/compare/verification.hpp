@@ -101,11 +101,18 @@ struct CompareOptions {
   double cannot_tell_de00 = 2.0;
   double cannot_tell_relative = 0.02;
   // The rendering's own noise (a Monte-Carlo renderer's region mean is an estimate too), estimated from the
-  // rendering: its per-pixel spread in each region, pooled over the `noise_neighbours` nearest regions of the same
-  // kind, with the noise's spatial correlation (docs/verify.md). Off only for a renderer that states it is exact.
+  // rendering: its per-pixel spread in each region, pooled over the `noise_neighbours` (≥ 1) nearest regions of the
+  // same kind, regions whose residuals their neighbours do not share left out, with the noise's spatial correlation
+  // (docs/verify.md). Off only for a renderer that states it is exact (CLI --no-rendering-noise, the API's
+  // "rendering_noise": false); both are kept in a stored verification's params.
   bool rendering_noise = true;
   int noise_neighbours = 8;
 };
+
+// Throws Error(bad_parameter) naming the option for options no comparison can be made with: a scale that is not a
+// positive number, k ≤ 0, noise_neighbours < 1 (whether or not the rendering's noise is on: a request that says both
+// is not guessed at). compare() calls it; the CLI and the daemon call it on what they were given.
+void check_options(const CompareOptions& options);
 
 enum class Verdict {
   agrees,
