@@ -4,9 +4,12 @@
 
 #include <cmath>
 #include <random>
+#include <string>
+#include <utility>
 
 #include "colorlab/core/error.hpp"
 #include "colorlab/verify/compare/stored.hpp"
+#include "colorlab/verify/compare/stored_request.hpp"
 #include "colorlab/verify/compare/uncertainty.hpp"
 #include "colorlab/verify/compare/verification.hpp"
 
@@ -178,6 +181,58 @@ TEST(VerifyCompare, StoredLikeARunWithAnExitStatus) {
   EXPECT_EQ(s.summary["kinds"]["light_spot"]["renderer_wrong_at"][0]["where"], "r0c1");
   EXPECT_EQ(s.params["against"].size(), 2u);
   EXPECT_EQ(s.params["scale"], 2.0);
+  EXPECT_EQ(s.params["rendering_noise"], true);
+  EXPECT_EQ(s.params["noise_neighbours"], 8);
+}
+
+TEST(VerifyCompare, TheRenderingNoiseOptionsTravelThroughTheRequestBody) {
+  const auto r = flat_xyz(50);
+  CompareOptions o;
+  o.scale = 2.0;
+  o.noise_neighbours = 3;
+  const auto v = compare(r, two_spots(100, 80), o);
+  auto s = stored_from_request(store_request(v, "render.exr", {"run-1"}, o));
+  EXPECT_EQ(s.params["rendering_noise"], true);
+  EXPECT_EQ(s.params["noise_neighbours"], 3);
+  CompareOptions off = o;
+  off.rendering_noise = false;
+  const auto v_off = compare(r, two_spots(100, 80), off);
+  for (const auto& c : v_off.comparisons)
+    for (const auto& [source, u] : c.budget) EXPECT_NE(source, "rendering noise");
+  s = stored_from_request(store_request(v_off, "render.exr", {"run-1"}, off));
+  EXPECT_EQ(s.params["rendering_noise"], false);
+  EXPECT_TRUE(s.params["noise_neighbours"].is_null());
+  // A body from before the fields existed: made the only way there was then, on over 8 regions.
+  auto old = store_request(v, "render.exr", {"run-1"}, CompareOptions{});
+  old.erase("rendering_noise");
+  old.erase("noise_neighbours");
+  s = stored_from_request(old);
+  EXPECT_EQ(s.params["rendering_noise"], true);
+  EXPECT_EQ(s.params["noise_neighbours"], 8);
+  // Bad values, and a budget that contradicts "rendering_noise": false, are bad parameters naming the field.
+  const std::pair<const char*, nlohmann::json> bad[] = {
+      {"rendering_noise", "yes"},
+      {"rendering_noise", 1},
+      {"noise_neighbours", 0},
+      {"noise_neighbours", -4},
+      {"noise_neighbours", 2.5},
+      {"noise_neighbours", "8"},
+      {"noise_neighbours", 1ll << 40},
+  };
+  for (const auto& [field, value] : bad) {
+    auto body = store_request(v, "render.exr", {"run-1"}, o);
+    body[field] = value;
+    try {
+      stored_from_request(body);
+      ADD_FAILURE() << field << " = " << value.dump() << " was accepted";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.cls(), ErrorClass::bad_parameter);
+      EXPECT_NE(std::string(e.what()).find(std::string("body.") + field), std::string::npos) << e.what();
+    }
+  }
+  auto contradiction = store_request(v, "render.exr", {"run-1"}, o);  // its budgets carry the rendering's noise
+  contradiction["rendering_noise"] = false;
+  EXPECT_THROW(stored_from_request(contradiction), Error);
 }
 
 }  // namespace

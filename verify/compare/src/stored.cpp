@@ -10,6 +10,9 @@ StoredVerification to_store(const Verification& v, const std::string& rendering,
       {"against", against},
       {"scale", options.scale ? nlohmann::json(*options.scale) : nlohmann::json(nullptr)},
       {"k", options.k},
+      // Whether the rendering's own noise was budgeted, and over how many regions it was pooled (null when off).
+      {"rendering_noise", options.rendering_noise},
+      {"noise_neighbours", options.rendering_noise ? nlohmann::json(options.noise_neighbours) : nlohmann::json(nullptr)},
   };
   if (!placement.is_null()) s.params["placement"] = placement;
   const auto full = v.to_json();

@@ -1,7 +1,9 @@
 #include "colorlab/verify/compare/stored_request.hpp"
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <string>
 
 #include "colorlab/core/error.hpp"
 
@@ -124,13 +126,38 @@ StoredVerification stored_from_request(const json& body) {
     if (!(*options.scale > 0)) throw bad("body.scale must be positive (renderer unit -> cd/m²) or null (fitted)");
   }
   if (body.contains("k")) options.k = num(body, "k", "body");
+  // Absent (a client from before they were sent): the only way a verification was made then, on over 8 regions.
+  if (body.contains("rendering_noise") && !body["rendering_noise"].is_null()) {
+    if (!body["rendering_noise"].is_boolean())
+      throw bad("body.rendering_noise is not a boolean (whether the rendering's own noise was in the budget)");
+    options.rendering_noise = body["rendering_noise"].get<bool>();
+  }
+  if (body.contains("noise_neighbours") && !body["noise_neighbours"].is_null()) {
+    const json& n = body["noise_neighbours"];
+    if (!n.is_number_integer()) throw bad("body.noise_neighbours is not a whole number (the regions the rendering's noise was pooled over)");
+    const bool in_range = n.is_number_unsigned() ? n.get<std::uint64_t>() >= 1 &&
+                                                       n.get<std::uint64_t>() <= static_cast<std::uint64_t>(std::numeric_limits<int>::max())
+                                                 : n.get<std::int64_t>() >= 1 && n.get<std::int64_t>() <= std::numeric_limits<int>::max();
+    if (!in_range)
+      throw bad("body.noise_neighbours must be a whole number from 1 to " + std::to_string(std::numeric_limits<int>::max()) +
+                ", got " + n.dump());
+    options.noise_neighbours = static_cast<int>(n.get<std::int64_t>());
+  }
+  check_options(options);
   json placement;
   if (body.contains("placement") && !body["placement"].is_null()) {
     placement = body["placement"];
     if (!placement.is_object()) throw bad("body.placement is not an object");
     if (placement.dump().size() > 4096) throw bad("body.placement is larger than 4 KiB");
   }
-  return to_store(verification_from_json(field(body, "result", "body")), rendering, runs, options, placement);
+  const Verification v = verification_from_json(field(body, "result", "body"));
+  // A verification said to be made without the rendering's noise cannot carry it in a budget.
+  if (!options.rendering_noise)
+    for (std::size_t i = 0; i < v.comparisons.size(); ++i)
+      for (const auto& [source, u] : v.comparisons[i].budget)
+        if (source == "rendering noise")
+          throw bad("comparisons[" + std::to_string(i) + "].budget has \"rendering noise\" while body.rendering_noise is false");
+  return to_store(v, rendering, runs, options, placement);
 }
 
 json store_request(const Verification& v, const std::string& rendering, const std::vector<std::string>& against,
@@ -140,6 +167,8 @@ json store_request(const Verification& v, const std::string& rendering, const st
       {"against", against},
       {"scale", options.scale ? json(*options.scale) : json(nullptr)},
       {"k", options.k},
+      {"rendering_noise", options.rendering_noise},
+      {"noise_neighbours", options.rendering_noise ? json(options.noise_neighbours) : json(nullptr)},
       {"result", v.to_json()},
   };
   if (!placement.is_null()) body["placement"] = placement;

@@ -16,7 +16,7 @@ namespace colorlab::verify {
 inline constexpr const char* kVerifyCampaign = "verify";
 
 struct StoredVerification {
-  nlohmann::json params;                           // {rendering, against: [run ids], scale (null: fitted), k[, placement]}
+  nlohmann::json params;                           // {rendering, against: [run ids], scale (null: fitted), k, rendering_noise, noise_neighbours[, placement]}
   nlohmann::json summary;                          // Verification::summary() plus floor_difference
   std::vector<records::Measurement> measurements;  // step "<kind>/<where>", value = the difference
 };

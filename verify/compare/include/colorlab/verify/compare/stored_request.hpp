@@ -2,6 +2,7 @@
 // POST /v1/verifications' body read back into a stored verification (docs/API.md): the comparison is made where the
 // rendering is (the CLI, the Python client), and the daemon stores its result like a run. The body is
 //   {"rendering": name, "against": [run ids], "scale": number|null, "k": number, "result": Verification::to_json(),
+//    "rendering_noise": bool (optional, default true), "noise_neighbours": integer ≥ 1 | null (optional, default 8),
 //    "placement": {...} (optional: how the light was placed in the rendering, kept in the run's params)}
 // and the summary is recomputed here from the comparisons, so a stored verdict always matches its rows.
 #include <nlohmann/json.hpp>
