@@ -38,6 +38,8 @@ struct VerifyOptions {
   double corner_accuracy_px = 0.5;
   std::string lens;
   std::string lens_calibration;
+  bool no_rendering_noise = false;
+  int noise_neighbours = 8;
   bool json = false;
   bool store = false;
 };
@@ -89,6 +91,8 @@ std::string human(const json& j) {
     for (const auto& [kind, why] : j["not_compared"].items()) out << "  " << kind << " not compared: " << why.get<std::string>() << "\n";
   if (j.contains("placement") && j["placement"].contains("light"))
     out << "  floor placed: " << j["placement"]["light"]["how"].get<std::string>() << "\n";
+  if (j.contains("rendering_noise") && !j["rendering_noise"].get<bool>())
+    out << "  the rendering's own noise: not in the budget (--no-rendering-noise: the renderer states it is exact)\n";
   if (j.contains("stored_run")) out << "  stored as run " << j["stored_run"].get<std::string>() << "\n";
   return out.str();
 }
@@ -169,6 +173,11 @@ json place_light(client::ApiClient& api, const VerifyOptions& o, const std::vect
 }
 
 int verify(const GlobalOptions& global, const VerifyOptions& o) {
+  verify::CompareOptions options;
+  options.scale = o.scale;
+  options.rendering_noise = !o.no_rendering_noise;
+  options.noise_neighbours = o.noise_neighbours;
+  verify::check_options(options);  // before the file and the daemon: a bad option is the first thing said
   // The file first: a rendering that cannot be read is a local error (exit 1) whatever the daemon says.
   const verify::Rendering rendering = verify::read_rendering(o.rendering);
   auto api = make_client(global);
@@ -202,8 +211,6 @@ int verify(const GlobalOptions& global, const VerifyOptions& o) {
 #else
   const auto scene = verify::scene_from_runs(runs, rendering.width, rendering.height, scene_options);
 #endif
-  verify::CompareOptions options;
-  options.scale = o.scale;
   const auto v = verify::compare(rendering, scene, options);
 
   const std::string name = std::filesystem::path(o.rendering).filename().string();
@@ -212,6 +219,8 @@ int verify(const GlobalOptions& global, const VerifyOptions& o) {
   out["against"] = o.against;
   out["lamp"] = scene.lamp;
   out["exit_status"] = verify::exit_status(v);
+  out["rendering_noise"] = options.rendering_noise;
+  out["noise_neighbours"] = options.rendering_noise ? json(options.noise_neighbours) : json(nullptr);
   if (!placement.is_null()) out["placement"] = placement;
 #ifdef COLORLAB_HAVE_VERIFY_COLOUR
   if (!colour.is_null()) out["colour"] = colour;
@@ -260,6 +269,13 @@ void add_verify_command(CLI::App& app, GlobalOptions& global) {
                   "photograph's size, else a pinhole, said in `placement`)");
   cmd->add_option("--lens-calibration", o->lens_calibration,
                   "the stored lens calibration to place the floor through, by name (colorlab lens list), when several fit");
+  cmd->add_flag("--no-rendering-noise", o->no_rendering_noise,
+                "leave the rendering's own Monte-Carlo noise out of the budget: only for a renderer that states its image is "
+                "exact (noise-free); recorded in the result and a stored verification");
+  cmd->add_option("--noise-neighbours", o->noise_neighbours,
+                  "the rendering's noise level is pooled over this many nearest regions of a kind (≥ 1; regions whose "
+                  "residuals are not their neighbours' noise are left out)")
+      ->capture_default_str();
   cmd->add_flag("--json", o->json, "print the whole result: summary, every comparison with its budget, floor_difference");
   cmd->add_flag("--store", o->store, "store the verification on the daemon as a `verify` run (POST /v1/verifications)");
   cmd->callback([&global, o] {

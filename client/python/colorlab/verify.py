@@ -32,7 +32,8 @@ class VerifyFailed(ColorlabError):
 
 class VerifyMixin:
     def verify(self, path: str | os.PathLike, against: Sequence, scale: float | None = None, *, store: bool = False,
-               lamp: str | None = None, dimmer: float | None = None, lens_calibration: str | None = None) -> dict:
+               lamp: str | None = None, dimmer: float | None = None, lens_calibration: str | None = None,
+               rendering_noise: bool = True, noise_neighbours: int | None = None) -> dict:
         """``colorlab verify PATH --against RUN… --json``: the rendering beside the runs' measured scene.
 
         Returns the result document — ``summary`` (``verdict`` "agrees"/"differs", per kind compared/agree/differ,
@@ -41,9 +42,19 @@ class VerifyMixin:
         ``against``, ``placement`` (how the floor was placed: through the lab's lens calibration for the floor
         photograph's size, ``lens_calibration`` naming one among several, or as a pinhole) — plus ``table``: the comparisons as a DataFrame (kind, where,
         difference, expanded, verdict, …). ``scale``: renderer unit → cd/m² (omitted: one factor fitted per kind,
-        which cannot see a uniformly wrong level). Raises ``VerifyFailed`` when no verdict could be made."""
+        which cannot see a uniformly wrong level). ``rendering_noise=False`` leaves the rendering's own Monte-Carlo
+        noise out of the budget (only for a renderer that states its image is exact); ``noise_neighbours``: the
+        regions its level is pooled over (an int ≥ 1; colorlab's default 8); both are in the result and a stored
+        verification's params. Raises ``VerifyFailed`` when no verdict could be made, ``TypeError``/``ValueError``
+        for a ``noise_neighbours`` that is not a whole number ≥ 1."""
         from .report.analyze import colorlab_binary  # the one place that knows where the binary is
 
+        if noise_neighbours is not None:
+            if isinstance(noise_neighbours, bool) or not isinstance(noise_neighbours, int):
+                raise TypeError(f"noise_neighbours must be an int, not {type(noise_neighbours).__name__}")
+            if noise_neighbours < 1:
+                raise ValueError(f"noise_neighbours must be at least 1 (got {noise_neighbours}): the rendering's noise "
+                                 "is pooled over that many nearest regions; rendering_noise=False leaves it out")
         runs = [run_id(r) for r in against]
         if not runs:
             raise ValueError("against: give at least one run (a floor-luminance run, optionally a cabinet-grid run; "
@@ -66,6 +77,10 @@ class VerifyMixin:
             cmd += ["--lamp", str(lamp), "--dimmer", repr(float(dimmer))]
         if lens_calibration is not None:
             cmd += ["--lens-calibration", str(lens_calibration)]
+        if not rendering_noise:
+            cmd.append("--no-rendering-noise")
+        if noise_neighbours is not None:
+            cmd += ["--noise-neighbours", str(noise_neighbours)]
         if store:
             cmd.append("--store")
         try:

@@ -9,6 +9,7 @@
 #include <iostream>
 #include <map>
 #include <stdexcept>
+#include <utility>
 #include <fstream>
 
 #include <gtest/gtest.h>
@@ -238,6 +239,75 @@ void store_makes_a_run_readable_through_the_api() {
   }
 }
 
+// The rendering's own noise, off or pooled over another count: from the CLI into the result and the stored run's
+// params, and through the API's body; a count below 1 and a mistyped field are typed errors (exit 1 / a 400 naming
+// the field).
+void rendering_noise_options_are_recorded_and_checked() {
+  auto api = api_for(*daemon_);
+  auto off = verify_args("faithful.exr");
+  off.insert(off.end(), {"--no-rendering-noise", "--store"});
+  const auto r = cli(off);
+  ASSERT_TRUE(r.exit_code == 0 || r.exit_code == 4) << r.err;
+  const json result = json::parse(r.out);
+  EXPECT_EQ(result["rendering_noise"], false);
+  EXPECT_TRUE(result["noise_neighbours"].is_null());
+  for (const auto& c : result["comparisons"]) EXPECT_FALSE(c["budget"].contains("rendering noise")) << c.dump();
+  const json run = client::fetch_run(api, result.at("stored_run").get<std::string>());
+  EXPECT_EQ(run["params"]["rendering_noise"], false) << run["params"].dump();
+  EXPECT_TRUE(run["params"]["noise_neighbours"].is_null()) << run["params"].dump();
+
+  auto four = verify_args("faithful.exr");
+  four.insert(four.end(), {"--noise-neighbours", "4", "--store"});
+  const auto r4 = cli(four);
+  ASSERT_TRUE(r4.exit_code == 0 || r4.exit_code == 4) << r4.err;
+  const json result4 = json::parse(r4.out);
+  for (const auto& c : result4["comparisons"]) EXPECT_TRUE(c["budget"].contains("rendering noise")) << c.dump();
+  const json run4 = client::fetch_run(api, result4.at("stored_run").get<std::string>());
+  EXPECT_EQ(run4["params"]["rendering_noise"], true) << run4["params"].dump();
+  EXPECT_EQ(run4["params"]["noise_neighbours"], 4) << run4["params"].dump();
+
+  for (const char* n : {"0", "-2"}) {
+    auto bad = verify_args("faithful.exr");
+    bad.insert(bad.end(), {"--noise-neighbours", n});
+    const auto rb = cli(bad);
+    EXPECT_EQ(rb.exit_code, 1) << n << ": " << rb.err;
+    EXPECT_NE(rb.err.find("noise_neighbours must be at least 1"), std::string::npos) << rb.err;
+    EXPECT_TRUE(rb.out.empty()) << rb.out;
+  }
+
+  // The API: a body with the options is stored with them; a bad value is a 400 naming the field.
+  json body = {{"rendering", "x.exr"}, {"against", {*grid_}}, {"scale", 1}, {"k", 2}, {"result", result}, {"rendering_noise", false}};
+  const json stored = api.post("/v1/verifications", body);
+  const json run_api = client::fetch_run(api, stored.at("run_id").get<std::string>());
+  EXPECT_EQ(run_api["params"]["rendering_noise"], false) << run_api["params"].dump();
+  EXPECT_TRUE(run_api["params"]["noise_neighbours"].is_null()) << run_api["params"].dump();
+  body["rendering_noise"] = true;
+  body["noise_neighbours"] = 12;
+  const json run12 = client::fetch_run(api, api.post("/v1/verifications", body).at("run_id").get<std::string>());
+  EXPECT_EQ(run12["params"]["noise_neighbours"], 12) << run12["params"].dump();
+  const std::pair<json, std::string> bad_bodies[] = {
+      {{{"rendering_noise", "no"}}, "body.rendering_noise"},
+      {{{"noise_neighbours", 0}}, "body.noise_neighbours"},
+      {{{"noise_neighbours", -1}}, "body.noise_neighbours"},
+      {{{"noise_neighbours", 2.5}}, "body.noise_neighbours"},
+      {{{"noise_neighbours", "8"}}, "body.noise_neighbours"},
+      // Said to be made without the rendering's noise, while its budgets carry it.
+      {{{"rendering_noise", false}, {"result", result4}}, "rendering_noise is false"},
+  };
+  for (const auto& [patch, names] : bad_bodies) {
+    json b = body;
+    b.erase("noise_neighbours");
+    b.update(patch);
+    try {
+      api.post("/v1/verifications", b);
+      ADD_FAILURE() << "stored: " << patch.dump();
+    } catch (const client::ApiError& e) {
+      EXPECT_EQ(e.problem().status, 400) << patch.dump();
+      EXPECT_NE(e.problem().detail.find(names), std::string::npos) << e.problem().detail;
+    }
+  }
+}
+
 }  // namespace
 
 // One daemon and one pair of campaigns for every check (ctest runs each TEST in its own process): the campaigns are
@@ -268,6 +338,10 @@ TEST(VerifyCli, EndToEndAgainstTheSimulatedLab) {
   {
     SCOPED_TRACE("--store");
     store_makes_a_run_readable_through_the_api();
+  }
+  {
+    SCOPED_TRACE("the rendering's noise options");
+    rendering_noise_options_are_recorded_and_checked();
   }
   Lab::stop();
 }

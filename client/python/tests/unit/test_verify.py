@@ -69,6 +69,23 @@ class VerifyTest(unittest.TestCase):
         lab.verify("box.exr", against=["a1"], lens_calibration="EOS 20D / EF 50mm")
         self.assertEqual(self.called()["argv"][-2:], ["--lens-calibration", "EOS 20D / EF 50mm"])
 
+    def test_the_rendering_noise_options_passed_on(self):
+        self.fake(0, json.dumps({**RESULT, "exit_status": 0}))
+        lab = colorlab.Client(socket="/s")
+        lab.verify("box.exr", against=["a1"])
+        self.assertNotIn("--no-rendering-noise", self.called()["argv"])
+        self.assertNotIn("--noise-neighbours", self.called()["argv"])
+        lab.verify("box.exr", against=["a1"], rendering_noise=False, store=True)
+        self.assertEqual(self.called()["argv"][-2:], ["--no-rendering-noise", "--store"])
+        lab.verify("box.exr", against=["a1"], noise_neighbours=4)
+        self.assertEqual(self.called()["argv"][-2:], ["--noise-neighbours", "4"])
+        # Not a whole number >= 1: refused here, before colorlab is run (the binary records its argv when it is).
+        self.args.unlink()
+        for bad, error in ((0, ValueError), (-3, ValueError), (2.5, TypeError), ("8", TypeError), (True, TypeError)):
+            with self.assertRaises(error):
+                lab.verify("box.exr", against=["a1"], noise_neighbours=bad)
+        self.assertFalse(self.args.exists())
+
     def test_no_verdict_raises_with_colorlabs_message(self):
         for code, err in ((1, "colorlab: bad.exr: not an image\n  hint: …\n"), (2, "colorlab: 404 Not Found: no run 'x'\n")):
             self.fake(code, "", err)
