@@ -142,6 +142,44 @@ TEST(VerifyCalibration, TheRenderingsOwnNoiseAlone) {
   EXPECT_LE(coverage(k), 0.97);
 }
 
+TEST(VerifyCalibration, TheChartReadsOwnNoiseIsInsideTheHeldOutErrors) {
+  // The renderer is given the chart-read's spectra, one reading per patch with the instrument's noise (here a 3 %
+  // gain per patch and 1 % per band, larger than a Spectrolino's so that it matters beside the mapping's own error),
+  // while the camera photographed the true chart. The colour half from runs has no source for that noise: the
+  // characterization and the black box are fitted against the same chart-read, so their held-out errors carry its
+  // variance (docs/verify.md "Not yet done"). 200 draws, every source, colour only: with the mappings fitted against
+  // the read spectra the truth must be inside the k = 2 band 93–97 % (issue 23); fitted against the true spectra (a
+  // budget without the reading noise, the same rendering) it must fall below 93 % — the noise is large enough here
+  // that leaving it out shows, so the first bound is a statement about the budget, not about a negligible source.
+  auto run_read = [](bool read_is_reference, std::uint64_t seed0) {
+    Sources s;
+    s.read_gain_sd = 0.03;
+    s.read_band_sd = 0.01;
+    s.read_is_reference = read_is_reference;
+    CompareOptions o;
+    o.scale = 1.0;
+    Tally t;
+    for (int d = 0; d < kDraws; ++d) {
+      std::mt19937_64 rng(seed0 + static_cast<std::uint64_t>(d));
+      Eigen::MatrixXd read;
+      MeasuredScene m = lab().measure(rng, s, &read);
+      m.spots.clear();
+      m.floor.clear();
+      t.add(compare(lab().render({}, &read), m, o), [](const Comparison&) { return false; });
+    }
+    return t.elsewhere;
+  };
+  const auto with = run_read(true, 70000), without = run_read(false, 70000);
+  for (const char* kind : {"colour_7_3", "colour_7_4"}) {
+    std::printf("chart-read noise (3 %% gain, 1 %% per band), %s: truth inside the band in %6.2f %% with the mapping fitted to the "
+                "read spectra, %6.2f %% fitted to the true ones\n",
+                kind, 100 * coverage(with.at(kind)), 100 * coverage(without.at(kind)));
+    EXPECT_GE(coverage(with.at(kind)), 0.93) << kind;
+    EXPECT_LE(coverage(with.at(kind)), 0.97) << kind;
+    EXPECT_LT(coverage(without.at(kind)), 0.93) << kind;
+  }
+}
+
 TEST(VerifyCalibration, CharacterizationsModelErrorAlone) {
   // No noise at all: the only difference left is the fitted mappings' own error (the camera is not a colorimeter,
   // the black box is smooth), judged against their cross-validated errors in the patch's region. It is the same

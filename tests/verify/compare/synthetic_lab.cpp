@@ -126,7 +126,7 @@ double SyntheticLab::floor_mean(const PixelRect& g, double dx, double dy) const 
   return s / (g.w * g.h);
 }
 
-Rendering SyntheticLab::render(const Defects& d) const {
+Rendering SyntheticLab::render(const Defects& d, const Eigen::MatrixXd* reflectances) const {
   Rendering r;
   r.width = width_;
   r.height = height_;
@@ -155,7 +155,7 @@ Rendering SyntheticLab::render(const Defects& d) const {
     }
   for (int i = 0; i < kPatches; ++i) {
     const int row = i / 14, col = i % 14;
-    Eigen::RowVectorXd rho = refl_.row(i);
+    Eigen::RowVectorXd rho = reflectances ? reflectances->row(i) : refl_.row(i);
     if (i == d.patch) rho *= d.patch_factor;
     const Eigen::RowVectorXd rad = rho.cwiseProduct(lamp);
     for (int y = 10 + 10 * row; y < 18 + 10 * row; ++y)
@@ -188,9 +188,18 @@ std::vector<double> SyntheticLab::true_de00(const Defects& d) const {
   return out;
 }
 
-MeasuredScene SyntheticLab::measure(std::mt19937_64& rng, const Sources& s) const {
+MeasuredScene SyntheticLab::measure(std::mt19937_64& rng, const Sources& s, Eigen::MatrixXd* read) const {
   std::normal_distribution<double> N(0, 1);
   std::uniform_real_distribution<double> U(-1, 1);
+  // The chart-read first, and only when it has noise: the other draws stay what they were without it.
+  Eigen::MatrixXd spectra = refl_;
+  if (s.read_gain_sd > 0 || s.read_band_sd > 0)
+    for (Eigen::Index i = 0; i < spectra.rows(); ++i) {
+      const double gain = 1 + s.read_gain_sd * N(rng);
+      for (Eigen::Index j = 0; j < spectra.cols(); ++j) spectra(i, j) *= gain * (1 + s.read_band_sd * N(rng));
+    }
+  if (read) *read = spectra;
+  const Eigen::MatrixXd& reference = s.read_is_reference ? spectra : refl_;
   MeasuredScene m;
   m.lamp = "CWF";
   m.runs = {"synthetic"};
@@ -205,7 +214,7 @@ MeasuredScene SyntheticLab::measure(std::mt19937_64& rng, const Sources& s) cons
   for (int i = 0; i < kPatches; ++i) {
     const Eigen::RowVectorXd rad = refl_.row(i).cwiseProduct(lamp_);
     truth_counts.row(i) = (camera_ * rad.transpose()).transpose();
-    truth_xyz.row(i) = (cmf_ * rad.transpose()).transpose() * (100.0 / white_.Y);
+    truth_xyz.row(i) = (cmf_ * reference.row(i).cwiseProduct(lamp_).transpose()).transpose() * (100.0 / white_.Y);
     for (int c = 0; c < 3; ++c) train(i, c) = truth_counts(i, c) + counts_sd(truth_counts(i, c)) * N(rng);
   }
   const double eps = drift();
@@ -252,7 +261,7 @@ MeasuredScene SyntheticLab::measure(std::mt19937_64& rng, const Sources& s) cons
     for (Eigen::Index j = 0; j < n; ++j)
       for (int k = 0; k < kBasis; ++k) basis(j, k) = gauss(wl_[static_cast<std::size_t>(j)], 400 + 20 * k, 15);
     Eigen::MatrixXd A(kPatches, kBasis);
-    for (int i = 0; i < kPatches; ++i) A.row(i) = refl_.row(i).cwiseProduct(lamp_) * kStep * basis;
+    for (int i = 0; i < kPatches; ++i) A.row(i) = reference.row(i).cwiseProduct(lamp_) * kStep * basis;
     const Eigen::MatrixXd G = (A.transpose() * A + 1e-6 * (A.transpose() * A).trace() / kBasis *
                                                        Eigen::MatrixXd::Identity(kBasis, kBasis))
                                   .inverse();

@@ -22,6 +22,13 @@ struct Sources {  // which noises the draw makes (and the engine is told of)
   bool misregistration = true;
   bool floor_map = true;
   bool characterization = true;  // false: §7.3/§7.4 mappings are exact (the true curves)
+  // The chart-read's own reading noise (the Spectrolino's): each patch's spectrum read × (1 + gain) per patch and
+  // × (1 + band) per band, both normal with these relative σ. The read spectra are what a renderer is given (measure's
+  // `read`) and, with `read_is_reference`, what the characterization and the black box are fitted against, as the
+  // colour half from runs does; false: fitted against the true spectra (a budget that lacks the reading noise).
+  double read_gain_sd = 0;
+  double read_band_sd = 0;
+  bool read_is_reference = true;
 };
 
 // A Monte-Carlo renderer's own noise on a rendering: each pixel's spectrum × (1 + sd · n), n standard normal and the
@@ -49,9 +56,10 @@ class SyntheticLab {
 
   // The spectral rendering a renderer that gets the physics right (or with the planted defects) produces, in
   // W·m⁻²·sr⁻¹·nm⁻¹: with the given scale 1 its luminance is in cd/m².
-  Rendering render(const Defects& d = {}) const;
-  // One draw of the whole measurement of the (faithful) scene.
-  MeasuredScene measure(std::mt19937_64& rng, const Sources& s) const;
+  // `reflectances` (patches × bands): the chart's patches rendered with these instead of the true ones.
+  Rendering render(const Defects& d = {}, const Eigen::MatrixXd* reflectances = nullptr) const;
+  // One draw of the whole measurement of the (faithful) scene; `read`, when given, gets the chart-read's spectra.
+  MeasuredScene measure(std::mt19937_64& rng, const Sources& s, Eigen::MatrixXd* read = nullptr) const;
   // The reflectance factor that puts `patch` `de00` away from itself under the lamp.
   double factor_for_de00(int patch, double de00) const;
   // ΔE00 between the faithful and the defective rendering of each patch (the defect's true size, §7.3's way).
