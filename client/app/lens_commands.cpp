@@ -121,7 +121,7 @@ void add_lens_commands(CLI::App& app, GlobalOptions& global) {
   from_run->add_option("RUN", *run, "the lens-calibration run's id")->required();
   from_run->callback([&global, run] {
     check_id(*run, "a run id", "colorlab runs lists them");
-    const json r = json::parse(fetch_bytes(global, "/v1/runs/" + *run).body);
+    const json r = make_client(global).get("/v1/runs/" + *run);
     const std::string campaign = r.value("campaign", std::string());
     const json* lens = nullptr;
     if (r.contains("summary") && r["summary"].is_object() && r["summary"].contains("script") && r["summary"]["script"].is_object() &&
@@ -145,7 +145,7 @@ void add_lens_commands(CLI::App& app, GlobalOptions& global) {
     if (!lab->empty()) {
       for (const auto& l : verify::lenses_from_file(*lab)) items.push_back(verify::lens_to_json(l));
     } else {
-      const json answer = json::parse(fetch_bytes(global, "/v1/lab/lenses").body);
+      const json answer = make_client(global).get("/v1/lab/lenses");  // a body that is not JSON: Error, not a crash
       if (!answer.is_object() || !answer.contains("items") || !answer["items"].is_array())
         throw Error(ErrorClass::bad_data, "GET /v1/lab/lenses: no items in the daemon's answer");
       for (const auto& i : answer["items"]) items.push_back(verify::lens_to_json(verify::lens_from_json(i, "GET /v1/lab/lenses")));

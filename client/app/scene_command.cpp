@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "client_support.hpp"
+#include "daemon_lenses.hpp"
 #include "lens_option.hpp"
 #include "colorlab/core/error.hpp"
 #include "colorlab/verify/cabinet_json.hpp"
@@ -50,8 +51,7 @@ json load_run(const GlobalOptions& g, const std::string& run) {
     }
   }
   check_id(run, "a run id or a run's JSON export file", "colorlab runs lists them");
-  const auto r = fetch_bytes(g, "/v1/runs/" + run + "/export?format=json");
-  return json::parse(r.body);
+  return make_client(g).get("/v1/runs/" + run + "/export?format=json");  // a body that is not JSON: Error, not a crash
 }
 
 bool is_file(const std::string& run) {
@@ -64,7 +64,7 @@ bool is_file(const std::string& run) {
 std::pair<verify::CabinetGeometry, std::string> choose_cabinet(const GlobalOptions& g, const SceneOptions& o) {
   if (!o.lab.empty()) return {verify::cabinet_from_file(o.lab), "lab file " + o.lab};
   if (std::all_of(o.runs.begin(), o.runs.end(), is_file)) return {verify::default_cabinet(), "built-in"};
-  const json answer = json::parse(fetch_bytes(g, "/v1/lab/cabinet").body);
+  const json answer = make_client(g).get("/v1/lab/cabinet");
   if (!answer.is_object() || !answer.contains("cabinet"))
     throw Error(ErrorClass::bad_data, "GET /v1/lab/cabinet: no cabinet in the daemon's answer", "give the cabinet with --lab FILE");
   return {verify::cabinet_from_json(answer["cabinet"], "GET /v1/lab/cabinet"),
@@ -72,16 +72,17 @@ std::pair<verify::CabinetGeometry, std::string> choose_cabinet(const GlobalOptio
 }
 
 // The lab's stored lens calibrations, from where the cabinet comes from: --lab's [[lens]]; the daemon's
-// (GET /v1/lab/lenses) when the runs come from it; none for run files alone.
+// (GET /v1/lab/lenses) when the runs come from it; none for run files alone, or from a daemon that serves none
+// (said so; naming one with --lens-calibration there is refused).
 std::pair<std::vector<verify::LensCalibration>, std::string> lab_lenses(const GlobalOptions& g, const SceneOptions& o) {
   if (!o.lab.empty()) return {verify::lenses_from_file(o.lab), "lab file " + o.lab};
   if (std::all_of(o.runs.begin(), o.runs.end(), is_file)) return {{}, "none (run files only)"};
-  const json answer = json::parse(fetch_bytes(g, "/v1/lab/lenses").body);
-  if (!answer.is_object() || !answer.contains("items") || !answer["items"].is_array())
-    throw Error(ErrorClass::bad_data, "GET /v1/lab/lenses: no items in the daemon's answer", "give the lens with --lens");
-  std::vector<verify::LensCalibration> out;
-  for (const auto& i : answer["items"]) out.push_back(verify::lens_from_json(i, "GET /v1/lab/lenses"));
-  return {out, "daemon"};
+  auto served = daemon_lenses(make_client(g));
+  if (served) return {std::move(*served), "daemon"};
+  if (!o.lens_calibration.empty())
+    throw Error(ErrorClass::not_found, "--lens-calibration \"" + o.lens_calibration + "\": " + kNoLensRoute,
+                "give the lens with --lens fx,fy,cx,cy,k1,k2, or the lab file holding it with --lab FILE");
+  return {{}, std::string("none (") + kNoLensRoute + ")"};
 }
 
 }  // namespace

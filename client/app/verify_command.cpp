@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "client_support.hpp"
+#include "daemon_lenses.hpp"
 #include "lens_option.hpp"
 #include "colorlab/client/runs.hpp"
 #include "colorlab/core/error.hpp"
@@ -113,7 +114,8 @@ std::optional<std::pair<int, int>> floor_photograph_size(const std::vector<json>
 
 // Where the light half's floor lies in the rendering: through the lens the floor was photographed with — --lens, or
 // the lab's stored calibration (GET /v1/lab/lenses) for the photograph's size — else as a pinhole, and said which
-// (`placement.light`, also stored). Nothing to place without a floor-luminance run: null.
+// (`placement.light`, also stored), as when the daemon serves no calibrations at all (a 404: daemon_lenses.hpp).
+// Nothing to place without a floor-luminance run: null.
 json place_light(client::ApiClient& api, const VerifyOptions& o, const std::vector<json>& runs, verify::RunsSceneOptions& so) {
   const auto size = floor_photograph_size(runs);
   if (!size) {
@@ -126,13 +128,15 @@ json place_light(client::ApiClient& api, const VerifyOptions& o, const std::vect
   const std::string frame = std::to_string(w) + " × " + std::to_string(h);
   std::optional<verify::CameraIntrinsics> k = parse_lens(o.lens);
   std::string name = k ? "given with --lens" : "", described = k ? "lens given with --lens" : "";
+  std::optional<std::vector<verify::LensCalibration>> lenses;
   if (!k) {
-    const json answer = api.get("/v1/lab/lenses");
-    if (!answer.is_object() || !answer.contains("items") || !answer["items"].is_array())
-      throw Error(ErrorClass::bad_data, "GET /v1/lab/lenses: no items in the daemon's answer", "give the lens with --lens");
-    std::vector<verify::LensCalibration> lenses;
-    for (const auto& i : answer["items"]) lenses.push_back(verify::lens_from_json(i, "GET /v1/lab/lenses"));
-    if (const auto l = verify::choose_lens(lenses, o.lens_calibration, w, h)) {
+    lenses = daemon_lenses(api);
+    if (!lenses && !o.lens_calibration.empty())
+      throw Error(ErrorClass::not_found, "--lens-calibration \"" + o.lens_calibration + "\": " + kNoLensRoute,
+                  "give the lens's numbers with --lens fx,fy,cx,cy,k1,k2 (colorlab lens list --lab FILE shows a lab file's)");
+  }
+  if (lenses) {
+    if (const auto l = verify::choose_lens(*lenses, o.lens_calibration, w, h)) {
       if (l->width_px != w || l->height_px != h)
         throw Error(ErrorClass::bad_parameter,
                     "lens calibration \"" + l->name() + "\" holds for " + std::to_string(l->width_px) + " × " + std::to_string(l->height_px) +
@@ -144,9 +148,9 @@ json place_light(client::ApiClient& api, const VerifyOptions& o, const std::vect
     }
   }
   if (!k) {
-    const std::string why = "no lens calibration for " + frame +
-                            " photographs (GET /v1/lab/lenses): the floor photograph's corners taken as a pinhole camera's; "
-                            "a distorted lens misplaces spots towards the frame's edges";
+    const std::string none = lenses ? "no lens calibration for " + frame + " photographs (GET /v1/lab/lenses)" : std::string(kNoLensRoute);
+    const std::string why = none + ": the floor photograph's corners taken as a pinhole camera's; "
+                                   "a distorted lens misplaces spots towards the frame's edges";
     return {{"light", {
                           {"model", "pinhole"},
                           {"lens", nullptr},

@@ -37,12 +37,13 @@ std::shared_ptr<campaigns::CampaignScript> script_from(const std::string& name, 
 }
 
 EngineRun run_script(campaigns::ScriptRunSetup setup, MemorySink& sink, campaigns::ExecutionControl& control,
-                     double time_scale) {
+                     double time_scale, campaigns::OperatorHands* hands) {
   boost::asio::io_context io;
   campaigns::InstrumentSet none;
   campaigns::LabOptions options;
   options.time_scale = time_scale;
   campaigns::Lab lab(io.get_executor(), none, options);
+  lab.set_operator(nullptr, hands);
   auto future = boost::asio::co_spawn(io, campaigns::run_campaign_script(std::move(setup), lab, sink, control),
                                       boost::asio::use_future);
   io.run();

@@ -35,8 +35,8 @@ struct EngineRun {
   bool crashed = false;
 };
 
-// Runs to an outcome (or a CrashNow) on a fresh io_context.
+// Runs to an outcome (or a CrashNow) on a fresh io_context; `hands` do the operator actions they can.
 EngineRun run_script(campaigns::ScriptRunSetup setup, MemorySink& sink, campaigns::ExecutionControl& control,
-                     double time_scale = 1000);
+                     double time_scale = 1000, campaigns::OperatorHands* hands = nullptr);
 
 }  // namespace colorlab::testing

@@ -73,6 +73,8 @@ class ScriptRun final : public LabCallSink {
     } catch (const Error& e) {
       failed_outside_script(e);
     }
+    // Whatever the outcome: a script's own "put it back" step is not reached when it fails or stops mid-way.
+    co_await lab_.put_back(state_);
     co_return outcome_;
   }
 

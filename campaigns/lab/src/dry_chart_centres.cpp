@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 
+#include "colorlab/analysis/chart_attitude.hpp"
 #include "colorlab/analysis/chart_layout.hpp"
 
 namespace colorlab::campaigns::detail {
@@ -15,19 +15,11 @@ json dry_chart_centres(const json& placement, const std::string& chart) {
   const auto number = [&](const char* key, double fallback) {
     return placement.is_object() && placement.contains(key) && placement[key].is_number() ? placement[key].get<double>() : fallback;
   };
-  const double deg = std::numbers::pi / 180;
-  // Negated as the simulator's chart_pose.cpp does: a positive tilt leans the top edge away, a positive swing the right
-  // edge (camera coordinates: y down, z along the view).
-  const double rz = number("rotation_deg", 0) * deg, rx = -number("tilt_deg", 0) * deg, ry = -number("swing_deg", 0) * deg;
+  // The simulator's convention, from the one function both use (chart_attitude.hpp): the dry run's poses lean the
+  // way the simulated lab's hands will lean them.
+  const Eigen::Matrix3d R =
+      analysis::chart_attitude_rotation(number("rotation_deg", 0), number("tilt_deg", 0), number("swing_deg", 0));
   const double fill = std::clamp(number("fill", 0.8), 0.05, 1.0);
-  // R = Rz · Rx(−tilt) · Ry(−swing), as the simulator poses its chart (rotation in the image plane, tilt, swing).
-  const double cz = std::cos(rz), sz = std::sin(rz), cx = std::cos(rx), sx = std::sin(rx), cy = std::cos(ry), sy = std::sin(ry);
-  const double Rzx[3][3] = {{cz, -sz * cx, sz * sx}, {sz, cz * cx, -cz * sx}, {0, sx, cx}};
-  const double Ry[3][3] = {{cy, 0, sy}, {0, 1, 0}, {-sy, 0, cy}};
-  double R[3][3] = {};
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j)
-      for (int k = 0; k < 3; ++k) R[i][j] += Rzx[i][k] * Ry[k][j];
   // A 50 mm lens on a 22.5 mm wide sensor; the chart's distance (in its grid units) makes it fill `fill` of the height.
   const double f = kDryPhotoWidth * 50.0 / 22.5, W = layout.grid_width(), H = layout.grid_height();
   const double distance = f * H / (fill * kDryPhotoHeight);
@@ -36,7 +28,7 @@ json dry_chart_centres(const json& placement, const std::string& chart) {
   for (int k = 0; k < layout.size(); ++k) {
     const double X = layout.centre_x(k) - W / 2, Y = layout.centre_y(k) - H / 2;
     double c[3];
-    for (int i = 0; i < 3; ++i) c[i] = R[i][0] * X + R[i][1] * Y + t[i];
+    for (int i = 0; i < 3; ++i) c[i] = R(i, 0) * X + R(i, 1) * Y + t[i];
     observed.push_back({{"id", layout.ids[static_cast<std::size_t>(k)]},
                         {"x", f * c[0] / c[2] + (kDryPhotoWidth - 1) / 2.0},
                         {"y", f * c[1] / c[2] + (kDryPhotoHeight - 1) / 2.0}});

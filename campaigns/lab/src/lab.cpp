@@ -595,6 +595,22 @@ asio::awaitable<json> Lab::restore(const LabState& desired, const ExecutionContr
   co_return done;
 }
 
+asio::awaitable<json> Lab::put_back(const LabState& state) {
+  json done = json::array();
+  if (!hands_) co_return done;
+  for (const auto& [action, details] : state.done_by_hands) {
+    try {
+      if (auto undone = co_await hands_->put_back(action, details)) {
+        log::info("lab", "put back after the run: " + action + " " + undone->dump());
+        done.push_back(json{{"operator_action", action}, {"put_back", *undone}});
+      }
+    } catch (const std::exception& e) {  // a run's outcome is its own: what the hands could not undo is only said
+      log::warning("lab", "cannot put back what " + action + " moved: " + e.what());
+    }
+  }
+  co_return done;
+}
+
 asio::awaitable<void> Lab::safe_state() {
   for (const auto& i : instruments_.all()) {
     if (i->state() == drivers::InstrumentState::disconnected) continue;

@@ -105,4 +105,22 @@ asio::awaitable<std::optional<json>> SimulatorHands::perform(const std::string& 
   co_return std::nullopt;
 }
 
+asio::awaitable<std::optional<json>> SimulatorHands::put_back(const std::string& action, const json& details) {
+  // As perform read them: a pose of "measurement" is the chart's measuring place; a view is a string.
+  const bool object = details.is_object();
+  const std::string pose = object && details.contains("pose") ? details["pose"].dump() : std::string();
+  const std::string view = object && details.contains("view") && details["view"].is_string() ? details["view"].get<std::string>() : std::string();
+  if (action == "place_chart" && pose != "\"measurement\"") {
+    json cmd{{"cmd", "place_chart"}, {"placement", "configured"}};
+    co_await command(cmd);
+    co_return json{{"chart_placed", "configured"}};
+  }
+  if (action == "aim_camera" && view == "floor") {
+    json cmd{{"cmd", "camera_view"}, {"view", "chart"}};
+    co_await command(cmd);
+    co_return json{{"camera_view", "chart"}};
+  }
+  co_return std::nullopt;
+}
+
 }  // namespace colorlab::daemon

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <random>
 
+#include "colorlab/analysis/chart_attitude.hpp"
 #include "colorlab/core/error.hpp"
 
 namespace colorlab::sim::camera {
@@ -26,20 +27,6 @@ ChartPose random_chart_pose(std::uint64_t seed) {
 
 namespace detail {
 
-namespace {
-
-Eigen::Matrix3d rotation(const ChartPose& pose) {
-  // Camera coordinates: x right, y down, z along the view. A rotation of −tilt about x takes the board's top edge
-  // (y < 0) to larger z, away from the camera; −swing about y takes its right edge (x > 0) away likewise.
-  const double deg = M_PI / 180;
-  return (Eigen::AngleAxisd(pose.rotation_deg * deg, Eigen::Vector3d::UnitZ()) *
-          Eigen::AngleAxisd(-pose.tilt_deg * deg, Eigen::Vector3d::UnitX()) *
-          Eigen::AngleAxisd(-pose.swing_deg * deg, Eigen::Vector3d::UnitY()))
-      .toRotationMatrix();
-}
-
-}  // namespace
-
 PoseGeometry::PoseGeometry(const ChartPose& pose, int width, int height, double fraction) {
   if (!(pose.distance_mm > chart_width_mm))
     throw Error(ErrorClass::bad_parameter, "chart pose distance must exceed the chart's width (" + std::to_string(chart_width_mm) + " mm)");
@@ -49,7 +36,7 @@ PoseGeometry::PoseGeometry(const ChartPose& pose, int width, int height, double 
     throw Error(ErrorClass::bad_parameter, "chart pose fy_over_fx must be within (0.5, 2)");
   if (std::abs(pose.principal_dx_px) > width / 4.0 || std::abs(pose.principal_dy_px) > height / 4.0)
     throw Error(ErrorClass::bad_parameter, "chart pose principal point must stay within a quarter frame of the centre");
-  const Eigen::Matrix3d R = rotation(pose);
+  const Eigen::Matrix3d R = analysis::chart_attitude_rotation(pose.rotation_deg, pose.tilt_deg, pose.swing_deg);
   f_ = fraction * height * pose.distance_mm / chart_height_mm;
   fy_ = f_ * pose.fy_over_fx;
   cx_ = width / 2.0 + pose.principal_dx_px, cy_ = height / 2.0 + pose.principal_dy_px;

@@ -93,6 +93,9 @@ class Lab {
   boost::asio::awaitable<nlohmann::json> restore(const LabState& desired, const ExecutionControl& control);
   // Table home with the head up; lamps off if configured. Errors are logged, not thrown.
   boost::asio::awaitable<void> safe_state();
+  // A run has ended (in any state): what the lab's hands did for it and left out of the lab's rest is put back
+  // (OperatorHands::put_back, `state`'s done_by_hands). Returns what was done; errors are logged, not thrown.
+  boost::asio::awaitable<nlohmann::json> put_back(const LabState& state);
   // Connects the instruments named in `expected` (id → serial the run started with) and lists those
   // that now report another serial: "id: the run started with serial A, now B".
   boost::asio::awaitable<std::vector<std::string>> serial_mismatches(std::map<std::string, std::string> expected);

@@ -45,6 +45,16 @@ class OperatorHands {
                                                                         const nlohmann::json& details) = 0;
   // Whether perform would do `action` itself (a dry run lists the rest as waits for a person).
   virtual bool can_perform(const std::string& action) const = 0;
+  // Undoes what `action` (done by perform with `details`) left out of the lab's rest, when the run that asked for it
+  // ends in any state — finished, failed, aborted, paused or stopped with the daemon: a script's own last step
+  // ("put the chart back") is not reached when it fails or is aborted mid-way, and the next run would photograph a
+  // chart still posed for a lens calibration. A run that continues redoes the action first (LabState's
+  // done_by_hands). What was done, or nullopt when the action left nothing to put back (the default).
+  virtual boost::asio::awaitable<std::optional<nlohmann::json>> put_back(const std::string& action, const nlohmann::json& details) {
+    (void)action;
+    (void)details;
+    co_return std::nullopt;
+  }
 };
 
 class OperatorDesk {

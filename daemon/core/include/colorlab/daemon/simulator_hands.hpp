@@ -19,6 +19,10 @@ class SimulatorHands final : public campaigns::OperatorHands {
   }
   boost::asio::awaitable<std::optional<nlohmann::json>> perform(const std::string& action,
                                                                 const nlohmann::json& details) override;
+  // The chart back at its configured place after a place_chart pose, the cameras back at the chart after an
+  // aim_camera at the floor; nothing for what leaves the lab at rest.
+  boost::asio::awaitable<std::optional<nlohmann::json>> put_back(const std::string& action,
+                                                                 const nlohmann::json& details) override;
 
  private:
   // One line of JSON out, one back; Error{no_comms|timeout|device_error} otherwise.
