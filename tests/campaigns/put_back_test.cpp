@@ -122,5 +122,20 @@ TEST(PutBack, AHandThatCannotPutBackLeavesTheRunsOwnOutcome) {
   EXPECT_EQ(stand.asked.size(), 1u);
 }
 
+// A failure that is not colorlab's own (a library's exception out of a commit) is the execution's to record, but
+// the stand is put back before it leaves the engine; a deliberate crash (the harness's CrashNow) is not.
+TEST(PutBack, AForeignExceptionStillPutsBackAndLeavesTheEngine) {
+  ChartStand stand;
+  MemorySink sink;
+  ExecutionControl control;
+  sink.on_commit = [&](std::size_t n) {
+    if (n == 1) throw std::runtime_error("a library's own exception");
+  };
+  EXPECT_THROW(run_script(setup("back"), sink, control, 1000, &stand), std::runtime_error);
+  EXPECT_EQ(stand.at, "rest");
+  ASSERT_EQ(stand.asked.size(), 1u);
+  EXPECT_NE(stand.asked[0].find("\"pose\":1"), std::string::npos) << stand.asked[0];
+}
+
 }  // namespace
 }  // namespace colorlab::campaigns

@@ -1,6 +1,7 @@
 #include "colorlab/campaigns/engine.hpp"
 
 #include <chrono>
+#include <exception>
 #include <functional>
 #include <memory>
 #include <regex>
@@ -50,6 +51,7 @@ class ScriptRun final : public LabCallSink {
         progress_(setup.initial_progress) {}
 
   asio::awaitable<RunOutcome> run() {
+    std::exception_ptr unexpected;
     try {
       start_script();
       int nargs = 1;
@@ -72,9 +74,14 @@ class ScriptRun final : public LabCallSink {
       }
     } catch (const Error& e) {
       failed_outside_script(e);
+    } catch (const std::exception&) {
+      // Not ours to classify (the execution records it as an internal failure), but the chart is still put back
+      // first; a deliberate crash (not a std::exception) is left as it is, like the process it stands for.
+      unexpected = std::current_exception();
     }
     // Whatever the outcome: a script's own "put it back" step is not reached when it fails or stops mid-way.
     co_await lab_.put_back(state_);
+    if (unexpected) std::rethrow_exception(unexpected);
     co_return outcome_;
   }
 

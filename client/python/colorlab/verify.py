@@ -46,15 +46,19 @@ class VerifyMixin:
         noise out of the budget (only for a renderer that states its image is exact); ``noise_neighbours``: the
         regions its level is pooled over (an int ≥ 1; colorlab's default 8); both are in the result and a stored
         verification's params. Raises ``VerifyFailed`` when no verdict could be made, ``TypeError``/``ValueError``
-        for a ``noise_neighbours`` that is not a whole number ≥ 1."""
+        for a ``rendering_noise`` that is not a bool or a ``noise_neighbours`` that is not a whole number ≥ 1."""
         from .report.analyze import colorlab_binary  # the one place that knows where the binary is
 
+        if not isinstance(rendering_noise, bool):  # None or 0 would silently narrow every band, "false" keep it
+            raise TypeError(f"rendering_noise must be True or False, not {type(rendering_noise).__name__}")
         if noise_neighbours is not None:
             if isinstance(noise_neighbours, bool) or not isinstance(noise_neighbours, int):
                 raise TypeError(f"noise_neighbours must be an int, not {type(noise_neighbours).__name__}")
             if noise_neighbours < 1:
                 raise ValueError(f"noise_neighbours must be at least 1 (got {noise_neighbours}): the rendering's noise "
                                  "is pooled over that many nearest regions; rendering_noise=False leaves it out")
+            if noise_neighbours > 2**31 - 1:  # the CLI's int: beyond it colorlab could not parse the option
+                raise ValueError(f"noise_neighbours must be at most {2**31 - 1} (got {noise_neighbours})")
         runs = [run_id(r) for r in against]
         if not runs:
             raise ValueError("against: give at least one run (a floor-luminance run, optionally a cabinet-grid run; "

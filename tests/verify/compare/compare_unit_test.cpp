@@ -218,6 +218,9 @@ TEST(VerifyCompare, TheRenderingNoiseOptionsTravelThroughTheRequestBody) {
       {"noise_neighbours", 2.5},
       {"noise_neighbours", "8"},
       {"noise_neighbours", 1ll << 40},
+      {"noise_neighbours", true},
+      {"k", 0},
+      {"k", -2},
   };
   for (const auto& [field, value] : bad) {
     auto body = store_request(v, "render.exr", {"run-1"}, o);

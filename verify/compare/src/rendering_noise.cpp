@@ -137,6 +137,7 @@ RenderingNoise rendering_noise(const Rendering& r, const std::vector<PixelRect>&
                 "noise_neighbours must be at least 1 (got " + std::to_string(neighbours) + ")",
                 "the rendering's noise level is pooled over that many nearest regions; 8 is the default");
   RenderingNoise out;
+  out.left_out.assign(regions.size(), false);  // per region, as documented, on every return
   if (regions.empty()) return out;
   const auto dim = to.rows();
   const int channels = r.channels();
@@ -232,7 +233,6 @@ RenderingNoise rendering_noise(const Rendering& r, const std::vector<PixelRect>&
       dof[j] = residual_dof(window_of(j), g.w, g.h, lags, rho);
     }
   }
-  out.left_out.assign(regions.size(), false);
   const auto screen_n = static_cast<std::size_t>(std::max(neighbours, kScreenAtLeast));
   for (std::size_t i = 0; i < regions.size(); ++i) {
     if (!has[i]) continue;
@@ -255,6 +255,9 @@ RenderingNoise rendering_noise(const Rendering& r, const std::vector<PixelRect>&
     double median = *mid;
     if (others.size() % 2 == 0) median = 0.5 * (median + *std::max_element(others.begin(), mid));
     const double sigma2 = median / (chi_square_quantile(0.5, v) / v);
+    // Neighbours without noise (an exact or clipped region) say nothing of this one's: judging it by its own few
+    // degrees of freedom would cover too rarely, keeping it in their pool only widens theirs.
+    if (!(sigma2 > 0)) continue;
     out.left_out[i] = level[i] > sigma2 * chi_square_quantile(kScreenP, v) / v;
   }
 

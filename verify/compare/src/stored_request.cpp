@@ -125,7 +125,10 @@ StoredVerification stored_from_request(const json& body) {
     options.scale = num(body, "scale", "body");
     if (!(*options.scale > 0)) throw bad("body.scale must be positive (renderer unit -> cd/m²) or null (fitted)");
   }
-  if (body.contains("k")) options.k = num(body, "k", "body");
+  if (body.contains("k")) {
+    options.k = num(body, "k", "body");
+    if (!(options.k > 0)) throw bad("body.k must be positive (the coverage factor of the bands, 2 for about 95 %)");
+  }
   // Absent (a client from before they were sent): the only way a verification was made then, on over 8 regions.
   if (body.contains("rendering_noise") && !body["rendering_noise"].is_null()) {
     if (!body["rendering_noise"].is_boolean())

@@ -176,6 +176,9 @@ def load(client, run, items_by_kind) -> dict:
     against = [str(a) for a in params.get("against") or []]
     light = (params.get("placement") or {}).get("light") or {}
     stored_lens = light.get("lens") if light.get("model") == "lens calibration" else None
+    # Compared as a pinhole (no calibration then, or a daemon without the route): drawn as compared, not through a
+    # lens the comparison never used.
+    stored_pinhole = light.get("model") == "pinhole"
     calibrations = None
 
     def lens_for(photo, stored=None):
@@ -209,7 +212,7 @@ def load(client, run, items_by_kind) -> dict:
                     "light_floor" in items_by_kind or "light_spot" in items_by_kind):
                 photo = floor_photo(client, rid, items_by_kind.get("light_floor", []))
                 if photo is not None:
-                    photo.lens = lens_for(photo, stored_lens)
+                    photo.lens = None if stored_pinhole else lens_for(photo, stored_lens)
                     out["floor"] = photo
         except Exception:  # noqa: BLE001 — the maps on the chart's and floor's own coordinates still stand
             continue

@@ -188,6 +188,11 @@ class ChoiceTest(unittest.TestCase):
         photos = self.build([], {"light": {"model": "pinhole", "lens": None, "how": "…"}})
         self.assertIsNone(photos["floor"].lens)
         self.assertIn("pinhole", overlay.floor_placement(photos["floor"]).how)
+        # Compared as a pinhole (a daemon without the route then) in a lab that has a calibration now: the floor map is
+        # drawn as it was compared, not through the lab's lens; the chart still takes the lab's.
+        photos = self.build([self.calibration("lab")], {"light": {"model": "pinhole", "lens": None, "how": "…"}})
+        self.assertIsNone(photos["floor"].lens)
+        self.assertEqual(photos["chart"].lens["name"], "lab")
 
 
 if __name__ == "__main__":

@@ -84,6 +84,12 @@ class VerifyTest(unittest.TestCase):
         for bad, error in ((0, ValueError), (-3, ValueError), (2.5, TypeError), ("8", TypeError), (True, TypeError)):
             with self.assertRaises(error):
                 lab.verify("box.exr", against=["a1"], noise_neighbours=bad)
+        with self.assertRaises(ValueError):
+            lab.verify("box.exr", against=["a1"], noise_neighbours=2**31)
+        # None or 0 would silently leave the noise out (narrower bands), "false" silently keep it.
+        for bad in (None, 0, 1, "false", "no"):
+            with self.assertRaises(TypeError):
+                lab.verify("box.exr", against=["a1"], rendering_noise=bad)
         self.assertFalse(self.args.exists())
 
     def test_no_verdict_raises_with_colorlabs_message(self):
