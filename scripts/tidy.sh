@@ -8,7 +8,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${COLORLAB_TIDY_BUILD:-build}
 jobs=${COLORLAB_TIDY_JOBS:-2}
-regex=${1:-"$(pwd)/(core|analysis|drivers|sim|campaigns|daemon|protocol|client)/.*\\.cpp\$"}
+regex=${1:-"$(pwd)/(core|analysis|drivers|sim|campaigns|daemon|protocol|client|verify|fleet)/.*\\.cpp\$"}
 RUN_CLANG_TIDY=${RUN_CLANG_TIDY:-run-clang-tidy}
 command -v "$RUN_CLANG_TIDY" >/dev/null || { echo "tidy.sh: $RUN_CLANG_TIDY not found (apt-get install clang-tidy)" >&2; exit 2; }
 [[ -f $build/compile_commands.json ]] || { echo "tidy.sh: no $build/compile_commands.json: cmake --preset dev first" >&2; exit 2; }

@@ -18,7 +18,7 @@ if [[ ${1:-} == --whole ]]; then
   targets+=(daemon_unit_tests daemon_blob_service_tests daemon_wal_bound_tests daemon_http_robustness_tests
             integration_commit_hold_tests integration_worker_pool_tests integration_watchdog_hold_tests
             integration_event_stream_tests integration_crash_loop_tests integration_server_timing_tests
-            integration_blob_tests colorlabd colorlab-sim colorlab_faultshim)
+            integration_blob_tests colorlabd colorlab colorlab-sim colorlab_faultshim)
 fi
 cmake --preset tsan >/dev/null
 nice -n 19 cmake --build --preset tsan -j2 --target "${targets[@]}"

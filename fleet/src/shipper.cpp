@@ -3,6 +3,7 @@
 #include <chrono>
 #include <exception>
 #include <optional>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 
@@ -431,8 +432,7 @@ CycleReport ship_cycle(const ShipConfig& c) {
       while (static_cast<int>(group.size()) < c.transaction_runs && measurements < c.transaction_measurements) {
         std::optional<RunBatch> b;
         if (held) {
-          b = std::move(held);
-          held.reset();
+          b = std::exchange(held, std::nullopt);  // taken, and no longer held
         } else {
           try {
             b = ahead.next();
