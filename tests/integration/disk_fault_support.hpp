@@ -33,7 +33,8 @@ class DiskFaults {
     ScopedEnv env{{"LD_PRELOAD", COLORLAB_FAULTSHIM},
                   {"COLORLAB_FAULT_DIR", state_dir_.string()},
                   {"COLORLAB_FAULT_CONTROL", control_.string()},
-                  {"ASAN_OPTIONS", asan_options_for_preload()}};
+                  {"ASAN_OPTIONS", asan_options_for_preload()},
+                  {"TSAN_OPTIONS", tsan_options_for_preload()}};
     return std::make_unique<DaemonProcess>(state_dir_, config);
   }
 
