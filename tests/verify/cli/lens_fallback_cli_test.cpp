@@ -22,6 +22,7 @@
 #include "colorlab/verify/cabinet_json.hpp"
 #include "colorlab/verify/lens_calibration.hpp"
 #include "colorlab/verify/rendering.hpp"
+#include "ramp_rendering.hpp"
 #include "colorlab/verify/scene_export.hpp"
 #include "fake_daemon.hpp"
 #include "located_chart_run.hpp"
@@ -35,6 +36,8 @@ using colorlab::testing::bin_path;
 using colorlab::testing::run_command;
 using colorlab::testing::TempDir;
 using testing::FakeDaemon;
+using cli_testing::ramp;
+using cli_testing::rendered;
 
 constexpr const char* kFloorRun = "0193c0de-0000-7000-8000-0000000f1009";
 constexpr const char* kLensRoute = "/v1/lab/lenses";
@@ -64,28 +67,6 @@ void serve_floor_run(FakeDaemon& d) {
   const std::string base = std::string("/v1/runs/") + kFloorRun;
   d.answer(base, {200, json{{"id", kFloorRun}, {"campaign", "floor-luminance"}, {"status", "finished_ok"}, {"params", json::object()}}.dump()});
   d.answer(base + "/measurements", {200, json{{"items", m}, {"next_cursor", nullptr}}.dump()});
-}
-
-// A luminance ramp across the frame, so where a region is sampled shows in its rendered value.
-Rendering ramp(int width, int height) {
-  Rendering r;
-  r.width = width, r.height = height;
-  r.encoding = Encoding::xyz;
-  r.units = "cd/m^2";
-  r.pixels.resize(static_cast<std::size_t>(width) * height * 3);
-  for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) {
-      const float Y = 50.0f + 0.05f * static_cast<float>(x) + 0.03f * static_cast<float>(y);
-      float* p = r.pixels.data() + (static_cast<std::size_t>(y) * width + x) * 3;
-      p[0] = Y * 0.95047f, p[1] = Y, p[2] = Y * 1.08883f;
-    }
-  return r;
-}
-
-std::vector<double> rendered(const json& result) {
-  std::vector<double> out;
-  for (const auto& c : result["comparisons"]) out.push_back(c["rendered"][0].get<double>());
-  return out;
 }
 
 // A barrel lens for the floor photograph's size: placing through it moves the sampled regions.

@@ -16,12 +16,15 @@
 #include "colorlab/client/runs.hpp"
 #include "colorlab/sim/control_channel.hpp"
 #include "colorlab/verify/rendering.hpp"
+#include "ramp_rendering.hpp"
 #include "colorlab/testing/simulator_capture.hpp"
 #include "resume_support.hpp"
 
 using namespace colorlab;
 using namespace colorlab::testing;
 using nlohmann::json;
+using verify::cli_testing::ramp;
+using verify::cli_testing::rendered;
 
 namespace {
 
@@ -74,29 +77,6 @@ date = "2026-11-29"
 json control(const DaemonProcess& daemon, const json& command) {
   json endpoint = json::parse(std::ifstream(daemon.state_dir() / "colorlabd.endpoint"));
   return sim::send_control_command(endpoint.at("simulator_control").get<std::string>(), command);
-}
-
-// An XYZ rendering whose luminance ramps across the frame: the comparisons' verdicts do not matter here, only where
-// the regions were sampled, which the ramp turns into the rendered value.
-verify::Rendering ramp(int width, int height) {
-  verify::Rendering r;
-  r.width = width, r.height = height;
-  r.encoding = verify::Encoding::xyz;
-  r.units = "cd/m^2";
-  r.pixels.resize(static_cast<std::size_t>(width) * height * 3);
-  for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) {
-      const float Y = 50.0f + 0.05f * static_cast<float>(x) + 0.03f * static_cast<float>(y);
-      float* p = r.pixels.data() + (static_cast<std::size_t>(y) * width + x) * 3;
-      p[0] = Y * 0.95047f, p[1] = Y, p[2] = Y * 1.08883f;
-    }
-  return r;
-}
-
-std::vector<double> rendered(const json& result) {
-  std::vector<double> out;
-  for (const auto& c : result["comparisons"]) out.push_back(c["rendered"][0].get<double>());
-  return out;
 }
 
 TEST(VerifyLensCli, TheFloorIsPlacedThroughTheNamedCalibrationAndSaysSo) {
