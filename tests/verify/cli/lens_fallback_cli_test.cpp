@@ -39,6 +39,13 @@ using testing::FakeDaemon;
 using cli_testing::ramp;
 using cli_testing::rendered;
 
+// An answer the lens route must not be taken as "no calibrations" from: the exit status and words it must give.
+struct Refusal {
+  FakeDaemon::Answer answer;
+  int exit_code;
+  const char* words;
+};
+
 constexpr const char* kFloorRun = "0193c0de-0000-7000-8000-0000000f1009";
 constexpr const char* kLensRoute = "/v1/lab/lenses";
 
@@ -149,11 +156,7 @@ TEST(VerifyLensFallback, APinholeSaidSoWhenTheDaemonServesNoLensesAndOtherRefusa
 
   // Every other refusal is an error: the API's (exit 2) with its status, or a local one (exit 1) for an answer that
   // is not the route's — never a pinhole placement.
-  const struct {
-    FakeDaemon::Answer answer;
-    int exit_code;
-    const char* words;
-  } refusals[] = {
+  const Refusal refusals[] = {
       {{401, problem(401, "unauthorized"), "application/problem+json"}, 2, "401"},
       {{403, problem(403, "forbidden"), "application/problem+json"}, 2, "403"},
       {{503, problem(503, "unavailable"), "application/problem+json"}, 2, "503"},
@@ -224,11 +227,7 @@ TEST(SceneLensFallback, TheNominalLensSaidSoWhenTheDaemonServesNoLensesAndOtherR
   EXPECT_EQ(written()["camera"]["lens_calibration"]["name"], l.name());
 
   // Every other refusal is an error, and nothing is written in its place.
-  const struct {
-    FakeDaemon::Answer answer;
-    int exit_code;
-    const char* words;
-  } refusals[] = {
+  const Refusal refusals[] = {
       {{401, problem(401, "unauthorized"), "application/problem+json"}, 2, "401"},
       {{503, problem(503, "unavailable"), "application/problem+json"}, 2, "503"},
       {{200, "not json at all"}, 1, "invalid JSON"},
