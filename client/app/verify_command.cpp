@@ -40,7 +40,7 @@ struct VerifyOptions {
   std::string lens;
   std::string lens_calibration;
   bool no_rendering_noise = false;
-  int noise_neighbours = 8;
+  int noise_neighbours = verify::CompareOptions{}.noise_neighbours;  // the library's default, shown in --help
   bool json = false;
   bool store = false;
 };

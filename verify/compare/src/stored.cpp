@@ -2,10 +2,9 @@
 
 namespace colorlab::verify {
 
-StoredVerification to_store(const Verification& v, const std::string& rendering, const std::vector<std::string>& against,
-                            const CompareOptions& options, const nlohmann::json& placement) {
-  StoredVerification s;
-  s.params = {
+nlohmann::json verification_params(const std::string& rendering, const std::vector<std::string>& against,
+                                   const CompareOptions& options, const nlohmann::json& placement) {
+  nlohmann::json params{
       {"rendering", rendering},
       {"against", against},
       {"scale", options.scale ? nlohmann::json(*options.scale) : nlohmann::json(nullptr)},
@@ -14,7 +13,14 @@ StoredVerification to_store(const Verification& v, const std::string& rendering,
       {"rendering_noise", options.rendering_noise},
       {"noise_neighbours", options.rendering_noise ? nlohmann::json(options.noise_neighbours) : nlohmann::json(nullptr)},
   };
-  if (!placement.is_null()) s.params["placement"] = placement;
+  if (!placement.is_null()) params["placement"] = placement;
+  return params;
+}
+
+StoredVerification to_store(const Verification& v, const std::string& rendering, const std::vector<std::string>& against,
+                            const CompareOptions& options, const nlohmann::json& placement) {
+  StoredVerification s;
+  s.params = verification_params(rendering, against, options, placement);
   const auto full = v.to_json();
   s.summary = full["summary"];
   s.summary["floor_difference"] = full["floor_difference"];

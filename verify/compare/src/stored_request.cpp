@@ -165,16 +165,8 @@ StoredVerification stored_from_request(const json& body) {
 
 json store_request(const Verification& v, const std::string& rendering, const std::vector<std::string>& against,
                    const CompareOptions& options, const json& placement) {
-  json body{
-      {"rendering", rendering},
-      {"against", against},
-      {"scale", options.scale ? json(*options.scale) : json(nullptr)},
-      {"k", options.k},
-      {"rendering_noise", options.rendering_noise},
-      {"noise_neighbours", options.rendering_noise ? json(options.noise_neighbours) : json(nullptr)},
-      {"result", v.to_json()},
-  };
-  if (!placement.is_null()) body["placement"] = placement;
+  json body = verification_params(rendering, against, options, placement);
+  body["result"] = v.to_json();
   return body;
 }
 

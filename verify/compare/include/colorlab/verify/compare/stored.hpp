@@ -21,6 +21,12 @@ struct StoredVerification {
   std::vector<records::Measurement> measurements;  // step "<kind>/<where>", value = the difference
 };
 
+// What a verification was made with, as a stored verification's params and POST /v1/verifications' body carry it
+// (the body adds `result`): {rendering, against, scale (null: fitted), k, rendering_noise, noise_neighbours (null
+// when the rendering's noise is off)[, placement]}.
+nlohmann::json verification_params(const std::string& rendering, const std::vector<std::string>& against,
+                                   const CompareOptions& options, const nlohmann::json& placement = nullptr);
+
 // `placement`: how the comparison placed the measurement in the rendering (the CLI's `placement`: the floor through
 // the lens calibration or as a pinhole), kept in params when given so the stored verification says which.
 StoredVerification to_store(const Verification& v, const std::string& rendering, const std::vector<std::string>& against,
