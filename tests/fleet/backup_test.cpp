@@ -26,6 +26,7 @@
 #include "colorlab/testing/process.hpp"
 #include "colorlab/testing/temp_dir.hpp"
 #include "fleet_servers.hpp"
+#include "scoped_env.hpp"
 #include "resume_support.hpp"
 #include "sim_bench.hpp"
 
@@ -319,9 +320,12 @@ TEST_F(Backup, FullOrFailingDiskFailsClearlyAndLeavesNoHalfSnapshot) {
   auto s3 = bucket();
   for (const char* fault : {"ENOSPC", "EIO"}) {
     std::ofstream(control) << fault << " backup\n";
+    // The sanitizer presets' options as the preloading integration tests hand them to a preloaded process.
     auto r = ct::run_command({"/usr/bin/env", std::string("LD_PRELOAD=") + COLORLAB_FAULTSHIM,
                               "COLORLAB_FAULT_DIR=" + bench.state_dir().string(), "COLORLAB_FAULT_CONTROL=" + control.string(),
-                              ct::bin_path("colorlab-ship"), "--config", config.string(), "backup"},
+                              "ASAN_OPTIONS=" + ct::asan_options_for_preload(),
+                              "TSAN_OPTIONS=" + ct::tsan_options_for_preload(), ct::bin_path("colorlab-ship"), "--config",
+                              config.string(), "backup"},
                              std::chrono::seconds(120));
     EXPECT_EQ(r.exit_code, 1) << fault << ": " << r.out << r.err;
     EXPECT_NE(r.err.find("cannot write the snapshot"), std::string::npos) << fault << ": " << r.err;

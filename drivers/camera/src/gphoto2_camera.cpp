@@ -278,11 +278,17 @@ struct Gphoto2Camera::Session {
   ::Camera* cam = nullptr;
   std::map<std::string, std::vector<std::string>> choices;  // widget name -> labels
   bool has_config = false;
+  bool initialized = false;
 
   ~Session() {
-    if (cam) {
+    if (cam && initialized) {
       gp_camera_exit(cam, ctx);
       gp_camera_unref(cam);
+    } else if (cam) {
+      // libgphoto2 2.5.30's gp_camera_init and gp_camera_set_port_info, failing (no such USB device), leave the
+      // camera's private `used` count decremented below zero (an unsigned char: 255), and gp_camera_unref never frees
+      // a camera it thinks is in use; gp_camera_free frees regardless (seen by LeakSanitizer, docs/TESTING.md).
+      gp_camera_free(cam);
     }
     if (ctx) gp_context_unref(ctx);
   }
@@ -432,6 +438,7 @@ Camera::Connected Gphoto2Camera::do_connect() {
     check(gp_port_info_list_get_info(ports, port_index, &info), "gp_port_info_list_get_info");
     check(gp_camera_set_port_info(s->cam, info), "gp_camera_set_port_info");
     check(gp_camera_init(s->cam, s->ctx), "init " + model + " on " + port);
+    s->initialized = true;
 
     // Cameras without configuration (Directory Browse) answer NOT_SUPPORTED: no settings then.
     WidgetGuard window;
