@@ -141,6 +141,7 @@ TEST(DryRun, NamesEveryLimitACampaignWouldBreakAndMovesAndStoresNothing) {
 
   // Nothing was stored, nothing ran, no instrument was touched.
   EXPECT_TRUE(api.get("/v1/runs")["items"].empty());
-  for (const auto& ev : api.get("/v1/events")["items"]) EXPECT_NE(ev["topic"], "execution") << ev.dump();
+  const auto events = api.get("/v1/events");  // held: a range-for over a temporary's member reads freed memory
+  for (const auto& ev : events["items"]) EXPECT_NE(ev["topic"], "execution") << ev.dump();
   EXPECT_EQ(lab_truth(daemon), truth_before);
 }

@@ -179,7 +179,8 @@ void a_lamp_ten_percent_too_bright_differs_and_exits_4() {
   args.resize(args.size() - 2);
   const auto fitted = cli(args);
   ASSERT_TRUE(fitted.exit_code == 0 || fitted.exit_code == 4) << fitted.err;
-  for (const auto& s : json::parse(fitted.out)["summary"]["scales"]) EXPECT_EQ(s["how"], "fitted") << s.dump();
+  const json fitted_result = json::parse(fitted.out);  // held: a range-for over a temporary's member reads freed memory
+  for (const auto& s : fitted_result["summary"]["scales"]) EXPECT_EQ(s["how"], "fitted") << s.dump();
 }
 
 void bad_inputs_are_typed_errors_with_their_exit_codes() {
