@@ -81,6 +81,8 @@ class ScriptRun final : public LabCallSink {
     }
     // Whatever the outcome: a script's own "put it back" step is not reached when it fails or stops mid-way.
     co_await lab_.put_back(state_);
+    // Ended, however: what its calls kept is in its steps (or was no call's).
+    lab_.forget_kept(control_.execution_id);
     if (unexpected) std::rethrow_exception(unexpected);
     co_return outcome_;
   }
@@ -309,7 +311,7 @@ class ScriptRun final : public LabCallSink {
     state_.apply(c.call, c.args, result);
     timing_keys_.follow(c.call, c.args, result);
     const auto seq = static_cast<std::int64_t>(replay_index_++);
-    for (auto& b : lab_.take_kept()) {
+    for (auto& b : lab_.take_kept(control_.execution_id)) {
       b.name = c.call + "#" + std::to_string(seq) + "/" + b.name;
       pending_.blobs.push_back(std::move(b));
     }

@@ -289,14 +289,30 @@ void Lab::follow_execution(const ExecutionControl& control) {
 
 asio::awaitable<json> Lab::perform(const std::string& call, const json& args, const ExecutionControl& control) {
   follow_execution(control);
-  ledger_.take();  // what an attempt that failed kept is no call's
+  // What an attempt of this execution that failed kept is no call's; another execution's call may be mid-way.
+  if (auto it = ledgers_.find(control.execution_id); it != ledgers_.end()) it->second.take();
   const LabCall* c = find_lab_call(call);
   if (!c || !c->perform) throw Error(ErrorClass::internal, "the lab has no call " + call);
   json result = co_await (this->*(c->perform))(args, control);
   co_return result;
 }
 
-FrameKeeper* Lab::call_keeper() { return keeper_ ? &ledger_ : nullptr; }
+FrameKeeper* Lab::call_keeper(const ExecutionControl& control) {
+  if (!keeper_) return nullptr;
+  auto [it, made] = ledgers_.try_emplace(control.execution_id);
+  if (made) it->second.set_keeper(keeper_);
+  return &it->second;
+}
+
+void Lab::set_frame_keeper(FrameKeeper* keeper) {
+  keeper_ = keeper;
+  for (auto& [execution, ledger] : ledgers_) ledger.set_keeper(keeper);
+}
+
+std::vector<KeptBlob> Lab::take_kept(const std::string& execution_id) {
+  auto it = ledgers_.find(execution_id);
+  return it == ledgers_.end() ? std::vector<KeptBlob>{} : it->second.take();
+}
 
 asio::awaitable<std::shared_ptr<cam::CameraInstrument>> Lab::camera_named_in(const json& options) {
   // A lab with two cameras (GenICam and DSLR) lets the script say which one: {camera = id or kind}.
@@ -468,25 +484,25 @@ asio::awaitable<json> Lab::call_camera_configure(const json& args, const Executi
   co_return json(nullptr);
 }
 
-asio::awaitable<json> Lab::call_camera_capture(const json& args, const ExecutionControl&) {
+asio::awaitable<json> Lab::call_camera_capture(const json& args, const ExecutionControl& control) {
   auto camera = co_await acquire<cam::CameraInstrument>("camera");
   // Named, not a temporary in the co_await: GCC 12 destroys such temporaries twice.
   json options = args.empty() ? json::object() : args[0];
-  json table = co_await capture_noise_table(*camera, options, call_keeper());
+  json table = co_await capture_noise_table(*camera, options, call_keeper(control));
   co_return table;
 }
 
-asio::awaitable<json> Lab::call_camera_photograph_chart(const json& args, const ExecutionControl&) {
+asio::awaitable<json> Lab::call_camera_photograph_chart(const json& args, const ExecutionControl& control) {
   json options = args.empty() ? json::object() : args[0];
   auto camera = co_await camera_named_in(options);
-  json photographs = co_await photograph_chart(*camera, options, call_keeper());
+  json photographs = co_await photograph_chart(*camera, options, call_keeper(control));
   co_return photographs;
 }
 
-asio::awaitable<json> Lab::call_camera_photograph_floor(const json& args, const ExecutionControl&) {
+asio::awaitable<json> Lab::call_camera_photograph_floor(const json& args, const ExecutionControl& control) {
   auto camera = co_await acquire<cam::CameraInstrument>("camera");
   json options = args[0];
-  json photograph = co_await photograph_floor(*camera, options, call_keeper());
+  json photograph = co_await photograph_floor(*camera, options, call_keeper(control));
   co_return photograph;
 }
 

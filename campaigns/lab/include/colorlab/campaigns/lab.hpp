@@ -109,13 +109,15 @@ class Lab {
   // Where lab.runs.* reads earlier runs (the daemon's store); without one those calls fail.
   void set_run_reader(RunReader* runs) { runs_ = runs; }
   // Where frames worth keeping go (the daemon's blob store); without one nothing is kept.
-  void set_frame_keeper(FrameKeeper* keeper) {
-    keeper_ = keeper;
-    ledger_.set_keeper(keeper);
-  }
+  void set_frame_keeper(FrameKeeper* keeper);
   FrameKeeper* frame_keeper() const { return keeper_; }
-  // The blobs the last perform() kept, in the order kept (typed, for the step that journals the call); forgets them.
-  std::vector<KeptBlob> take_kept() { return ledger_.take(); }
+  // The blobs the last perform() of this execution kept, in the order kept (typed, for the step that journals the
+  // call); forgets them.
+  std::vector<KeptBlob> take_kept(const std::string& execution_id);
+  // The execution has ended (however it ended): its ledger goes, so a week of nights leaves none behind.
+  void forget_kept(const std::string& execution_id) { ledgers_.erase(execution_id); }
+  // Executions holding a ledger now: none once every execution has ended.
+  std::size_t executions_keeping() const { return ledgers_.size(); }
   // What a dry run of a campaign on this lab needs to know of it.
   const OperatorHands* hands() const { return hands_; }
   RunReader* run_reader() const { return runs_; }
@@ -152,8 +154,8 @@ class Lab {
   boost::asio::awaitable<nlohmann::json> call_operator_request(const nlohmann::json& args, const ExecutionControl& control);
   boost::asio::awaitable<nlohmann::json> call_wait(const nlohmann::json& args, const ExecutionControl& control);
   boost::asio::awaitable<nlohmann::json> call_now(const nlohmann::json& args, const ExecutionControl& control);
-  // The keeper a call keeps its frames through (notes them for take_kept()), or nullptr.
-  FrameKeeper* call_keeper();
+  // The keeper a call of `control`'s execution keeps its frames through (notes them for take_kept()), or nullptr.
+  FrameKeeper* call_keeper(const ExecutionControl& control);
   // The camera an options table names ({camera = id or kind}), else the one serving the role; connected.
   boost::asio::awaitable<std::shared_ptr<drivers::camera::CameraInstrument>> camera_named_in(const nlohmann::json& options);
 
@@ -212,8 +214,11 @@ class Lab {
   OperatorHands* hands_ = nullptr;
   RunReader* runs_ = nullptr;
   FrameKeeper* keeper_ = nullptr;
-  // In front of keeper_ for the calls: notes what each call kept.
-  KeepLedger ledger_;
+  // In front of keeper_ for the calls: notes what each call kept, one ledger per execution. Two executions may run
+  // at once on this lab (a direct start beside the night queue) and a call suspends (camera, lamps): with one ledger
+  // the call of one would clear, or its step take, the frames of the other's call. Touched on the lab's executor
+  // only; a node stays put while a worker thread keeps through it.
+  std::map<std::string, KeepLedger> ledgers_;
 };
 
 }  // namespace colorlab::campaigns

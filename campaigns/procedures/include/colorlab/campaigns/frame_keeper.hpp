@@ -5,7 +5,7 @@
 //
 // A kept blob's file is durable when keep_* returns; the row that makes it part of the run is
 // written with the step that made the lab call: the lab hands the typed references it kept during
-// the call (KeepLedger) to the engine, which commits them with the call's journal entry. The call's
+// the call (a KeepLedger per execution) to the engine, which commits them with the call's journal entry. The call's
 // result carries them as JSON too (`blobs`), for the script and for a replay.
 #include <cstdint>
 #include <filesystem>
