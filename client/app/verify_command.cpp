@@ -225,6 +225,7 @@ int verify(const GlobalOptions& global, const VerifyOptions& o) {
   out["exit_status"] = verify::exit_status(v);
   out["rendering_noise"] = options.rendering_noise;
   out["noise_neighbours"] = options.rendering_noise ? json(options.noise_neighbours) : json(nullptr);
+  out["noise_pooling"] = options.rendering_noise ? json(verify::kNoisePooling) : json(nullptr);
   if (!placement.is_null()) out["placement"] = placement;
 #ifdef COLORLAB_HAVE_VERIFY_COLOUR
   if (!colour.is_null()) out["colour"] = colour;

@@ -7,6 +7,7 @@ The comparison engine is C++ (verify/compare) and reads the rendering file where
 from __future__ import annotations
 
 import json
+import math
 import os
 import subprocess
 from typing import Sequence
@@ -44,16 +45,22 @@ class VerifyMixin:
         difference, expanded, verdict, …). ``scale``: renderer unit → cd/m² (omitted: one factor fitted per kind,
         which cannot see a uniformly wrong level). ``rendering_noise=False`` leaves the rendering's own Monte-Carlo
         noise out of the budget (only for a renderer that states its image is exact); ``noise_neighbours``: the
-        regions its level is pooled over (an int ≥ 1; colorlab's default 8); both are in the result and a stored
+        regions its level is pooled over (a whole number ≥ 1, 8.0 as 8; colorlab's default 8); both are in the result and a stored
         verification's params. Raises ``VerifyFailed`` when no verdict could be made, ``TypeError``/``ValueError``
-        for a ``rendering_noise`` that is not a bool or a ``noise_neighbours`` that is not a whole number ≥ 1."""
+        for a ``rendering_noise`` that is not a bool or a ``noise_neighbours`` that is not a whole number ≥ 1
+        (``TypeError`` for a non-number, ``ValueError`` for 2.5, NaN, ∞, 0 or less)."""
         from .report.analyze import colorlab_binary  # the one place that knows where the binary is
 
         if not isinstance(rendering_noise, bool):  # None or 0 would silently narrow every band, "false" keep it
             raise TypeError(f"rendering_noise must be True or False, not {type(rendering_noise).__name__}")
         if noise_neighbours is not None:
-            if isinstance(noise_neighbours, bool) or not isinstance(noise_neighbours, int):
-                raise TypeError(f"noise_neighbours must be an int, not {type(noise_neighbours).__name__}")
+            if isinstance(noise_neighbours, bool) or not isinstance(noise_neighbours, (int, float)):
+                raise TypeError(f"noise_neighbours must be a whole number, not {type(noise_neighbours).__name__}")
+            if isinstance(noise_neighbours, float):
+                # One number type in JSON: 8.0 (from a config, a JSON body, a JS caller) is the whole number 8.
+                if not math.isfinite(noise_neighbours) or not noise_neighbours.is_integer():
+                    raise ValueError(f"noise_neighbours must be a whole number (got {noise_neighbours!r})")
+                noise_neighbours = int(noise_neighbours)
             if noise_neighbours < 1:
                 raise ValueError(f"noise_neighbours must be at least 1 (got {noise_neighbours}): the rendering's noise "
                                  "is pooled over that many nearest regions; rendering_noise=False leaves it out")

@@ -13,6 +13,7 @@
 #include <fstream>
 
 #include <gtest/gtest.h>
+#include <sqlite3.h>
 
 #include "colorlab/analysis/floor_luminance.hpp"
 #include "colorlab/sim/control_channel.hpp"
@@ -256,6 +257,8 @@ void rendering_noise_options_are_recorded_and_checked() {
   const json run = client::fetch_run(api, result.at("stored_run").get<std::string>());
   EXPECT_EQ(run["params"]["rendering_noise"], false) << run["params"].dump();
   EXPECT_TRUE(run["params"]["noise_neighbours"].is_null()) << run["params"].dump();
+  EXPECT_TRUE(result.contains("noise_pooling") && result["noise_pooling"].is_null()) << result.dump().substr(0, 300);
+  EXPECT_TRUE(run["params"].contains("noise_pooling") && run["params"]["noise_pooling"].is_null()) << run["params"].dump();
 
   auto four = verify_args("faithful.exr");
   four.insert(four.end(), {"--noise-neighbours", "4", "--store"});
@@ -266,6 +269,11 @@ void rendering_noise_options_are_recorded_and_checked() {
   const json run4 = client::fetch_run(api, result4.at("stored_run").get<std::string>());
   EXPECT_EQ(run4["params"]["rendering_noise"], true) << run4["params"].dump();
   EXPECT_EQ(run4["params"]["noise_neighbours"], 4) << run4["params"].dump();
+  EXPECT_EQ(result4["noise_pooling"], "median-screen");
+  EXPECT_EQ(run4["params"]["noise_pooling"], "median-screen") << run4["params"].dump();
+  for (const auto& c : result4["comparisons"]) EXPECT_TRUE(c.at("noise_left_out").is_boolean()) << c.dump();
+  for (const auto& [kind, k] : result4["summary"]["kinds"].items())
+    EXPECT_TRUE(k.at("rendering_noise_left_out").is_array()) << kind;
 
   for (const char* n : {"0", "-2"}) {
     auto bad = verify_args("faithful.exr");
@@ -286,12 +294,55 @@ void rendering_noise_options_are_recorded_and_checked() {
   body["noise_neighbours"] = 12;
   const json run12 = client::fetch_run(api, api.post("/v1/verifications", body).at("run_id").get<std::string>());
   EXPECT_EQ(run12["params"]["noise_neighbours"], 12) << run12["params"].dump();
+  // A body without noise_pooling (a client from before it): its pooling not recorded.
+  EXPECT_TRUE(run12["params"].contains("noise_pooling") && run12["params"]["noise_pooling"].is_null()) << run12["params"].dump();
+  // JSON's one number type: 8.0 (a Python float, a JavaScript number) is the whole number 8.
+  body["noise_neighbours"] = 8.0;
+  ASSERT_NE(body.dump().find("\"noise_neighbours\":8.0"), std::string::npos);
+  const json run8 = client::fetch_run(api, api.post("/v1/verifications", body).at("run_id").get<std::string>());
+  EXPECT_TRUE(run8["params"]["noise_neighbours"].is_number_integer()) << run8["params"].dump();
+  EXPECT_EQ(run8["params"]["noise_neighbours"], 8) << run8["params"].dump();
+
+  // A verification stored before noise_pooling existed: its row's params without the key (as the store holds such a
+  // row) read back with it null — not recorded — through the run and the run list.
+  {
+    const std::string id = result4.at("stored_run").get<std::string>();
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open_v2((daemon_->state_dir() / "colorlab.db").c_str(), &db, SQLITE_OPEN_READWRITE, nullptr), SQLITE_OK);
+    sqlite3_busy_timeout(db, 10000);
+    sqlite3_stmt* st = nullptr;
+    ASSERT_EQ(sqlite3_prepare_v2(db, "UPDATE runs SET params = json_remove(params, '$.noise_pooling') WHERE id = ?1", -1, &st, nullptr), SQLITE_OK);
+    sqlite3_bind_text(st, 1, id.c_str(), -1, SQLITE_TRANSIENT);
+    EXPECT_EQ(sqlite3_step(st), SQLITE_DONE);
+    sqlite3_finalize(st);
+    EXPECT_EQ(sqlite3_changes(db), 1);
+    sqlite3_close(db);
+    const json old = api.get("/v1/runs/" + id);
+    ASSERT_TRUE(old["params"].contains("noise_pooling")) << old["params"].dump();
+    EXPECT_TRUE(old["params"]["noise_pooling"].is_null()) << old["params"].dump();
+    EXPECT_EQ(old["params"]["noise_neighbours"], 4) << old["params"].dump();
+    bool listed = false;
+    const json list = api.get("/v1/runs?campaign=verify&limit=100");
+    for (const auto& r : list["items"])
+      if (r["id"] == id) {
+        listed = true;
+        EXPECT_TRUE(r["params"].contains("noise_pooling") && r["params"]["noise_pooling"].is_null()) << r["params"].dump();
+      }
+    EXPECT_TRUE(listed) << list.dump().substr(0, 1500);
+  }
   const std::pair<json, std::string> bad_bodies[] = {
       {{{"rendering_noise", "no"}}, "body.rendering_noise"},
       {{{"noise_neighbours", 0}}, "body.noise_neighbours"},
       {{{"noise_neighbours", -1}}, "body.noise_neighbours"},
       {{{"noise_neighbours", 2.5}}, "body.noise_neighbours"},
+      {{{"noise_neighbours", 8.5}}, "body.noise_neighbours"},
+      {{{"noise_neighbours", 0.0}}, "body.noise_neighbours"},
+      {{{"noise_neighbours", -8.0}}, "body.noise_neighbours"},
+      {{{"noise_neighbours", 1e300}}, "body.noise_neighbours"},
+      {{{"noise_neighbours", 4294967304.0}}, "body.noise_neighbours"},  // 2^32 + 8: 8 if wrapped into an int
+      {{{"noise_neighbours", true}}, "body.noise_neighbours"},
       {{{"noise_neighbours", "8"}}, "body.noise_neighbours"},
+      {{{"noise_pooling", "sum"}}, "body.noise_pooling"},
       // Said to be made without the rendering's noise, while its budgets carry it.
       {{{"rendering_noise", false}, {"result", result4}}, "rendering_noise is false"},
   };

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 #include <string>
 #include <utility>
@@ -91,8 +92,13 @@ TEST(VerifyCompare, SaysWhichScaleItUsed) {
 
 // A (4·side)² XYZ rendering of Y = 100 with relative noise `sd` per pixel (white, or a 2 × 2 block filter: unit
 // variance, neighbours correlated 0.5, diagonals 0.25) and a linear ramp of `ramp` per pixel, and 16 spots of
-// side × side pixels on it, each read exactly.
-double stated_rendering_noise(double sd, bool correlated, double ramp, int side = 10) {
+// side × side pixels on it, each read exactly. `textured`: that spot (row-major) carries a ±30 % checkerboard as
+// well — the scene's texture, not the renderer's noise — its measured value the checkerboard's mean.
+struct NoisyGrid {
+  Rendering rendering;
+  MeasuredScene scene;
+};
+NoisyGrid noisy_grid(double sd, bool correlated, double ramp, int side = 10, int textured = -1) {
   const int n = 4 * side;
   std::mt19937_64 rng(7);
   std::normal_distribution<double> n01(0, 1);
@@ -105,7 +111,9 @@ double stated_rendering_noise(double sd, bool correlated, double ramp, int side 
     for (int x = 0; x < n; ++x) {
       const auto at = [&](int dx, int dy) { return white[static_cast<std::size_t>((y + dy) * (n + 1) + x + dx)]; };
       const double e = correlated ? 0.5 * (at(0, 0) + at(1, 0) + at(0, 1) + at(1, 1)) : at(0, 0);
-      const double v = 100 * (1 + ramp * x) * (1 + sd * e);
+      const bool in_texture = (y / side) * 4 + x / side == textured;
+      const double texture = in_texture ? ((x + y) % 2 ? 1.3 : 0.7) : 1.0;
+      const double v = 100 * (1 + ramp * x) * (1 + sd * e) * texture;
       for (int c = 0; c < 3; ++c) r.pixels[static_cast<std::size_t>((y * n + x) * 3 + c)] = static_cast<float>(v);
     }
   MeasuredScene m;
@@ -118,14 +126,66 @@ double stated_rendering_noise(double sd, bool correlated, double ramp, int side 
     s.reading_sd = 1e-6;
     m.spots.push_back(s);
   }
+  return {std::move(r), std::move(m)};
+}
+
+double stated_rendering_noise(double sd, bool correlated, double ramp, int side = 10) {
+  const auto g = noisy_grid(sd, correlated, ramp, side);
   CompareOptions o;
   o.scale = 1.0;
-  const auto v = compare(r, m, o);
+  const auto v = compare(g.rendering, g.scene, o);
   double sum = 0;  // the stated standard uncertainty of each spot's mean, relative, averaged over the spots
   for (const auto& c : v.comparisons)
     for (const auto& [source, u] : c.budget)
       if (source == "rendering noise") sum += u;  // the budget is relative for light: u / measured
   return sum / static_cast<double>(v.comparisons.size());
+}
+
+double budget_of(const Comparison& c, const std::string& source) {
+  for (const auto& [name, u] : c.budget)
+    if (name == source) return u;
+  return 0;
+}
+
+// The screen's left-out regions are in the result (issue 23's loose end): a spot whose pixels are the scene's
+// texture, ±30 % against 2 % noise — its level ~225 times its neighbours', far past the screen's 99.99 % quantile —
+// is named, per kind in the summary and on its comparison, and its band is its own spread; a faithful rendering
+// names none. Through the stored body and back, and refused when it contradicts "rendering_noise": false.
+TEST(VerifyCompare, TheNoiseScreensLeftOutRegionsAreNamedInTheResult) {
+  CompareOptions o;
+  o.scale = 1.0;
+  const auto faithful = noisy_grid(0.02, false, 0);
+  const auto clean = compare(faithful.rendering, faithful.scene, o).to_json();
+  ASSERT_TRUE(clean["summary"]["kinds"]["light_spot"]["rendering_noise_left_out"].is_array());
+  EXPECT_TRUE(clean["summary"]["kinds"]["light_spot"]["rendering_noise_left_out"].empty()) << clean["summary"].dump();
+  for (const auto& c : clean["comparisons"]) EXPECT_EQ(c["noise_left_out"], false);
+
+  const auto textured = noisy_grid(0.02, false, 0, 10, 5);  // r1c1
+  const auto v = compare(textured.rendering, textured.scene, o);
+  const auto j = v.to_json();
+  EXPECT_EQ(j["summary"]["kinds"]["light_spot"]["rendering_noise_left_out"], nlohmann::json::array({"r1c1"})) << j["summary"].dump();
+  for (std::size_t i = 0; i < v.comparisons.size(); ++i) {
+    EXPECT_EQ(j["comparisons"][i]["noise_left_out"], v.comparisons[i].where == "r1c1") << v.comparisons[i].where;
+    // Its band is its own spread: a checkerboard of ±30 % over 96 residual degrees of freedom states ~0.3/√100 = 3 %,
+    // where the pooled noise of its neighbours would have said 2 %/√100 = 0.2 %.
+    const double u = budget_of(v.comparisons[i], "rendering noise");
+    if (v.comparisons[i].where == "r1c1") EXPECT_NEAR(u / 0.03, 1.0, 0.1) << u;
+    else EXPECT_NEAR(u / 0.002, 1.0, 0.25) << v.comparisons[i].where << " " << u;
+  }
+  const auto s = stored_from_request(store_request(v, "render.exr", {"run-1"}, o));
+  EXPECT_EQ(s.summary["kinds"]["light_spot"]["rendering_noise_left_out"], nlohmann::json::array({"r1c1"}));
+  auto contradiction = store_request(v, "render.exr", {"run-1"}, o);
+  contradiction["rendering_noise"] = false;
+  for (auto& c : contradiction["result"]["comparisons"]) c["budget"].erase("rendering noise");
+  try {
+    stored_from_request(contradiction);
+    ADD_FAILURE() << "a left-out region without the rendering's noise was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("noise_left_out"), std::string::npos) << e.what();
+  }
+  auto mistyped = store_request(v, "render.exr", {"run-1"}, o);
+  mistyped["result"]["comparisons"][0]["noise_left_out"] = "yes";
+  EXPECT_THROW(stored_from_request(mistyped), Error);
 }
 
 TEST(VerifyCompare, TheRenderingsOwnNoiseIsStatedFromItsPixels) {
@@ -183,6 +243,7 @@ TEST(VerifyCompare, StoredLikeARunWithAnExitStatus) {
   EXPECT_EQ(s.params["scale"], 2.0);
   EXPECT_EQ(s.params["rendering_noise"], true);
   EXPECT_EQ(s.params["noise_neighbours"], 8);
+  EXPECT_EQ(s.params["noise_pooling"], "median-screen");
 }
 
 TEST(VerifyCompare, TheRenderingNoiseOptionsTravelThroughTheRequestBody) {
@@ -202,12 +263,25 @@ TEST(VerifyCompare, TheRenderingNoiseOptionsTravelThroughTheRequestBody) {
   s = stored_from_request(store_request(v_off, "render.exr", {"run-1"}, off));
   EXPECT_EQ(s.params["rendering_noise"], false);
   EXPECT_TRUE(s.params["noise_neighbours"].is_null());
-  // A body from before the fields existed: made the only way there was then, on over 8 regions.
+  EXPECT_TRUE(s.params["noise_pooling"].is_null());
+  // A body from before the fields existed: made the only way there was then, on over 8 regions; how it was pooled
+  // (plain sums before the robust screen, the screen after) the body cannot say: not recorded.
   auto old = store_request(v, "render.exr", {"run-1"}, CompareOptions{});
+  EXPECT_EQ(old["noise_pooling"], "median-screen");
   old.erase("rendering_noise");
   old.erase("noise_neighbours");
+  old.erase("noise_pooling");
   s = stored_from_request(old);
   EXPECT_EQ(s.params["rendering_noise"], true);
+  EXPECT_EQ(s.params["noise_neighbours"], 8);
+  ASSERT_TRUE(s.params.contains("noise_pooling"));
+  EXPECT_TRUE(s.params["noise_pooling"].is_null());
+  // JSON's one number type: 8.0 (a Python float, a JavaScript number) is the whole number 8.
+  auto as_double = store_request(v, "render.exr", {"run-1"}, o);
+  as_double["noise_neighbours"] = 8.0;
+  ASSERT_TRUE(as_double.dump().find("\"noise_neighbours\":8.0") != std::string::npos) << as_double.dump();
+  s = stored_from_request(nlohmann::json::parse(as_double.dump()));
+  EXPECT_TRUE(s.params["noise_neighbours"].is_number_integer());
   EXPECT_EQ(s.params["noise_neighbours"], 8);
   // Bad values, and a budget that contradicts "rendering_noise": false, are bad parameters naming the field.
   const std::pair<const char*, nlohmann::json> bad[] = {
@@ -216,9 +290,20 @@ TEST(VerifyCompare, TheRenderingNoiseOptionsTravelThroughTheRequestBody) {
       {"noise_neighbours", 0},
       {"noise_neighbours", -4},
       {"noise_neighbours", 2.5},
+      {"noise_neighbours", 8.5},
+      {"noise_neighbours", 0.0},
+      {"noise_neighbours", -8.0},
+      {"noise_neighbours", 1e300},
+      {"noise_neighbours", 4294967304.0},  // 2^32 + 8: whole, and 8 if it were wrapped into an int
+      {"noise_neighbours", std::numeric_limits<double>::quiet_NaN()},
+      {"noise_neighbours", std::numeric_limits<double>::infinity()},
       {"noise_neighbours", "8"},
+      {"noise_neighbours", "8.0"},
+      {"noise_neighbours", nlohmann::json::array({8})},
       {"noise_neighbours", 1ll << 40},
       {"noise_neighbours", true},
+      {"noise_pooling", "sum"},  // this engine's body cannot have pooled otherwise
+      {"noise_pooling", 1},
       {"k", 0},
       {"k", -2},
   };
@@ -236,6 +321,19 @@ TEST(VerifyCompare, TheRenderingNoiseOptionsTravelThroughTheRequestBody) {
   auto contradiction = store_request(v, "render.exr", {"run-1"}, o);  // its budgets carry the rendering's noise
   contradiction["rendering_noise"] = false;
   EXPECT_THROW(stored_from_request(contradiction), Error);
+}
+
+// A verification stored before `noise_pooling` existed (its params without the key, as the store holds them) reads
+// back with it null — not recorded — and one stored since keeps its own.
+TEST(VerifyCompare, AStoredVerificationWithoutItsPoolingReadsBackAsNotRecorded) {
+  const nlohmann::json old_row = {{"rendering", "box.exr"}, {"against", {"run-1"}}, {"scale", 1}, {"k", 2}, {"rendering_noise", true}, {"noise_neighbours", 8}};
+  const auto back = params_read_back(old_row);
+  ASSERT_TRUE(back.contains("noise_pooling"));
+  EXPECT_TRUE(back["noise_pooling"].is_null());
+  EXPECT_EQ(back["noise_neighbours"], 8);
+  auto today = old_row;
+  today["noise_pooling"] = "median-screen";
+  EXPECT_EQ(params_read_back(today), today);
 }
 
 }  // namespace

@@ -187,6 +187,7 @@ void compare_colour_73(const Rendering& r, const MeasuredScene& s, const Compare
     c.where = p.id;
     c.rendered = {lr[0], lr[1], lr[2]};
     c.measured = {lm[0], lm[1], lm[2]};
+    c.noise_left_out = noise.own_level(i);
     const double de = analysis::delta_e2000(to_lab(lm), to_lab(lr));
     conclude(c, z * (lr - lm), b, o, de, 1.0, o.cannot_tell_de00);
     v.comparisons.push_back(std::move(c));
@@ -261,6 +262,7 @@ void compare_colour_74(const Rendering& r, const MeasuredScene& s, const Compare
     c.where = p.id;
     c.rendered = {pred[0], pred[1], pred[2]};
     c.measured = {meas[0], meas[1], meas[2]};
+    c.noise_left_out = noise.own_level(i);
     const double unit = 1.0 / std::max(meas.norm(), 1e-12);
     conclude(c, pred - meas, b, o, (pred - meas).norm() * unit, unit, o.cannot_tell_relative);
     v.comparisons.push_back(std::move(c));

@@ -62,6 +62,7 @@ void compare_sites(const Rendering& r, const std::vector<Site>& sites, const cha
     c.where = spot_name(site.row, site.col);
     c.rendered = {lr};
     c.measured = {site.measured};
+    c.noise_left_out = noise.own_level(i);
     conclude(c, Eigen::VectorXd::Constant(1, lr - site.measured), b, o, lr / site.measured - 1, 1 / site.measured,
              o.cannot_tell_relative);
     v.comparisons.push_back(std::move(c));

@@ -26,6 +26,8 @@ struct RenderingNoise {
   std::vector<Eigen::MatrixXd> covariance;
   double lag1_correlation = 0;  // the pooled correlation of horizontally adjacent pixels (for the record)
   std::vector<bool> left_out;   // per region: its residuals not its neighbours' noise, so not pooled into theirs
+  // Whether region i's stated covariance is its own spread alone (left out, with a level of its own to state).
+  bool own_level(std::size_t i) const { return !covariance.empty() && i < left_out.size() && left_out[i]; }
 };
 
 // Throws Error(bad_parameter) for `neighbours` < 1.

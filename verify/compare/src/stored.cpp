@@ -12,8 +12,14 @@ nlohmann::json verification_params(const std::string& rendering, const std::vect
       // Whether the rendering's own noise was budgeted, and over how many regions it was pooled (null when off).
       {"rendering_noise", options.rendering_noise},
       {"noise_neighbours", options.rendering_noise ? nlohmann::json(options.noise_neighbours) : nlohmann::json(nullptr)},
+      {"noise_pooling", options.rendering_noise ? nlohmann::json(kNoisePooling) : nlohmann::json(nullptr)},
   };
   if (!placement.is_null()) params["placement"] = placement;
+  return params;
+}
+
+nlohmann::json params_read_back(nlohmann::json params) {
+  if (params.is_object() && !params.contains("noise_pooling")) params["noise_pooling"] = nullptr;
   return params;
 }
 

@@ -46,6 +46,24 @@ std::vector<double> numbers(const json& o, const char* key, const std::string& w
   return out;
 }
 
+// JSON has one number type: a whole number may arrive as 8.0 (Python's float, any JavaScript client's number), and
+// is that whole number; 8.5, a number beyond int, NaN or infinity (not JSON, but a client may build one), a string or
+// a boolean are not.
+int whole_at_least_1(const json& n, const std::string& name, const std::string& what) {
+  constexpr auto kMax = std::numeric_limits<int>::max();
+  if (!n.is_number()) throw bad(name + " is not a whole number (" + what + "), got " + n.dump());
+  if (n.is_number_float()) {
+    const double d = n.get<double>();
+    if (!std::isfinite(d) || d != std::floor(d)) throw bad(name + " is not a whole number (" + what + "), got " + n.dump());
+    if (d < 1 || d > kMax) throw bad(name + " must be a whole number from 1 to " + std::to_string(kMax) + ", got " + n.dump());
+    return static_cast<int>(d);
+  }
+  const bool in_range = n.is_number_unsigned() ? n.get<std::uint64_t>() >= 1 && n.get<std::uint64_t>() <= static_cast<std::uint64_t>(kMax)
+                                               : n.get<std::int64_t>() >= 1 && n.get<std::int64_t>() <= kMax;
+  if (!in_range) throw bad(name + " must be a whole number from 1 to " + std::to_string(kMax) + ", got " + n.dump());
+  return static_cast<int>(n.get<std::int64_t>());
+}
+
 }  // namespace
 
 Verification verification_from_json(const json& result) {
@@ -76,6 +94,11 @@ Verification verification_from_json(const json& result) {
     const json& tell = field(c, "cannot_tell", at);
     if (!tell.is_boolean()) throw bad(at + ".cannot_tell is not a boolean");
     k.cannot_tell = tell.get<bool>();
+    // Absent: a client from before the screen's outliers were reported (none stated, none known).
+    if (c.contains("noise_left_out") && !c["noise_left_out"].is_null()) {
+      if (!c["noise_left_out"].is_boolean()) throw bad(at + ".noise_left_out is not a boolean");
+      k.noise_left_out = c["noise_left_out"].get<bool>();
+    }
     const json& budget = field(c, "budget", at);
     if (!budget.is_object()) throw bad(at + ".budget is not an object");
     for (const auto& [source, u] : budget.items()) {
@@ -135,17 +158,9 @@ StoredVerification stored_from_request(const json& body) {
       throw bad("body.rendering_noise is not a boolean (whether the rendering's own noise was in the budget)");
     options.rendering_noise = body["rendering_noise"].get<bool>();
   }
-  if (body.contains("noise_neighbours") && !body["noise_neighbours"].is_null()) {
-    const json& n = body["noise_neighbours"];
-    if (!n.is_number_integer()) throw bad("body.noise_neighbours is not a whole number (the regions the rendering's noise was pooled over)");
-    const bool in_range = n.is_number_unsigned() ? n.get<std::uint64_t>() >= 1 &&
-                                                       n.get<std::uint64_t>() <= static_cast<std::uint64_t>(std::numeric_limits<int>::max())
-                                                 : n.get<std::int64_t>() >= 1 && n.get<std::int64_t>() <= std::numeric_limits<int>::max();
-    if (!in_range)
-      throw bad("body.noise_neighbours must be a whole number from 1 to " + std::to_string(std::numeric_limits<int>::max()) +
-                ", got " + n.dump());
-    options.noise_neighbours = static_cast<int>(n.get<std::int64_t>());
-  }
+  if (body.contains("noise_neighbours") && !body["noise_neighbours"].is_null())
+    options.noise_neighbours = whole_at_least_1(body["noise_neighbours"], "body.noise_neighbours",
+                                                "the regions the rendering's noise was pooled over");
   check_options(options);
   json placement;
   if (body.contains("placement") && !body["placement"].is_null()) {
@@ -160,7 +175,21 @@ StoredVerification stored_from_request(const json& body) {
       for (const auto& [source, u] : v.comparisons[i].budget)
         if (source == "rendering noise")
           throw bad("comparisons[" + std::to_string(i) + "].budget has \"rendering noise\" while body.rendering_noise is false");
-  return to_store(v, rendering, runs, options, placement);
+  if (!options.rendering_noise)
+    for (std::size_t i = 0; i < v.comparisons.size(); ++i)
+      if (v.comparisons[i].noise_left_out)
+        throw bad("comparisons[" + std::to_string(i) + "].noise_left_out is true while body.rendering_noise is false");
+  auto stored = to_store(v, rendering, runs, options, placement);
+  // The pooling is the client's engine's, not this daemon's: stored as the body states it, null when it does not (a
+  // client from before the field, whose pooling the body cannot tell).
+  json pooling = body.contains("noise_pooling") ? body["noise_pooling"] : json(nullptr);
+  if (!pooling.is_null()) {
+    if (!options.rendering_noise) throw bad("body.noise_pooling is " + pooling.dump() + " while body.rendering_noise is false");
+    if (pooling != kNoisePooling)
+      throw bad("body.noise_pooling must be \"" + std::string(kNoisePooling) + "\" (or null, not recorded), got " + pooling.dump());
+  }
+  stored.params["noise_pooling"] = pooling;
+  return stored;
 }
 
 json store_request(const Verification& v, const std::string& rendering, const std::vector<std::string>& against,

@@ -58,9 +58,10 @@ nlohmann::json Verification::summary() const {
     int differ = 0, cannot = 0;
     std::vector<double> diffs;
     const Comparison* worst = nullptr;
-    nlohmann::json wrong = nlohmann::json::array(), blind = nlohmann::json::array();
+    nlohmann::json wrong = nlohmann::json::array(), blind = nlohmann::json::array(), own = nlohmann::json::array();
     for (const auto* c : list) {
       diffs.push_back(std::abs(c->difference));
+      if (c->noise_left_out) own.push_back(c->where);
       if (c->verdict == Verdict::differs) {
         ++differ;
         wrong.push_back({{"where", c->where}, {"difference", c->difference}, {"expanded", c->expanded}});
@@ -86,6 +87,9 @@ nlohmann::json Verification::summary() const {
     k["median_abs_difference"] = diffs.empty() ? 0.0 : diffs[diffs.size() / 2];
     k["renderer_wrong_at"] = wrong;
     k["measurement_cannot_tell_at"] = blind;
+    // Where the rendering-noise screen judged a region's residuals not the noise its neighbours share: its band
+    // there is its own spread (wide when it is the scene's texture), and it was kept out of the others' pools.
+    k["rendering_noise_left_out"] = own;
     if (worst) k["worst"] = {{"where", worst->where}, {"difference", worst->difference}, {"expanded", worst->expanded}};
     kinds[kind] = k;
   }
@@ -110,6 +114,7 @@ nlohmann::json Verification::to_json() const {
         {"threshold", c.threshold},
         {"verdict", to_string(c.verdict)},
         {"cannot_tell", c.cannot_tell},
+        {"noise_left_out", c.noise_left_out},
         {"budget", budget},
     });
   }

@@ -89,7 +89,28 @@ def header(run, s) -> str:
             f'against {", ".join(against) or "—"}. Scale: '
             + (f"given, {esc(scale)} renderer unit → cd/m²" if scale is not None else "fitted per kind (a fitted "
                "factor cannot see a lamp that is uniformly too bright)")
-            + (f"; used: {how}" if how else "") + ".</p>")
+            + (f"; used: {how}" if how else "") + ". " + noise_note(run, p) + "</p>")
+
+
+# How a stored verification's rendering noise was pooled, by its params' `noise_pooling` (verify/compare/stored.hpp).
+POOLING = {"median-screen": "each region screened against the median of its neighbours' levels first, an outlier "
+                            "left out of their pool and judged by its own spread"}
+
+
+def noise_note(run, p) -> str:
+    """The rendering-noise source as the stored params say it was made: off, or pooled over how many regions and how
+    (a verification stored before `noise_pooling` existed has none: not recorded)."""
+    if p.get("rendering_noise") is False:
+        return (f'<span id="{run.short}-verify-noise" data-noise-pooling="off">Rendering noise: not in the budget '
+                "(the renderer stated its image exact).</span>")
+    n = p.get("noise_neighbours", 8)
+    pooling = p.get("noise_pooling")
+    how = (esc(POOLING.get(pooling, pooling)) if pooling is not None else
+           "not recorded (stored before colorlab said it: plain sums over the neighbours if made before "
+           "2026-11-29's robust screen, the screen if after)")
+    return (f'<span id="{run.short}-verify-noise" data-noise-pooling="{esc(pooling or "not recorded")}">Rendering '
+            f"noise: in the budget, its level pooled over the {esc(n if n is not None else 8)} nearest regions of a "
+            f"kind; pooling: {how}.</span>")
 
 
 def summary_table(run, s) -> str:
@@ -114,7 +135,8 @@ def summary_table(run, s) -> str:
                   "Issue 23's bound for a faithful rendering: ≥ 95 % agree. Relative differences in %.")
 
 
-def wrong_and_blind(run, s) -> str:
+def wrong_and_blind(run, s, items_of=None) -> str:
+    items_of = items_of or {}
     out = []
     for kind, k in (s.get("kinds") or {}).items():
         rel = vd.is_relative(kind)
@@ -134,6 +156,13 @@ def wrong_and_blind(run, s) -> str:
                               f"</span>" for b in blind)
             out.append(f"<li><b>The measurement cannot tell</b> ({name}), {len(blind)} place(s) whose band is wider "
                        f"than 2{unit} — a renderer error that small would go unseen there: {items}.</li>")
+        own = vd.noise_left_out(kind, k, items_of.get(kind, []))
+        if own:
+            places = ", ".join(f'<span data-noise-left-out="{esc(w)}">{esc(w)}</span>' for w in own)
+            out.append(f"<li><b>Rendering noise judged on its own</b> ({name}), {len(own)} place(s): {places} — the "
+                       "screen found its pixels' spread beyond what its neighbours' noise explains (a texture, an "
+                       "edge, a firefly), so its rendering-noise uncertainty is its own spread alone and it was kept "
+                       "out of the others' pooled level.</li>")
     if not out:
         out.append("<li>Every comparison agrees within its k = 2 band, and every band is narrow enough to tell.</li>")
     return f'<ul id="{run.short}-verify-where">' + "".join(out) + "</ul>"
@@ -208,7 +237,7 @@ def section(run) -> str:
     items = vd.comparisons(run)
     s = vd.summary(run, items)
     kinds = vd.by_kind(items)
-    out = [header(run, s), summary_table(run, s), wrong_and_blind(run, s)]
+    out = [header(run, s), summary_table(run, s), wrong_and_blind(run, s, kinds)]
     svg = maps.chart_map(kinds, f"{run.short}-verify-chart-map")
     if svg:
         out.append(figure(f"{run.short}-fig-verify-chart", svg, "The chart as compared: each patch's difference in "

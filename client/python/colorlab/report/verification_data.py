@@ -23,7 +23,7 @@ _PATCH = re.compile(r"^([A-Z])(\d{1,2})$")
 def _plain(v):
     if isinstance(v, np.ndarray):
         return [float(x) for x in v.ravel()]
-    if isinstance(v, (np.floating, np.integer)):
+    if isinstance(v, (np.floating, np.integer, np.bool_)):
         return v.item()
     if isinstance(v, float) and math.isnan(v):
         return None
@@ -32,7 +32,8 @@ def _plain(v):
 
 def comparisons(run) -> list[dict]:
     """The stored comparisons in stored order: kind, where, rendered, measured, difference, expanded,
-    mahalanobis, threshold, verdict, cannot_tell, budget {source: standard uncertainty}."""
+    mahalanobis, threshold, verdict, cannot_tell, noise_left_out (None when stored before it was), budget {source:
+    standard uncertainty}."""
     m = run.measurements
     if m.empty:
         return []
@@ -46,7 +47,7 @@ def comparisons(run) -> list[dict]:
             where = row.get("data.where")
         c = {"kind": kind, "where": str(where), "step": row.step}
         for key in ("rendered", "measured", "difference", "expanded", "mahalanobis", "threshold", "verdict",
-                    "cannot_tell"):
+                    "cannot_tell", "noise_left_out"):
             c[key] = _plain(row.get(f"data.{key}"))
         if c["difference"] is None:
             c["difference"] = float(row.value)
@@ -77,6 +78,15 @@ def summary(run, items) -> dict:
     if "verdict" not in s:
         s["verdict"] = "differs" if any(c["verdict"] == "differs" for c in items) else "agrees"
     return s
+
+
+def noise_left_out(kind, k, items) -> list[str]:
+    """Where the rendering-noise screen left a region out (its own spread its band's rendering noise): the summary's
+    list for the kind, else the comparisons' flags; [] for a verification stored before either existed."""
+    listed = k.get("rendering_noise_left_out") if isinstance(k, dict) else None
+    if isinstance(listed, list):
+        return [str(w) for w in listed]
+    return [c["where"] for c in items if c.get("noise_left_out") is True]
 
 
 def spot_rc(where: str):

@@ -99,6 +99,48 @@ def stored_verification():
     return RunData(doc, measurements_frame(items)), comps
 
 
+def textured_verification(noise_pooling="median-screen", rendering_noise=True):
+    """A verification stored today (params with its noise pooling) where the screen left one spot out."""
+    comps = [comparison("light_spot", f"r0c{c}", [100.0], [100.0], 0.001, 0.02, False, {"rendering noise": 0.002})
+             for c in range(10)]
+    comps[4]["noise_left_out"] = True
+    comps[4]["budget"]["rendering noise"] = 0.03
+    for c in comps:
+        c.setdefault("noise_left_out", False)
+    items = [{"seq": i + 1, "step": f"light_spot/{c['where']}", "instrument_id": "verify", "quantity": "relative_difference",
+              "value": c["difference"], "unit": "1", "measured_at": "2026-11-29T06:00:00Z", "simulated": False, "data": c}
+             for i, c in enumerate(comps)]
+    summary = {"verdict": "agrees", "coverage_k": 2, "scales": [], "kinds": {"light_spot": {
+        "compared": 10, "agree": 10, "differ": 0, "agree_fraction": 1.0, "median_abs_difference": 0.001,
+        "renderer_wrong_at": [], "measurement_cannot_tell_at": [], "rendering_noise_left_out": ["r0c4"]}}}
+    params = {"rendering": "box.exr", "against": ["g"], "scale": 1.0, "k": 2, "rendering_noise": rendering_noise,
+              "noise_neighbours": 8 if rendering_noise else None, "noise_pooling": noise_pooling}
+    doc = {"id": "01a20a70-bc32-7d8d-bc85-0000000000f2", "campaign": "verify", "status": "finished_ok",
+           "simulated": False, "instruments": [], "params": params, "summary": summary}
+    return RunData(doc, measurements_frame(items))
+
+
+class NoiseScreenInTheReport(unittest.TestCase):
+    def test_the_left_out_spot_is_named_and_the_pooling_said(self):
+        cells = parse(render([textured_verification()]))
+        named = [a["data-noise-left-out"] for t, a in cells.tags if "data-noise-left-out" in a]
+        self.assertEqual(named, ["r0c4"])
+        pooling = [a["data-noise-pooling"] for t, a in cells.tags if "data-noise-pooling" in a]
+        self.assertEqual(pooling, ["median-screen"])
+        self.assertIn("its own spread alone", "".join(cells.text))
+
+    def test_from_the_comparisons_when_the_summary_lacks_the_list(self):
+        run = textured_verification()
+        del run.doc["summary"]["kinds"]["light_spot"]["rendering_noise_left_out"]
+        cells = parse(render([run]))
+        self.assertEqual([a["data-noise-left-out"] for t, a in cells.tags if "data-noise-left-out" in a], ["r0c4"])
+
+    def test_off_says_off(self):
+        run = textured_verification(noise_pooling=None, rendering_noise=False)
+        cells = parse(render([run]))
+        self.assertEqual([a["data-noise-pooling"] for t, a in cells.tags if "data-noise-pooling" in a], ["off"])
+
+
 class Cells(HTMLParser):
     """Every <td>'s attributes and text, and every <tr data-row>'s data-verdict."""
 
@@ -144,6 +186,15 @@ class VerificationSection(unittest.TestCase):
         cls.vrun, cls.comps = stored_verification()
         cls.html = render([cls.vrun])
         cls.cells = parse(cls.html)
+
+    def test_a_row_stored_before_the_pooling_was_recorded_says_so(self):
+        # stored_verification()'s params have no noise fields, as a verification stored before them: not recorded,
+        # and no region named as left out (nothing stored says so).
+        self.assertNotIn("noise_pooling", self.vrun.doc["params"])
+        pooling = [a["data-noise-pooling"] for t, a in self.cells.tags if "data-noise-pooling" in a]
+        self.assertEqual(pooling, ["not recorded"])
+        self.assertIn("pooling: not recorded", "".join(self.cells.text))
+        self.assertFalse([a for t, a in self.cells.tags if "data-noise-left-out" in a])
 
     def test_kind_and_section(self):
         self.assertEqual(kind_of(self.vrun), "verify")

@@ -79,9 +79,14 @@ class VerifyTest(unittest.TestCase):
         self.assertEqual(self.called()["argv"][-2:], ["--no-rendering-noise", "--store"])
         lab.verify("box.exr", against=["a1"], noise_neighbours=4)
         self.assertEqual(self.called()["argv"][-2:], ["--noise-neighbours", "4"])
+        # JSON's one number type: a whole-valued float is that whole number, passed on as an integer.
+        lab.verify("box.exr", against=["a1"], noise_neighbours=8.0)
+        self.assertEqual(self.called()["argv"][-2:], ["--noise-neighbours", "8"])
         # Not a whole number >= 1: refused here, before colorlab is run (the binary records its argv when it is).
         self.args.unlink()
-        for bad, error in ((0, ValueError), (-3, ValueError), (2.5, TypeError), ("8", TypeError), (True, TypeError)):
+        for bad, error in ((0, ValueError), (-3, ValueError), (2.5, ValueError), (0.0, ValueError), (-8.0, ValueError),
+                           (float("nan"), ValueError), (float("inf"), ValueError), (1e300, ValueError),
+                           ("8", TypeError), ("8.0", TypeError), (True, TypeError), ([8], TypeError)):
             with self.assertRaises(error):
                 lab.verify("box.exr", against=["a1"], noise_neighbours=bad)
         with self.assertRaises(ValueError):

@@ -4,6 +4,7 @@
 
 #include "colorlab/core/error.hpp"
 #include "colorlab/protocol/api.hpp"
+#include "colorlab/verify/compare/stored.hpp"
 #include "handlers.hpp"
 #include "query.hpp"
 #include "report_response.hpp"
@@ -11,6 +12,17 @@
 namespace colorlab::daemon::routes {
 
 using nlohmann::json;
+
+namespace {
+
+// A run as it reads back: a verification stored before a params field existed gets it as not recorded.
+json read_back(const store::RunRecord& r) {
+  json j = r.to_json();
+  if (r.campaign == verify::kVerifyCampaign && j.contains("params")) j["params"] = verify::params_read_back(j["params"]);
+  return j;
+}
+
+}  // namespace
 
 HttpResponse get_runs(ApiContext& ctx, const HttpRequest& req, const PathParams&) {
   unsigned limit = page_limit(req);
@@ -21,7 +33,7 @@ HttpResponse get_runs(ApiContext& ctx, const HttpRequest& req, const PathParams&
   if (auto it = req.query.find("status"); it != req.query.end()) filter.status = it->second;
   auto page = ctx.reads().runs(limit, cursor, filter);
   json items = json::array();
-  for (const auto& r : page.runs) items.push_back(r.to_json());
+  for (const auto& r : page.runs) items.push_back(read_back(r));
   json links = json::object();
   if (page.next_cursor) {
     std::string next = std::string(protocol::kPrefix) + "/runs?limit=" + std::to_string(limit) + "&cursor=" + *page.next_cursor;
@@ -40,7 +52,7 @@ HttpResponse get_run(ApiContext& ctx, const HttpRequest&, const PathParams& para
   auto& reads = ctx.reads();
   auto r = reads.run(id);
   if (!r) throw Error(ErrorClass::not_found, "no run with id '" + id + "'");
-  json j = r->to_json();
+  json j = read_back(*r);
   j["measurement_count"] = reads.measurement_count(id);
   const std::string self = std::string(protocol::kPrefix) + "/runs/" + id;
   j["links"] = {{"measurements", self + "/measurements"}, {"blobs", self + "/blobs"}, {"export", self + "/export"}};

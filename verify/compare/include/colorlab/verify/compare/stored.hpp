@@ -15,17 +15,28 @@ namespace colorlab::verify {
 
 inline constexpr const char* kVerifyCampaign = "verify";
 
+// How the rendering's noise level was pooled over a region's neighbours, in a stored verification's params
+// (`noise_pooling`): today's engine screens each region against its neighbours' median first (docs/verify.md "The
+// uncertainty, source by source"). Verifications stored before the field have none, and read back as null: those
+// made before 2026-11-29's robust screen pooled with plain sums, later ones with the screen, and the row cannot say
+// which.
+inline constexpr const char* kNoisePooling = "median-screen";
+
 struct StoredVerification {
-  nlohmann::json params;                           // {rendering, against: [run ids], scale (null: fitted), k, rendering_noise, noise_neighbours[, placement]}
+  nlohmann::json params;                           // {rendering, against: [run ids], scale (null: fitted), k, rendering_noise, noise_neighbours, noise_pooling[, placement]}
   nlohmann::json summary;                          // Verification::summary() plus floor_difference
   std::vector<records::Measurement> measurements;  // step "<kind>/<where>", value = the difference
 };
 
 // What a verification was made with, as a stored verification's params and POST /v1/verifications' body carry it
-// (the body adds `result`): {rendering, against, scale (null: fitted), k, rendering_noise, noise_neighbours (null
-// when the rendering's noise is off)[, placement]}.
+// (the body adds `result`): {rendering, against, scale (null: fitted), k, rendering_noise, noise_neighbours and
+// noise_pooling (both null when the rendering's noise is off)[, placement]}.
 nlohmann::json verification_params(const std::string& rendering, const std::vector<std::string>& against,
                                    const CompareOptions& options, const nlohmann::json& placement = nullptr);
+
+// A stored verification's params as they read back (GET /v1/runs/{id}): one stored before `noise_pooling` existed
+// gets it as null (not recorded), so every verification's params have the same keys.
+nlohmann::json params_read_back(nlohmann::json params);
 
 // `placement`: how the comparison placed the measurement in the rendering (the CLI's `placement`: the floor through
 // the lens calibration or as a pinhole), kept in params when given so the stored verification says which.

@@ -129,6 +129,9 @@ struct Comparison {
   double mahalanobis = 0, threshold = 0;
   Verdict verdict = Verdict::agrees;
   bool cannot_tell = false;
+  // The rendering-noise screen judged this region's residuals an outlier against its neighbours' (a texture, an
+  // edge, a firefly): its `rendering noise` is its own spread alone, and it was kept out of the others' pools.
+  bool noise_left_out = false;
   std::vector<std::pair<std::string, double>> budget;  // standard uncertainty per source along the difference
 };
 
