@@ -44,6 +44,12 @@ static int g_errno;               // 0: no fault
 static int g_hold;                // HOLD: syncs in scope wait
 static char g_scope[PATH_MAX * 2];  // the failing subtree (g_dir or below)
 
+// Set by the shim's constructor. A sanitizer's runtime starts before any constructor (the executable's
+// .preinit_array) and calls mkdir for its report directory while its interceptors are not yet set up: until then every
+// intercepted call passes straight to the kernel, untouched.
+static int g_ready;
+__attribute__((constructor)) static void mark_ready(void) { __atomic_store_n(&g_ready, 1, __ATOMIC_SEQ_CST); }
+
 static void init(void) {
   const char* dir = getenv("COLORLAB_FAULT_DIR");
   const char* control = getenv("COLORLAB_FAULT_CONTROL");
@@ -271,10 +277,12 @@ static int refuse_entry(int dirfd, const char* path) {
   return 1;
 }
 int mkdir(const char* path, mode_t mode) {
+  if (!__atomic_load_n(&g_ready, __ATOMIC_SEQ_CST)) return (int)syscall(SYS_mkdirat, AT_FDCWD, path, mode);
   if (refuse_entry(AT_FDCWD, path)) return -1;
   return REAL(mkdir)(path, mode);
 }
 int mkdirat(int dirfd, const char* path, mode_t mode) {
+  if (!__atomic_load_n(&g_ready, __ATOMIC_SEQ_CST)) return (int)syscall(SYS_mkdirat, dirfd, path, mode);
   if (refuse_entry(dirfd, path)) return -1;
   return REAL(mkdirat)(dirfd, path, mode);
 }
