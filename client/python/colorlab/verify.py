@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import math
+import numbers
 import os
 import subprocess
 from typing import Sequence
@@ -54,13 +55,17 @@ class VerifyMixin:
         if not isinstance(rendering_noise, bool):  # None or 0 would silently narrow every band, "false" keep it
             raise TypeError(f"rendering_noise must be True or False, not {type(rendering_noise).__name__}")
         if noise_neighbours is not None:
-            if isinstance(noise_neighbours, bool) or not isinstance(noise_neighbours, (int, float)):
+            # numbers.Integral / Real: numpy's int64 (a DataFrame's column) and float64 are numbers too.
+            if isinstance(noise_neighbours, bool) or not isinstance(noise_neighbours, numbers.Real):
                 raise TypeError(f"noise_neighbours must be a whole number, not {type(noise_neighbours).__name__}")
-            if isinstance(noise_neighbours, float):
-                # One number type in JSON: 8.0 (from a config, a JSON body, a JS caller) is the whole number 8.
-                if not math.isfinite(noise_neighbours) or not noise_neighbours.is_integer():
-                    raise ValueError(f"noise_neighbours must be a whole number (got {noise_neighbours!r})")
+            if isinstance(noise_neighbours, numbers.Integral):
                 noise_neighbours = int(noise_neighbours)
+            else:
+                # One number type in JSON: 8.0 (from a config, a JSON body, a JS caller) is the whole number 8.
+                value = float(noise_neighbours)
+                if not math.isfinite(value) or not value.is_integer():
+                    raise ValueError(f"noise_neighbours must be a whole number (got {noise_neighbours!r})")
+                noise_neighbours = int(value)
             if noise_neighbours < 1:
                 raise ValueError(f"noise_neighbours must be at least 1 (got {noise_neighbours}): the rendering's noise "
                                  "is pooled over that many nearest regions; rendering_noise=False leaves it out")

@@ -9,6 +9,8 @@ import tempfile
 import unittest
 from pathlib import Path
 
+import numpy as np
+
 import colorlab
 
 RESULT = {"summary": {"verdict": "differs", "kinds": {}, "scales": [{"kind": "light_spot", "how": "given", "factor": 1}]},
@@ -82,10 +84,16 @@ class VerifyTest(unittest.TestCase):
         # JSON's one number type: a whole-valued float is that whole number, passed on as an integer.
         lab.verify("box.exr", against=["a1"], noise_neighbours=8.0)
         self.assertEqual(self.called()["argv"][-2:], ["--noise-neighbours", "8"])
+        # numpy's numbers (a value read from a DataFrame) are numbers too.
+        lab.verify("box.exr", against=["a1"], noise_neighbours=np.int64(6))
+        self.assertEqual(self.called()["argv"][-2:], ["--noise-neighbours", "6"])
+        lab.verify("box.exr", against=["a1"], noise_neighbours=np.float64(5.0))
+        self.assertEqual(self.called()["argv"][-2:], ["--noise-neighbours", "5"])
         # Not a whole number >= 1: refused here, before colorlab is run (the binary records its argv when it is).
         self.args.unlink()
         for bad, error in ((0, ValueError), (-3, ValueError), (2.5, ValueError), (0.0, ValueError), (-8.0, ValueError),
-                           (float("nan"), ValueError), (float("inf"), ValueError), (1e300, ValueError),
+                           (float("nan"), ValueError), (float("inf"), ValueError), (1e300, ValueError), (np.float64(2.5), ValueError),
+                           (np.int64(0), ValueError),
                            ("8", TypeError), ("8.0", TypeError), (True, TypeError), ([8], TypeError)):
             with self.assertRaises(error):
                 lab.verify("box.exr", against=["a1"], noise_neighbours=bad)
