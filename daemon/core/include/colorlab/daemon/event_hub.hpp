@@ -36,9 +36,12 @@ class EventHub {
   bool stopped() const;
 
  private:
+  // The timer belongs to the waiting coroutine. A stream still waiting when its io_context is destroyed (colorlabd
+  // stopping with a follower connected) never gets to erase its entry; held strongly here, its timer was then
+  // destroyed with the hub, after its io_context's services were gone (a use-after-free ASan caught at exit).
   struct Waiter {
     boost::asio::any_io_executor executor;
-    std::shared_ptr<boost::asio::steady_timer> timer;
+    std::weak_ptr<boost::asio::steady_timer> timer;
   };
   void run();
   void wake_all();
