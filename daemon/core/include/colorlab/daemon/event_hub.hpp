@@ -36,9 +36,8 @@ class EventHub {
   bool stopped() const;
 
  private:
-  // The timer belongs to the waiting coroutine. A stream still waiting when its io_context is destroyed (colorlabd
-  // stopping with a follower connected) never gets to erase its entry; held strongly here, its timer was then
-  // destroyed with the hub, after its io_context's services were gone (a use-after-free ASan caught at exit).
+  // An entry lives as long as its waiting coroutine's frame (wait_beyond erases it however the frame ends), and its
+  // timer belongs to that frame: held weakly, so no entry can keep a timer past its io_context.
   struct Waiter {
     boost::asio::any_io_executor executor;
     std::weak_ptr<boost::asio::steady_timer> timer;
