@@ -388,6 +388,7 @@ int Daemon::run() {
     d.notifier.stopping();
     d.lag.stop();
     d.server->stop();
+    d.events->stop();  // event streams still waiting are woken (and end) while their io_contexts are alive
     d.monitor->stop();
     d.queue->shutdown();  // starts nothing more; stays started in the store for the next daemon
     // Running steps finish (or their waits are cut short), then the instruments go to a safe state.

@@ -1,5 +1,7 @@
 #include "colorlab/daemon/event_hub.hpp"
 
+#include <optional>
+
 #include <boost/asio/post.hpp>
 #include <boost/asio/redirect_error.hpp>
 #include <boost/asio/this_coro.hpp>
@@ -55,28 +57,39 @@ void EventHub::run() {
 void EventHub::wake_all() {
   std::lock_guard lock(mutex_);
   // Each timer is cancelled on its own executor: Asio timers are not safe to touch from two threads.
-  for (auto& w : waiters_) asio::post(w.executor, [timer = w.timer] { timer->cancel(); });
+  // A timer already gone is a stream whose io_context went with it: nothing to wake, and nowhere to post.
+  for (auto& w : waiters_)
+    if (auto timer = w.timer.lock()) asio::post(w.executor, [timer] { timer->cancel(); });
 }
 
 asio::awaitable<bool> EventHub::wait_beyond(std::int64_t seq, std::chrono::milliseconds timeout) {
   if (latest_.load() > seq) co_return true;
   auto executor = co_await asio::this_coro::executor;
   auto timer = std::make_shared<asio::steady_timer>(executor, timeout);
-  std::list<Waiter>::iterator me;
+  // Erased however the wait ends, also when the stream's io_context destroys this coroutine without resuming it
+  // (colorlabd stopping with a follower connected): an entry left behind would hold that io_context's executor and
+  // timer past its services' end (ASan's heap-use-after-free at exit).
+  struct Registration {
+    EventHub& hub;
+    std::list<Waiter>::iterator me;
+    ~Registration() {
+      std::lock_guard lock(hub.mutex_);
+      hub.waiters_.erase(me);
+    }
+  };
+  std::optional<Registration> registered;
   {
     std::lock_guard lock(mutex_);
     if (stopping_) co_return false;
-    me = waiters_.insert(waiters_.end(), Waiter{executor, timer});
+    // Made in place: a moved-from temporary's destructor would erase the entry at once.
+    registered.emplace(*this, waiters_.insert(waiters_.end(), Waiter{executor, timer}));
   }
   // Registered before this second look: a wake between the first look and now is not missed.
   if (latest_.load() <= seq) {
     boost::system::error_code ec;
     co_await timer->async_wait(asio::redirect_error(asio::use_awaitable, ec));
   }
-  {
-    std::lock_guard lock(mutex_);
-    waiters_.erase(me);
-  }
+  registered.reset();
   co_return latest_.load() > seq;
 }
 

@@ -45,8 +45,8 @@ static int g_hold;                // HOLD: syncs in scope wait
 static char g_scope[PATH_MAX * 2];  // the failing subtree (g_dir or below)
 
 // Set by the shim's constructor. A sanitizer's runtime starts before any constructor (the executable's
-// .preinit_array) and calls mkdir for its report directory while its interceptors are not yet set up: until then every
-// intercepted call passes straight to the kernel, untouched.
+// .preinit_array) and calls mkdir for its report directory while its interceptors are not yet set up: until then
+// mkdir and mkdirat (the only calls seen that early) go straight to the kernel, untouched.
 static int g_ready;
 __attribute__((constructor)) static void mark_ready(void) { __atomic_store_n(&g_ready, 1, __ATOMIC_SEQ_CST); }
 
