@@ -57,9 +57,7 @@ void EventHub::run() {
 void EventHub::wake_all() {
   std::lock_guard lock(mutex_);
   // Each timer is cancelled on its own executor: Asio timers are not safe to touch from two threads.
-  // A timer already gone is a stream whose io_context went with it: nothing to wake, and nowhere to post.
-  for (auto& w : waiters_)
-    if (auto timer = w.timer.lock()) asio::post(w.executor, [timer] { timer->cancel(); });
+  for (auto& w : waiters_) asio::post(w.executor, [timer = w.timer] { timer->cancel(); });
 }
 
 asio::awaitable<bool> EventHub::wait_beyond(std::int64_t seq, std::chrono::milliseconds timeout) {

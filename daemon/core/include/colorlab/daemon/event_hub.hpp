@@ -36,11 +36,11 @@ class EventHub {
   bool stopped() const;
 
  private:
-  // An entry lives as long as its waiting coroutine's frame (wait_beyond erases it however the frame ends), and its
-  // timer belongs to that frame: held weakly, so no entry can keep a timer past its io_context.
+  // An entry lives no longer than its waiting coroutine's frame (wait_beyond erases it however the frame ends), so
+  // its executor and timer never outlive their io_context.
   struct Waiter {
     boost::asio::any_io_executor executor;
-    std::weak_ptr<boost::asio::steady_timer> timer;
+    std::shared_ptr<boost::asio::steady_timer> timer;
   };
   void run();
   void wake_all();
