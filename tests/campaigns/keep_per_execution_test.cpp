@@ -1,7 +1,8 @@
-// Two executions at once on one lab (a direct start beside the night queue: the daemon does not forbid it). A call
-// suspends (the camera, the keeping worker) while the other execution's calls go on; the frames a call keeps must
-// still be named in the steps of the execution whose call kept them. Truth: the keeper's own list of what it kept,
-// all of it kept by A's calls. Bound, exact: every reference the keeper handed out is in A's steps, in the order
+// Two executions at once on one lab. The daemon now refuses a second start while one is unfinished (LabBusy),
+// but two can still run together: resume_unfinished relaunches every execution a database from before that
+// refusal left running. A call suspends (the camera, the keeping worker) while the other execution's calls go on;
+// the frames a call keeps must still be named in the steps of the execution whose call kept them. Truth: the
+// keeper's own list of what it kept, all of it kept by A's calls. Bound, exact: every reference the keeper handed out is in A's steps, in the order
 // kept, none in B's, and no execution's ledger is left once both have ended.
 //
 // The interleaving is forced, not hoped for: A's call keeps its average, then its preview, and the keeper holds the

@@ -352,13 +352,25 @@ TEST(queue_daemon, APausedItemHoldsTheQueueAndStopLetsTheRunningItemFinish) {
   EXPECT_EQ(run_count(api), 1u) << "a stopped queue starts nothing more";
 }
 
-// The lab has one set of instruments: a run started by hand holds the queue as much as its own items.
+// The lab has one set of instruments: a run started by hand holds the queue as much as its own items, and
+// refuses a second start by hand (409 lab-busy naming it) while a retry of its own POST still gets it back.
 TEST(queue_daemon, ARunStartedByHandHoldsTheQueueUntilItEnds) {
   TempDir dir;
   DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), 4, 1));
   auto api = api_for(daemon);
-  auto manual = api.post("/v1/executions", {{"campaign", "luminance-spot"}, {"params", spot(400)}});
-  std::string manual_id = manual["id"];
+  const json body{{"campaign", "luminance-spot"}, {"params", spot(400)}};
+  auto started = api.request("POST", "/v1/executions", body.dump(), {{"Idempotency-Key", "by-hand-1"}});
+  ASSERT_EQ(started.status, 202) << started.body;
+  std::string manual_id = json::parse(started.body)["id"];
+  auto retried = api.request("POST", "/v1/executions", body.dump(), {{"Idempotency-Key", "by-hand-1"}});
+  EXPECT_EQ(retried.status, 202) << retried.body;
+  EXPECT_EQ(json::parse(retried.body)["id"], manual_id) << "a retried POST is the same execution, not a busy lab";
+  auto second = problem_of([&] { api.post("/v1/executions", {{"campaign", "luminance-spot"}, {"params", spot(1)}}); });
+  EXPECT_EQ(second.status, 409);
+  EXPECT_EQ(second.code, "lab-busy");
+  EXPECT_NE(second.detail.find(manual_id), std::string::npos) << second.detail;
+  EXPECT_FALSE(second.hint.empty());
+  EXPECT_EQ(run_count(api), 1u) << "the refused start stored a run";
   std::string item = enqueue(api, "luminance-spot", spot(1))["id"];
   api.post("/v1/queue/start", json::object());
   auto q = wait_queue(

@@ -2,6 +2,7 @@
 
 #include "colorlab/protocol/api.hpp"
 #include "colorlab/protocol/problem.hpp"
+#include "colorlab/daemon/executions.hpp"
 #include "colorlab/daemon/worker_pool.hpp"
 #include "colorlab/store/queue.hpp"
 
@@ -39,6 +40,11 @@ http::HttpResponse error_response(const Error& e, const std::string& instance) {
     auto r = respond(p, nlohmann::json::object());
     r.headers["Retry-After"] = std::to_string(full->retry_after_s());
     return r;
+  }
+  // Another execution holds the lab: named, so a client can follow or abort it.
+  if (const auto* busy = dynamic_cast<const LabBusy*>(&e)) {
+    p.code = "lab-busy";
+    return respond(p, {{"execution_id", busy->execution_id()}});
   }
   return respond(p, nlohmann::json::object());
 }

@@ -200,10 +200,22 @@ asio::awaitable<json> Executions::dry_run(const std::string& campaign_name, cons
   co_return co_await std::move(report);
 }
 
+LabBusy::LabBusy(const store::ExecutionRecord& holder)
+    : Error(ErrorClass::conflict,
+            "the lab is busy: execution " + holder.id + " (" + holder.campaign + ") is " +
+                std::string(protocol::to_string(holder.status)),
+            "wait for it to end or abort it (colorlab abort " + holder.id +
+                "), or queue this campaign (colorlab queue add): the night queue starts it when the lab is free"),
+      execution_id_(holder.id) {}
+
 store::ExecutionRecord Executions::start(const std::string& campaign_name, const json& params,
                                          const std::optional<std::string>& idempotency_key) {
   if (shutting_down_) throw Error(ErrorClass::conflict, "colorlabd is shutting down", "start the campaign after it restarts");
   auto [script, normalized] = validate_campaign_request(catalogue_, lab_, campaign_name, params);
+  if (idempotency_key) {
+    if (auto existing = store_.execution_with_idempotency_key(*idempotency_key)) return *existing;
+  }
+  if (auto unfinished = store_.unfinished_executions(); !unfinished.empty()) throw LabBusy(unfinished.front());
 
   store::NewRun run;
   run.campaign = campaign_name;

@@ -152,9 +152,7 @@ Store::Store(const fs::path& database_path, SecondWriter) {
 
 Store::Created Store::create_execution(const NewRun& run) {
   if (run.idempotency_key) {
-    auto st = db_.prepare("SELECT id FROM executions WHERE idempotency_key = ?1");
-    st.bind(1, std::string_view(*run.idempotency_key));
-    if (st.step()) return {*execution(st.text(0)), false};
+    if (auto existing = execution_with_idempotency_key(*run.idempotency_key)) return {*existing, false};
   }
   ExecutionRecord e;
   e.id = new_uuid_v7();
@@ -531,6 +529,13 @@ bool Store::has_measurement(const std::string& run_id, const std::string& step) 
 std::optional<ExecutionRecord> Store::execution(const std::string& id) {
   auto st = db_.prepare(std::string("SELECT ") + kExecutionColumns + " FROM executions WHERE id = ?1");
   st.bind(1, std::string_view(id));
+  if (!st.step()) return std::nullopt;
+  return read_execution(st);
+}
+
+std::optional<ExecutionRecord> Store::execution_with_idempotency_key(const std::string& key) {
+  auto st = db_.prepare(std::string("SELECT ") + kExecutionColumns + " FROM executions WHERE idempotency_key = ?1");
+  st.bind(1, std::string_view(key));
   if (!st.step()) return std::nullopt;
   return read_execution(st);
 }

@@ -29,6 +29,17 @@ class Notifier;
 class WorkerPool;
 class StepCommitter;
 
+// A campaign start refused because the lab is in use: one set of instruments, one execution at a time.
+// The API answers 409 `lab-busy` naming the execution that holds the lab (`execution_id`).
+class LabBusy : public Error {
+ public:
+  explicit LabBusy(const store::ExecutionRecord& holder);
+  const std::string& execution_id() const noexcept { return execution_id_; }
+
+ private:
+  std::string execution_id_;
+};
+
 struct ExecutionOptions {
   CrashLoopPolicy crash_loop;          // includes max_resume_attempts
   std::filesystem::path state_dir;     // where runs are stored (a dry run checks its free space)
@@ -44,7 +55,10 @@ class Executions {
              std::function<void(const std::string&)> status_text = {});
   ~Executions();
 
-  // Validates, records and launches. Throws Error{bad_parameter|not_found} before anything starts.
+  // Validates, records and launches. Throws Error{bad_parameter|not_found} before anything starts, and
+  // LabBusy while another execution is unfinished (running, paused or suspended: it holds the
+  // instruments, the lamps and whatever the operator placed; the night queue waits for it likewise).
+  // A retried POST with the same Idempotency-Key gets its execution back, also while it holds the lab.
   store::ExecutionRecord start(const std::string& campaign, const nlohmann::json& params,
                                const std::optional<std::string>& idempotency_key);
   // The campaign run against a lab that moves nothing (campaigns/dry_run.hpp): limits, instruments,

@@ -220,6 +220,8 @@ class Store {
   bool has_measurement(const std::string& run_id, const std::string& step);
 
   std::optional<ExecutionRecord> execution(const std::string& id);
+  // The execution a POST with this Idempotency-Key started, if one did.
+  std::optional<ExecutionRecord> execution_with_idempotency_key(const std::string& key);
   std::optional<RunRecord> run(const std::string& id);
   std::vector<MeasurementRecord> measurements(const std::string& run_id);
   // Keyset page of a run's measurements in seq order, after `after_seq` (0: from the start).
