@@ -83,6 +83,19 @@ std::string human(const json& j) {
       if (wrong.size() > 8) out << " … (" << wrong.size() << " in all; --json lists them)";
       out << "\n";
     }
+    // The noise screen's verdict is part of the result: a region judged on its own spread says where the band
+    // came from when it is wider than its neighbours'.
+    if (k.contains("rendering_noise_left_out") && !k["rendering_noise_left_out"].empty()) {
+      const json& own = k["rendering_noise_left_out"];
+      out << "    the rendering's noise judged on its own at:";
+      std::size_t shown_n = 0;
+      for (const auto& where : own) {
+        if (++shown_n > 8) break;
+        out << " " << where.get<std::string>();
+      }
+      if (own.size() > 8) out << " … (" << own.size() << " in all; --json lists them)";
+      out << " (its band there is its own spread, kept out of its neighbours' pools)\n";
+    }
     const json& blind = k["measurement_cannot_tell_at"];
     if (!blind.empty())
       out << "    the measurement cannot tell at " << blind.size() << " (band wider than the cannot-tell limit; --json names "

@@ -8,6 +8,8 @@
 #include <cmath>
 #include <iostream>
 #include <map>
+#include <optional>
+#include <random>
 #include <stdexcept>
 #include <utility>
 #include <fstream>
@@ -38,7 +40,12 @@ json control(const DaemonProcess& daemon, const json& command) {
 // The true floor as an image from the photograph's view: each pixel mapped to the floor and given the true
 // luminance of the grid cell it falls in (piecewise constant, so a spot's region, well inside its 60 × 54 mm cell,
 // sees exactly its spot's truth). XYZ with the D65 white's chromaticity; Y in cd/m², so the scale is 1.
-verify::Rendering true_floor(const json& truth, double gain) {
+// `textured`: every pixel gets a path tracer's 2 % relative noise (seeded), and that grid cell a ±30 % pixel
+// checkerboard around its truth on top (its mean unchanged): the texture the rendering-noise screen must judge on its
+// own, among neighbours whose noise it can pool.
+verify::Rendering true_floor(const json& truth, double gain, std::optional<std::pair<int, int>> textured = std::nullopt) {
+  std::mt19937 draw(23);
+  std::normal_distribution<double> noise(0.0, 0.02);
   std::array<std::array<double, 2>, 4> corners{};
   for (int i = 0; i < 4; ++i) corners[i] = {truth["floor_corners_px"][i][0].get<double>(), truth["floor_corners_px"][i][1].get<double>()};
   const analysis::FloorMap map(corners, kFloorW, kFloorD);
@@ -55,7 +62,9 @@ verify::Rendering true_floor(const json& truth, double gain) {
       const auto f = map.floor_of(x, y);
       const int col = std::clamp(static_cast<int>(std::floor(f[0] / kPitchX)), 0, 19);
       const int row = std::clamp(static_cast<int>(std::floor(f[1] / kPitchY)), 0, 7);
-      const double Y = gain * lum.at({row, col});
+      double texture = 1.0;
+      if (textured) texture = (*textured == std::pair{row, col} ? ((x + y) % 2 ? 1.3 : 0.7) : 1.0) * (1.0 + noise(draw));
+      const double Y = gain * texture * lum.at({row, col});
       float* p = r.pixels.data() + (static_cast<std::size_t>(y) * r.width + x) * 3;
       p[0] = static_cast<float>(Y * 0.95047), p[1] = static_cast<float>(Y), p[2] = static_cast<float>(Y * 1.08883);
     }
@@ -360,6 +369,43 @@ void rendering_noise_options_are_recorded_and_checked() {
   }
 }
 
+// One spot's cell textured among noisy neighbours: the screen judges that region on its own spread (the truth: the
+// planted cell, whose band is then the widest of its kind), and the plain-text summary names the regions left out as
+// the JSON lists them; a faithful rendering's summary names none. The test's floor is piecewise constant, so regions
+// that straddle a cell's edge are left out too (an edge is not noise); the bound is on the planted one.
+void a_textured_spot_is_named_in_the_plain_text_summary() {
+  const json& spot = (*truth_)["spots"][0];
+  const std::pair cell{spot["row"].get<int>(), spot["col"].get<int>()};
+  verify::write_openexr(true_floor(*truth_, 1.0, cell), dir_->path() / "textured.exr");
+  const std::string planted = "r" + std::to_string(cell.first) + "c" + std::to_string(cell.second);
+  auto args = verify_args("textured.exr");
+  const auto r = cli(args);
+  ASSERT_TRUE(r.exit_code == 0 || r.exit_code == 4) << r.err;
+  const json result = json::parse(r.out);
+  args.erase(std::find(args.begin(), args.end(), "--json"));
+  const auto text = cli(args);
+  ASSERT_TRUE(text.exit_code == 0 || text.exit_code == 4) << text.err;
+  for (const auto& [kind, k] : result["summary"]["kinds"].items()) {
+    const json& own = k["rendering_noise_left_out"];
+    EXPECT_NE(std::find(own.begin(), own.end(), planted), own.end()) << kind << ": " << own.dump();
+    std::string widest;
+    double widest_noise = -1;
+    for (const auto& c : result["comparisons"]) {
+      if (c["kind"] != kind) continue;
+      const double n = c["budget"].value("rendering noise", 0.0);
+      if (n > widest_noise) widest_noise = n, widest = c["where"];
+    }
+    EXPECT_EQ(widest, planted) << kind;
+    std::string line = "    the rendering's noise judged on its own at:";
+    for (std::size_t i = 0; i < std::min<std::size_t>(own.size(), 8); ++i) line += " " + own[i].get<std::string>();
+    EXPECT_NE(text.out.find(line), std::string::npos) << line << "\n" << text.out;
+  }
+  auto faithful = verify_args("faithful.exr");
+  faithful.erase(std::find(faithful.begin(), faithful.end(), "--json"));
+  const auto plain = cli(faithful);
+  EXPECT_EQ(plain.out.find("judged on its own"), std::string::npos) << plain.out;
+}
+
 }  // namespace
 
 // One daemon and one pair of campaigns for every check (ctest runs each TEST in its own process): the campaigns are
@@ -394,6 +440,10 @@ TEST(VerifyCli, EndToEndAgainstTheSimulatedLab) {
   {
     SCOPED_TRACE("the rendering's noise options");
     rendering_noise_options_are_recorded_and_checked();
+  }
+  {
+    SCOPED_TRACE("a textured spot in the plain-text summary");
+    a_textured_spot_is_named_in_the_plain_text_summary();
   }
   Lab::stop();
 }
