@@ -398,7 +398,8 @@ void a_textured_spot_is_named_in_the_plain_text_summary() {
     EXPECT_EQ(widest, planted) << kind;
     std::string line = "    the rendering's noise judged on its own at:";
     for (std::size_t i = 0; i < std::min<std::size_t>(own.size(), 8); ++i) line += " " + own[i].get<std::string>();
-    EXPECT_NE(text.out.find(line), std::string::npos) << line << "\n" << text.out;
+    EXPECT_NE(text.out.find(line), std::string::npos) << line << "\n"
+                                                      << text.out;
   }
   auto faithful = verify_args("faithful.exr");
   faithful.erase(std::find(faithful.begin(), faithful.end(), "--json"));
