@@ -90,9 +90,10 @@ class ExecutionsMixin:
               **kwargs: Any) -> Execution:
         """Start ``campaign`` with its parameters as keywords (or ``params={...}``). The request carries an
         idempotency key (a fresh one unless given), so the retry after a lost answer can never start the
-        campaign twice. One execution at a time on a lab: while another is unfinished (running, paused or
-        suspended) this raises ``Conflict`` with ``code == "lab-busy"`` and ``problem["execution_id"]`` naming
-        it; ``enqueue`` has a campaign start when the lab is free."""
+        campaign twice. One execution at a time on a lab: while another is unfinished (waiting, running, paused
+        or suspended) this raises ``Conflict`` with ``code == "lab-busy"`` and ``problem["execution_id"]``
+        naming it (after ``abort``, ``wait`` for it to end first); ``enqueue`` with the queue started
+        (``start_queue``) has a campaign start when the lab is free."""
         body_params = dict(params or {})
         body_params.update(kwargs)
         key = idempotency_key or f"python-{uuid.uuid4()}"

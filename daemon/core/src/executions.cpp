@@ -205,7 +205,8 @@ LabBusy::LabBusy(const store::ExecutionRecord& holder)
             "the lab is busy: execution " + holder.id + " (" + holder.campaign + ") is " +
                 std::string(protocol::to_string(holder.status)),
             "wait for it to end or abort it (colorlab abort " + holder.id +
-                "), or queue this campaign (colorlab queue add): the night queue starts it when the lab is free"),
+                "), or queue this campaign (colorlab queue add; colorlab queue start if the queue is stopped): the "
+                "queue starts it when the lab is free, after the items before it"),
       execution_id_(holder.id) {}
 
 store::ExecutionRecord Executions::start(const std::string& campaign_name, const json& params,
@@ -544,6 +545,11 @@ store::ExecutionRecord Executions::resume(const std::string& id) {
                 "only a paused or suspended execution can be resumed");
   }
   if (shutting_down_) throw Error(ErrorClass::conflict, "colorlabd is shutting down");
+  // One execution at a time holds the lab, a resumed one too (two are unfinished only in a database from before
+  // that rule, or a restored backup).
+  if (!active_.empty()) {
+    if (auto other = store_.execution(active_.begin()->first)) throw LabBusy(*other);
+  }
   const bool crash_loop = is_crash_loop(record.suspension);
   cancel_backoff(id);
   relaunch(record, record.status == ExecutionStatus::paused,

@@ -156,6 +156,10 @@ void NightQueue::start_next() {
     auto execution = executions_.start(next->campaign, next->params, store::queue_execution_key(next->id));
     queue_.mark_running(next->id, execution.id);
     log::info("queue", describe_item(*next) + " started as execution " + execution.id);
+  } catch (const LabBusy& busy) {
+    // Not the item's fault: it waits, as above (the check there and the refusal agree today; this keeps a
+    // disagreement from skipping the item and halting the night).
+    waiting_for_ = busy.execution_id();
   } catch (const Error& e) {
     if (e.cls() == ErrorClass::io_error) throw;  // the disk, not the item: try again at the next poll
     // The script was removed or edited since the item was queued, or an instrument it needs is gone.

@@ -5,6 +5,9 @@
 
 #include <filesystem>
 
+#include <sqlite3.h>
+
+#include "colorlab/core/error.hpp"
 #include "store_verification.hpp"
 
 namespace colorlab::verify {
@@ -47,6 +50,45 @@ TEST(VerifyStore, ReadBackAsARun) {
   ASSERT_EQ(rows.size(), 2u);
   EXPECT_EQ(rows[1].step, "light_spot/r0c1");
   EXPECT_EQ(rows[1].data["verdict"], "differs");
+  std::filesystem::remove_all(dir);
+}
+
+// A write that fails after the execution was created (a trigger stands in for the disk refusing the rows): the
+// error reaches the caller, and the execution is ended, not left unfinished to hold the lab (one execution at a time)
+// until the next start-up.
+TEST(VerifyStore, AFailedWriteLeavesNoUnfinishedExecution) {
+  const auto dir = std::filesystem::temp_directory_path() / ("verify-store-fail-" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  Rendering r;
+  r.width = 20;
+  r.height = 10;
+  r.encoding = Encoding::xyz;
+  r.pixels.assign(20 * 10 * 3, 50.0f);
+  MeasuredScene m;
+  SpotMeasurement s;
+  s.luminance_cd_m2 = 100;
+  s.reading_sd = 1;
+  s.rendering_region = {2, 2, 4, 4};
+  m.spots.push_back(s);
+  CompareOptions o;
+  o.scale = 2.0;
+  const auto v = compare(r, m, o);
+  {
+    store::Store st(dir / "colorlab.db");
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open((dir / "colorlab.db").c_str(), &db), SQLITE_OK);
+    ASSERT_EQ(sqlite3_exec(db, "CREATE TRIGGER refuse BEFORE INSERT ON measurements BEGIN SELECT RAISE(ABORT, 'refused'); END",
+                           nullptr, nullptr, nullptr),
+              SQLITE_OK);
+    sqlite3_close(db);
+    EXPECT_THROW(store_verification(st, to_store(v, "render.exr", {"run-a"}, o)), colorlab::Error);
+    EXPECT_TRUE(st.unfinished_executions().empty());
+  }
+  store::Store st(dir / "colorlab.db", store::Store::ReadOnly{});
+  const auto page = st.runs(10, std::nullopt);
+  ASSERT_EQ(page.runs.size(), 1u);
+  EXPECT_EQ(page.runs[0].status, "finished_error");
   std::filesystem::remove_all(dir);
 }
 

@@ -56,7 +56,7 @@ class Executions {
   ~Executions();
 
   // Validates, records and launches. Throws Error{bad_parameter|not_found} before anything starts, and
-  // LabBusy while another execution is unfinished (running, paused or suspended: it holds the
+  // LabBusy while another execution is unfinished (waiting, running, paused or suspended: it holds the
   // instruments, the lamps and whatever the operator placed; the night queue waits for it likewise).
   // A retried POST with the same Idempotency-Key gets its execution back, also while it holds the lab.
   store::ExecutionRecord start(const std::string& campaign, const nlohmann::json& params,
@@ -71,6 +71,7 @@ class Executions {
   // the crash-loop guard suspends (or, its retries spent, ends) and one waiting out the guard's back-off.
   void resume_unfinished();
   store::ExecutionRecord pause(const std::string& id);
+  // Throws LabBusy while another execution runs.
   store::ExecutionRecord resume(const std::string& id);
   store::ExecutionRecord abort(const std::string& id);
   // SIGTERM: running executions stop at their next safe point as `suspended` (resumed at the next
