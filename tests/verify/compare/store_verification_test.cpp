@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <string>
 
 #include <sqlite3.h>
 
@@ -13,15 +14,26 @@
 namespace colorlab::verify {
 namespace {
 
-TEST(VerifyStore, ReadBackAsARun) {
-  const auto dir = std::filesystem::temp_directory_path() / ("verify-store-" + std::to_string(::getpid()));
+std::filesystem::path fresh_dir(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / (name + "-" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
+  return dir;
+}
+
+// A flat 20 × 10 XYZ rendering at Y = 50.
+Rendering flat_rendering() {
   Rendering r;
   r.width = 20;
   r.height = 10;
   r.encoding = Encoding::xyz;
   r.pixels.assign(20 * 10 * 3, 50.0f);
+  return r;
+}
+
+TEST(VerifyStore, ReadBackAsARun) {
+  const auto dir = fresh_dir("verify-store");
+  const Rendering r = flat_rendering();
   MeasuredScene m;
   for (int i = 0; i < 2; ++i) {
     SpotMeasurement s;
@@ -57,14 +69,8 @@ TEST(VerifyStore, ReadBackAsARun) {
 // error reaches the caller, and the execution is ended, not left unfinished to hold the lab (one execution at a time)
 // until the next start-up.
 TEST(VerifyStore, AFailedWriteLeavesNoUnfinishedExecution) {
-  const auto dir = std::filesystem::temp_directory_path() / ("verify-store-fail-" + std::to_string(::getpid()));
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  Rendering r;
-  r.width = 20;
-  r.height = 10;
-  r.encoding = Encoding::xyz;
-  r.pixels.assign(20 * 10 * 3, 50.0f);
+  const auto dir = fresh_dir("verify-store-fail");
+  const Rendering r = flat_rendering();
   MeasuredScene m;
   SpotMeasurement s;
   s.luminance_cd_m2 = 100;
