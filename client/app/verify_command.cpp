@@ -56,6 +56,17 @@ std::string shown(const std::string& kind, double x) {
   return kind == "colour_7_3" ? fixed(x, 2) + " ΔE00" : fixed(100 * x, 2) + " %";
 }
 
+// The first eight items of a list, each after a space, and how many there are when that is not all of them.
+template <class Describe>
+void list_first_eight(std::ostringstream& out, const json& items, Describe describe) {
+  std::size_t n = 0;
+  for (const auto& item : items) {
+    if (++n > 8) break;
+    out << " " << describe(item);
+  }
+  if (items.size() > 8) out << " … (" << items.size() << " in all; --json lists them)";
+}
+
 std::string human(const json& j) {
   std::ostringstream out;
   const json& s = j["summary"];
@@ -75,25 +86,16 @@ std::string human(const json& j) {
     const json& wrong = k["renderer_wrong_at"];
     if (!wrong.empty()) {
       out << "    renderer differs at:";
-      std::size_t shown_n = 0;
-      for (const auto& w : wrong) {
-        if (++shown_n > 8) break;
-        out << " " << w["where"].get<std::string>() << " " << shown(kind, w["difference"].get<double>());
-      }
-      if (wrong.size() > 8) out << " … (" << wrong.size() << " in all; --json lists them)";
+      list_first_eight(out, wrong, [&](const json& w) {
+        return w["where"].get<std::string>() + " " + shown(kind, w["difference"].get<double>());
+      });
       out << "\n";
     }
     // The noise screen's verdict is part of the result: a region judged on its own spread says where the band
     // came from when it is wider than its neighbours'.
     if (k.contains("rendering_noise_left_out") && !k["rendering_noise_left_out"].empty()) {
-      const json& own = k["rendering_noise_left_out"];
       out << "    the rendering's noise judged on its own at:";
-      std::size_t shown_n = 0;
-      for (const auto& where : own) {
-        if (++shown_n > 8) break;
-        out << " " << where.get<std::string>();
-      }
-      if (own.size() > 8) out << " … (" << own.size() << " in all; --json lists them)";
+      list_first_eight(out, k["rendering_noise_left_out"], [](const json& where) { return where.get<std::string>(); });
       out << " (its band there is its own spread, kept out of its neighbours' pools)\n";
     }
     const json& blind = k["measurement_cannot_tell_at"];
