@@ -1,14 +1,21 @@
 #include "colorlab/store/sqlite.hpp"
 
+#include <pthread.h>
 #include <sqlite3.h>
 
 #include <chrono>
+#include <cmath>
 
 #include "colorlab/core/error.hpp"
 #include "colorlab/core/log.hpp"
 #include "colorlab/store/writer_wait.hpp"
 
 namespace colorlab::store {
+
+namespace {
+// Beyond the API's target for an answer (issue 27): a wait this long behind one transaction is worth a line in the log.
+constexpr std::chrono::milliseconds kLongWriteLockHold{50};
+}  // namespace
 
 Database::Database(const std::string& path, bool read_only) : path_(path) {
   int flags = read_only ? SQLITE_OPEN_READONLY : (SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE);
@@ -165,6 +172,7 @@ ReadTransaction::~ReadTransaction() {
 Transaction::Transaction(Database& db) : db_(db) {
   WriterWaitTimer timed;
   db_.exec("BEGIN IMMEDIATE");
+  holding_since_ = std::chrono::steady_clock::now();
 }
 
 Transaction::~Transaction() {
@@ -178,9 +186,18 @@ Transaction::~Transaction() {
 }
 
 void Transaction::commit() {
-  WriterWaitTimer timed;
-  db_.exec("COMMIT");
+  {
+    WriterWaitTimer timed;
+    db_.exec("COMMIT");
+  }
   done_ = true;
+  const std::chrono::duration<double, std::milli> held = std::chrono::steady_clock::now() - holding_since_;
+  if (held >= kLongWriteLockHold) {
+    char thread[16] = "?";
+    pthread_getname_np(pthread_self(), thread, sizeof thread);
+    log::warning("store", "a transaction held the write lock " + std::to_string(std::lround(held.count())) +
+                              " ms (thread " + thread + "); other writers waited as long");
+  }
 }
 
 }  // namespace colorlab::store

@@ -8,6 +8,7 @@
 #include "colorlab/core/ids.hpp"
 #include "colorlab/core/log.hpp"
 #include "colorlab/store/blob_index.hpp"
+#include "colorlab/store/busy_retry.hpp"
 #include "colorlab/store/schema.hpp"
 #include "colorlab/store/ship_log.hpp"
 #include "colorlab/store/wal_policy.hpp"
@@ -89,7 +90,7 @@ Store::Store(const fs::path& database_path) {
                                           ec.message());
   }
   db_ = Database(database_path.string(), false);
-  db_.exec("PRAGMA busy_timeout = " + std::to_string(kBusyTimeoutMs));
+  retry_promptly_when_busy(db_, kBusyTimeout);
   {
     auto st = db_.prepare("PRAGMA journal_mode = WAL");
     st.step();
@@ -136,14 +137,14 @@ Store::Store(const fs::path& database_path) {
 
 Store::Store(const fs::path& database_path, ReadOnly) {
   db_ = Database(database_path.string(), true);
-  db_.exec("PRAGMA busy_timeout = 5000");
+  retry_promptly_when_busy(db_, kBusyTimeout);
   db_.exec("PRAGMA query_only = ON");
   db_.exec("PRAGMA temp_store = MEMORY");
 }
 
 Store::Store(const fs::path& database_path, SecondWriter) {
   db_ = Database(database_path.string(), false);
-  db_.exec("PRAGMA busy_timeout = " + std::to_string(kBusyTimeoutMs));
+  retry_promptly_when_busy(db_, kBusyTimeout);
   db_.exec("PRAGMA synchronous = FULL");
   db_.exec("PRAGMA foreign_keys = ON");
   apply_wal_policy(db_);

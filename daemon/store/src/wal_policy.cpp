@@ -5,6 +5,7 @@
 #include <string>
 
 #include "colorlab/core/log.hpp"
+#include "colorlab/store/busy_retry.hpp"
 
 namespace colorlab::store {
 
@@ -26,9 +27,9 @@ void bound_wal(Database& db) noexcept {
   int log_frames = 0, checkpointed = 0;
   // Without the busy handler: the writer runs on the daemon's io thread, which must not wait for a long
   // reader (an export); a checkpoint a reader prevents now is tried again after the next commit.
-  sqlite3_busy_timeout(db.handle(), 0);
+  never_wait_when_busy(db);
   const int rc = sqlite3_wal_checkpoint_v2(db.handle(), nullptr, SQLITE_CHECKPOINT_RESTART, &log_frames, &checkpointed);
-  sqlite3_busy_timeout(db.handle(), kBusyTimeoutMs);
+  retry_promptly_when_busy(db, kBusyTimeout);
   if (rc != SQLITE_OK && rc != SQLITE_BUSY) {
     log::warning("store", std::string("cannot checkpoint the WAL past its limit: ") + sqlite3_errstr(rc));
   }

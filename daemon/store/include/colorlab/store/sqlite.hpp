@@ -1,6 +1,7 @@
 #pragma once
 // A thin RAII layer over the SQLite C API. Every failure becomes colorlab::Error: io_error for
 // disk-level trouble (full, read-only, I/O), conflict for constraint violations, internal otherwise.
+#include <chrono>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -96,6 +97,9 @@ class Transaction {
  private:
   Database& db_;
   bool done_ = false;
+  // From BEGIN IMMEDIATE's return: a commit that held the write lock long is logged, since every other writer —
+  // the io thread among them — waited that long (busy_retry.hpp).
+  std::chrono::steady_clock::time_point holding_since_;
 };
 
 }  // namespace colorlab::store
