@@ -7,6 +7,7 @@
 // is the test's switch, and every wait is bounded with a message.
 #include <chrono>
 #include <filesystem>
+#include <fstream>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -112,6 +113,52 @@ TEST(CommitOffIoThread, MainRoutesAnswerWhileAStepsSyncIsHeldAndTheStepAppearsOn
     measured += ev["payload"].value("measurements", std::size_t{0});
   }
   EXPECT_EQ(measured, static_cast<std::size_t>(kReadings));
+  daemon->kill9();
+  EXPECT_EQ(integrity_check(faults.state_dir()), "ok");
+}
+
+// A run's last step — committed when its script ends, with no lab call after it — is off the io thread too: before
+// 2026-11-30 the engine committed it there, synchronously, and every main route waited for its fsync (up to 92 ms
+// measured, docs/PERFORMANCE.md "The writers' wait for the lock").
+TEST(CommitOffIoThread, MainRoutesAnswerWhileARunsLastStepIsHeldInItsSync) {
+  TempDir dir;
+  DiskFaults faults(dir / "state", dir / "fault");
+  std::filesystem::create_directories(dir / "state" / "campaigns");
+  // One lab call (5 s of wall time at time scale 100: the test sets the hold meanwhile), then a measurement and the
+  // end: the measurement's step is committed only when the script has ended.
+  std::ofstream(dir / "state" / "campaigns" / "last-step.lua") << R"lua(
+return {
+  description = "test: a wait, then one measurement as the run's last step",
+  needs = {},
+  parameters = {},
+  run = function(p)
+    lab.wait(500)
+    lab.record("last", { quantity = "count", value = 1, unit = "1" })
+  end,
+}
+)lua";
+  auto daemon = faults.start(write_daemon_config(dir.path(), 100, 3));
+  auto api = api_for(*daemon);
+  const json e = api.post("/v1/executions", {{"campaign", "last-step"}, {"params", json::object()}});
+  const std::string id = e["id"], run_id = e["run_id"];
+  ASSERT_TRUE(wait_for([&] { return api.get("/v1/executions/" + id)["status"] == "running"; }))
+      << "the run did not start within 60 s";
+
+  faults.fail("HOLD");
+  const auto held = std::filesystem::path(dir / "fault").string() + ".held";
+  ASSERT_TRUE(wait_for([&] { return std::filesystem::exists(held); })) << "the last step's commit never reached its sync";
+  EXPECT_TRUE(api.get("/v1").is_object());
+  EXPECT_TRUE(api.get("/v1/control").is_object());
+  EXPECT_TRUE(api.get("/v1/queue").is_object());
+  const json during = api.get("/v1/executions/" + id);
+  EXPECT_EQ(during["status"], "running") << "the run ended before its last step was durable: " << during.dump(2);
+  EXPECT_EQ(stored_rows(api, run_id), 0U) << "the held step's row showed before its sync returned";
+  ASSERT_TRUE(std::filesystem::exists(held));
+
+  faults.mend();
+  const json done = wait_terminal(api, id);
+  ASSERT_EQ(done["status"], "finished_ok") << done.dump(2);
+  EXPECT_EQ(stored_rows(api, run_id), 1U);
   daemon->kill9();
   EXPECT_EQ(integrity_check(faults.state_dir()), "ok");
 }

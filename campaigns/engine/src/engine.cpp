@@ -79,6 +79,18 @@ class ScriptRun final : public LabCallSink {
       // first; a deliberate crash (not a std::exception) is left as it is, like the process it stands for.
       unexpected = std::current_exception();
     }
+    // The run ends here (finished, failed or stopped): its last step is committed as each step before a lab call
+    // is, without holding the io thread through the fsync (it held it up to 92 ms, docs/PERFORMANCE.md). A disk that
+    // refuses it suspends the run, as it would have refused that step before a call.
+    if (last_step_due_ && !unexpected) {
+      try {
+        co_await flush_awaiting();
+      } catch (const Error& e) {
+        failed_outside_script(e);
+      } catch (const std::exception&) {
+        unexpected = std::current_exception();
+      }
+    }
     // Whatever the outcome: a script's own "put it back" step is not reached when it fails or stops mid-way.
     co_await lab_.put_back(state_);
     // Ended, however: what its calls kept is in its steps (or was no call's).
@@ -209,7 +221,7 @@ class ScriptRun final : public LabCallSink {
       outcome_.kind = RunOutcome::Kind::failed;
       outcome_.error = e;
       outcome_.script_location = location(calling_line(thread_));
-      flush();
+      last_step_due_ = true;
       co_return std::nullopt;
     }
   }
@@ -322,7 +334,7 @@ class ScriptRun final : public LabCallSink {
     outcome_.result = nresults > 0 ? to_json(thread_, -1, file_ + "'s result") : json(nullptr);
     outcome_.kind = RunOutcome::Kind::finished;
     progress(1.0, "done");
-    flush();
+    last_step_due_ = true;
   }
 
   // A runtime error in the script (or a limit it hit). A script that knows what a person must do
@@ -353,7 +365,7 @@ class ScriptRun final : public LabCallSink {
     outcome_.error = Error(std::move(raised));
     outcome_.script_location = location(line_of(message, file_));
     outcome_.script_location["traceback"] = traceback;
-    flush();
+    last_step_due_ = true;
   }
 
   void failed_outside_script(const Error& e) {
@@ -369,7 +381,7 @@ class ScriptRun final : public LabCallSink {
 
   // Stops at a safe point for a pause, abort or shutdown; what is pending is committed first.
   void stop_for(const ExecutionControl& c) {
-    flush();
+    last_step_due_ = true;
     switch (c.request) {
       case ExecutionControl::Request::pause: outcome_.kind = RunOutcome::Kind::paused; break;
       case ExecutionControl::Request::abort: outcome_.kind = RunOutcome::Kind::aborted; break;
@@ -378,16 +390,7 @@ class ScriptRun final : public LabCallSink {
     outcome_.reason = c.reason;
   }
 
-  void flush() {
-    if (pending_.journal.empty() && pending_.measurements.empty() && !progress_changed_) return;
-    pending_.progress = progress_;
-    pending_.label = label_;
-    sink_.commit(pending_);
-    pending_ = StepCommit{};
-    progress_changed_ = false;
-  }
-
-  // flush() without holding the daemon's io thread while the step is made durable.
+  // The step so far, committed off the daemon's io thread (the sink's commit_awaiting) while the io thread serves.
   asio::awaitable<void> flush_awaiting() {
     if (pending_.journal.empty() && pending_.measurements.empty() && !progress_changed_) co_return;
     pending_.progress = progress_;
@@ -427,6 +430,7 @@ class ScriptRun final : public LabCallSink {
   std::string label_;
   double progress_ = 0;
   bool progress_changed_ = false;
+  bool last_step_due_ = false;  // set where the run ends; run() commits the pending step then
 };
 
 }  // namespace

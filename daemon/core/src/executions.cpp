@@ -64,7 +64,8 @@ class StoreSink final : public campaigns::ExecutionSink {
     IoStage stage("commit step");
     store_.commit_step(record_, records_of(step));
   }
-  // Before each live call: on the committer's thread, the io thread serving meanwhile (step_committer.hpp).
+  // Every step the engine commits (before each live call, and the last when the run ends): on the committer's
+  // thread, the io thread serving meanwhile (step_committer.hpp).
   asio::awaitable<void> commit_awaiting(const campaigns::StepCommit& step) override {
     if (!committer_) {
       commit(step);

@@ -41,9 +41,10 @@ class ExecutionSink {
   virtual ~ExecutionSink() = default;
   // Durable on return; throws Error{io_error} if the disk refused it (nothing is half-stored).
   virtual void commit(const StepCommit& step) = 0;
-  // The same, durable when it completes: the daemon commits a step before each live call this way, on
-  // a thread of its own, so that its io thread serves meanwhile (issue 27). The step is copied before
-  // the first suspension; the engine does nothing else for this execution until it completes.
+  // The same, durable when it completes: the engine commits every step this way (before each live call, and the
+  // last when the run ends), and the daemon runs it on a thread of its own, so that its io thread serves meanwhile
+  // (issue 27). The step is copied before the first suspension; the engine does nothing else for this execution
+  // until it completes.
   virtual boost::asio::awaitable<void> commit_awaiting(const StepCommit& step) {
     commit(step);
     co_return;
