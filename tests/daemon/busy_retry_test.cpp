@@ -1,6 +1,6 @@
 // A writer finding SQLite's write lock held (colorlab/store/busy_retry.hpp): it waits and writes once the lock is
 // released, and gives up with a typed error after its timeout. How soon after the release it gets the lock, beside
-// SQLite's own handler, is measured in bench/daemon (bench_daemon_store, BM_WriterWaitsForTheLock).
+// SQLite's own handler, is measured in bench/daemon (bench_daemon_writer_wait, BM_WriterWaitsForTheLock).
 #include <future>
 #include <thread>
 

@@ -132,6 +132,51 @@ void commit_through(const std::string& how, const std::string& cause_text) {
   EXPECT_EQ(integrity_check(faults.state_dir()), "ok");
 }
 
+// The run's last step — committed once its script has ended, with no lab call after it — through a full disk: the
+// run is suspended with the cause, as for any other step, and finishes with the step once there is room. (Before
+// 2026-11-30 the engine ended the run there: the suspension it asked for could not be stored on the full disk, and
+// the execution stayed "running" until the next start.)
+TEST(DiskFaults, AFullDiskAtTheRunsLastStepSuspendsItUntilThereIsRoomAndTheStepIsKept) {
+  TempDir dir;
+  DiskFaults faults(dir / "state", dir / "fault");
+  std::filesystem::create_directories(dir / "state" / "campaigns");
+  // One lab call (5 s of wall time at the time scale: the test fills the disk meanwhile), then the measurement.
+  std::ofstream(dir / "state" / "campaigns" / "last-step.lua") << R"lua(
+return {
+  description = "test: a wait, then one measurement as the run's last step",
+  needs = {},
+  parameters = {},
+  run = function(p)
+    lab.wait(500)
+    lab.record("last", { quantity = "count", value = 1, unit = "1" })
+  end,
+}
+)lua";
+  auto daemon = faults.start(write_daemon_config(dir.path(), kTimeScale, 3, kSuspendConfig));
+  auto api = api_for(*daemon);
+  const json e = api.post("/v1/executions", {{"campaign", "last-step"}, {"params", json::object()}});
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (api.get("/v1/executions/" + e["id"].get<std::string>())["status"] != "running" &&
+         std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  faults.fail("ENOSPC");
+  const std::string reason = wait_suspended(api, e);
+  EXPECT_EQ(reason.rfind("storage: ", 0), 0u) << reason;
+  EXPECT_TRUE(run_of(api, e)["measurements"].empty()) << "a row of the refused step was stored";
+  std::this_thread::sleep_for(std::chrono::milliseconds(600));  // three of the engine's attempts to commit
+  EXPECT_EQ(api.get("/v1/executions/" + e["id"].get<std::string>())["status"], "suspended");
+  faults.mend();
+  const json done = wait_terminal(api, e["id"]);
+  ASSERT_EQ(done["status"], "finished_ok") << done.dump(2);
+  EXPECT_TRUE(resumed_after_storage(api)) << "no resumed_after_suspension {condition: storage} in the event log";
+  const json rows = run_of(api, e)["measurements"];
+  ASSERT_EQ(rows.size(), 1U);
+  EXPECT_EQ(rows[0]["step"], "last");
+  daemon->kill9();
+  EXPECT_EQ(integrity_check(faults.state_dir()), "ok");
+}
+
 TEST(DiskFaults, AFullDiskDuringACommitSuspendsTheRunUntilThereIsRoomAndNothingIsLost) {
   commit_through("ENOSPC", "full");
 }

@@ -80,13 +80,18 @@ class ScriptRun final : public LabCallSink {
       unexpected = std::current_exception();
     }
     // The run ends here (finished, failed or stopped): its last step is committed as each step before a lab call
-    // is, without holding the io thread through the fsync (it held it up to 92 ms, docs/PERFORMANCE.md). A disk that
-    // refuses it suspends the run, as it would have refused that step before a call.
+    // is, without holding the io thread through the fsync (it held it up to 92 ms, docs/PERFORMANCE.md), and a disk
+    // that refuses it suspends the run until there is room, so that the step is kept. A stop requested while it
+    // waits ends the run as that stop, the step uncommitted (a resume measures it again).
     if (last_step_due_ && !unexpected) {
       try {
-        co_await flush_awaiting();
+        co_await commit_pending_step();
       } catch (const Error& e) {
-        failed_outside_script(e);
+        if (e.cls() == ErrorClass::aborted && control_.requested()) {
+          stop_for(control_);
+        } else {
+          failed_outside_script(e);
+        }
       } catch (const std::exception&) {
         unexpected = std::current_exception();
       }
@@ -200,7 +205,7 @@ class ScriptRun final : public LabCallSink {
     try {
       // A call's cost includes committing the step before it: the dry run adds up whole calls.
       const auto started = std::chrono::steady_clock::now();
-      const bool storage_suspended = co_await commit_before_call();
+      const bool storage_suspended = co_await commit_pending_step();
       bool restored_now = false;
       if (restore_pending_) {
         restored_now = true;
@@ -226,9 +231,9 @@ class ScriptRun final : public LabCallSink {
     }
   }
 
-  // The step before this call is whole: commit it before anything moves. A disk that refuses it
-  // suspends the execution until there is room; nothing is lost meanwhile. True if it suspended.
-  asio::awaitable<bool> commit_before_call() {
+  // The step so far is whole (a lab call is next, or the run ends): commit it before anything moves. A disk that
+  // refuses it suspends the execution until there is room; nothing is lost meanwhile. True if it suspended.
+  asio::awaitable<bool> commit_pending_step() {
     bool storage_suspended = false;
     for (;;) {
       std::optional<Error> refused;

@@ -481,7 +481,9 @@ void Executions::launch(store::ExecutionRecord record, std::shared_ptr<const cam
               store_.set_execution_status(record, ExecutionStatus::paused, outcome.reason);
               break;
             case Kind::suspended: {
-              // A shutdown's suspension ends with the next start; the disk's is the operator's business.
+              // A shutdown's suspension ends with the next start; the disk's is the operator's business, whether
+              // the disk refused the run's start here or, in the engine, its last step's commit.
+              if (outcome.error && outcome.error->cls() == ErrorClass::io_error) storage_suspended = true;
               json problem = storage_suspended && outcome.error ? protocol::problem_from_error(*outcome.error).to_json() : json(nullptr);
               json document{{"category", storage_suspended ? "storage" : "shutdown"}};
               if (!problem.is_null()) document["problem"] = problem;
