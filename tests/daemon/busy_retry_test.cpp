@@ -36,32 +36,43 @@ int rows(const std::string& path) {
   return static_cast<int>(st.int64(0));
 }
 
-// Holds the write lock on a thread of its own until `release` is set; `held` is set once it has it.
-std::thread hold_the_lock(const std::string& path, std::promise<void>& held, std::shared_future<void> release) {
-  return std::thread([&path, &held, release] {
-    Database db(path, false);
-    Transaction tx(db);
-    db.exec("INSERT INTO written VALUES ('holder')");
-    held.set_value();
-    release.wait();
-    tx.commit();
-  });
-}
+// Another connection holds the write lock, on a thread of its own, from SetUp until release().
+class BusyRetry : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    path_ = wal_database(dir_);
+    std::promise<void> held;
+    holder_ = std::thread([this, &held, released = release_.get_future()] {
+      Database db(path_, false);
+      Transaction tx(db);
+      db.exec("INSERT INTO written VALUES ('holder')");
+      held.set_value();
+      released.wait();
+      tx.commit();
+    });
+    held.get_future().wait();
+  }
+  void TearDown() override { release(); }
+  void release() {
+    if (!holder_.joinable()) return;
+    release_.set_value();
+    holder_.join();
+  }
+
+  TempDir dir_;
+  std::string path_;
+  std::promise<void> release_;
+  std::thread holder_;
+};
 
 }  // namespace
 
-TEST(BusyRetry, AWriterWaitsForTheHeldLockAndWritesOnceItIsReleased) {
-  TempDir dir;
-  const auto path = wal_database(dir);
-  std::promise<void> held, release;
-  auto holder = hold_the_lock(path, held, release.get_future().share());
-  held.get_future().wait();
-
-  Database waiter(path, false);
+TEST_F(BusyRetry, AWriterWaitsForTheHeldLockAndWritesOnceItIsReleased) {
+  Database waiter(path_, false);
   colorlab::store::retry_promptly_when_busy(waiter, 5000ms);
-  std::thread releaser([&] {
+  std::thread releaser([this] {
     std::this_thread::sleep_for(60ms);  // many retry intervals: the waiter is refused many times first
-    release.set_value();
+    release();
   });
   {
     Transaction tx(waiter);
@@ -69,18 +80,11 @@ TEST(BusyRetry, AWriterWaitsForTheHeldLockAndWritesOnceItIsReleased) {
     tx.commit();
   }
   releaser.join();
-  holder.join();
-  EXPECT_EQ(rows(path), 2) << "both writers' rows are committed";
+  EXPECT_EQ(rows(path_), 2) << "both writers' rows are committed";
 }
 
-TEST(BusyRetry, AWriterGivesUpWithATypedErrorAfterItsTimeoutAndWritesNothing) {
-  TempDir dir;
-  const auto path = wal_database(dir);
-  std::promise<void> held, release;
-  auto holder = hold_the_lock(path, held, release.get_future().share());
-  held.get_future().wait();
-
-  Database waiter(path, false);
+TEST_F(BusyRetry, AWriterGivesUpWithATypedErrorAfterItsTimeoutAndWritesNothing) {
+  Database waiter(path_, false);
   colorlab::store::retry_promptly_when_busy(waiter, 50ms);
   try {
     Transaction tx(waiter);
@@ -89,22 +93,13 @@ TEST(BusyRetry, AWriterGivesUpWithATypedErrorAfterItsTimeoutAndWritesNothing) {
     EXPECT_EQ(e.cls(), ErrorClass::io_error);
     EXPECT_NE(std::string(e.what()).find("is locked"), std::string::npos) << e.what();
   }
-  release.set_value();
-  holder.join();
-  EXPECT_EQ(rows(path), 1) << "only the holder's row";
+  release();
+  EXPECT_EQ(rows(path_), 1) << "only the holder's row";
 }
 
-TEST(BusyRetry, WithoutWaitingAHeldLockIsRefusedAtOnce) {
-  TempDir dir;
-  const auto path = wal_database(dir);
-  std::promise<void> held, release;
-  auto holder = hold_the_lock(path, held, release.get_future().share());
-  held.get_future().wait();
-
-  Database waiter(path, false);
+TEST_F(BusyRetry, WithoutWaitingAHeldLockIsRefusedAtOnce) {
+  Database waiter(path_, false);
   colorlab::store::retry_promptly_when_busy(waiter, 5000ms);
   colorlab::store::never_wait_when_busy(waiter);
   EXPECT_THROW(Transaction tx(waiter), Error);
-  release.set_value();
-  holder.join();
 }

@@ -7,12 +7,12 @@
 // is the test's switch, and every wait is bounded with a message.
 #include <chrono>
 #include <filesystem>
-#include <fstream>
 #include <thread>
 
 #include <gtest/gtest.h>
 
 #include "disk_fault_support.hpp"
+#include "last_step_campaign.hpp"
 #include "resume_support.hpp"
 
 using namespace colorlab;
@@ -123,20 +123,7 @@ TEST(CommitOffIoThread, MainRoutesAnswerWhileAStepsSyncIsHeldAndTheStepAppearsOn
 TEST(CommitOffIoThread, MainRoutesAnswerWhileARunsLastStepIsHeldInItsSync) {
   TempDir dir;
   DiskFaults faults(dir / "state", dir / "fault");
-  std::filesystem::create_directories(dir / "state" / "campaigns");
-  // One lab call (5 s of wall time at time scale 100: the test sets the hold meanwhile), then a measurement and the
-  // end: the measurement's step is committed only when the script has ended.
-  std::ofstream(dir / "state" / "campaigns" / "last-step.lua") << R"lua(
-return {
-  description = "test: a wait, then one measurement as the run's last step",
-  needs = {},
-  parameters = {},
-  run = function(p)
-    lab.wait(500)
-    lab.record("last", { quantity = "count", value = 1, unit = "1" })
-  end,
-}
-)lua";
+  write_last_step_campaign(dir / "state");
   auto daemon = faults.start(write_daemon_config(dir.path(), 100, 3));
   auto api = api_for(*daemon);
   const json e = api.post("/v1/executions", {{"campaign", "last-step"}, {"params", json::object()}});

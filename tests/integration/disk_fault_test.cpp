@@ -11,6 +11,7 @@
 
 #include "colorlab/sim/control_channel.hpp"
 #include "disk_fault_support.hpp"
+#include "last_step_campaign.hpp"
 #include "resume_support.hpp"
 
 using namespace colorlab;
@@ -139,19 +140,7 @@ void commit_through(const std::string& how, const std::string& cause_text) {
 TEST(DiskFaults, AFullDiskAtTheRunsLastStepSuspendsItUntilThereIsRoomAndTheStepIsKept) {
   TempDir dir;
   DiskFaults faults(dir / "state", dir / "fault");
-  std::filesystem::create_directories(dir / "state" / "campaigns");
-  // One lab call (5 s of wall time at the time scale: the test fills the disk meanwhile), then the measurement.
-  std::ofstream(dir / "state" / "campaigns" / "last-step.lua") << R"lua(
-return {
-  description = "test: a wait, then one measurement as the run's last step",
-  needs = {},
-  parameters = {},
-  run = function(p)
-    lab.wait(500)
-    lab.record("last", { quantity = "count", value = 1, unit = "1" })
-  end,
-}
-)lua";
+  write_last_step_campaign(dir / "state");
   auto daemon = faults.start(write_daemon_config(dir.path(), kTimeScale, 3, kSuspendConfig));
   auto api = api_for(*daemon);
   const json e = api.post("/v1/executions", {{"campaign", "last-step"}, {"params", json::object()}});
