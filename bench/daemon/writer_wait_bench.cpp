@@ -38,9 +38,9 @@ void BM_WriterWaitsForTheLock(benchmark::State& state) {
   Database waiter(path, false);
   holder.exec("CREATE TABLE written (who TEXT NOT NULL)");
   if (handler == kSqliteBusyTimeout) {
-    waiter.exec("PRAGMA busy_timeout = 5000");
+    waiter.exec("PRAGMA busy_timeout = " + std::to_string(colorlab::store::kBusyTimeout.count()));
   } else {
-    colorlab::store::retry_promptly_when_busy(waiter, std::chrono::milliseconds(5000));
+    colorlab::store::retry_promptly_when_busy(waiter, colorlab::store::kBusyTimeout);
   }
   for (auto _ : state) {
     std::promise<void> held;

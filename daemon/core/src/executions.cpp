@@ -397,7 +397,6 @@ void Executions::launch(store::ExecutionRecord record, std::shared_ptr<const cam
       [this, active, script, params, resumed, accept_units, resumed_by]() -> asio::awaitable<void> {
         auto& record = active->record;
         campaigns::RunOutcome outcome;
-        bool storage_suspended = false;
         try {
           std::optional<IoStage> starting(std::in_place, "execution start");
           json how = resumed ? json{{"resumed", true}} : json(nullptr);
@@ -442,7 +441,6 @@ void Executions::launch(store::ExecutionRecord record, std::shared_ptr<const cam
           if (e.cls() == ErrorClass::io_error) {
             outcome.kind = campaigns::RunOutcome::Kind::suspended;
             outcome.reason = std::string("storage: ") + e.what();
-            storage_suspended = true;
           }
         } catch (const std::exception& e) {
           outcome.kind = campaigns::RunOutcome::Kind::failed;
@@ -482,9 +480,10 @@ void Executions::launch(store::ExecutionRecord record, std::shared_ptr<const cam
               break;
             case Kind::suspended: {
               // A shutdown's suspension ends with the next start; the disk's is the operator's business, whether
-              // the disk refused the run's start here or, in the engine, its last step's commit.
-              if (outcome.error && outcome.error->cls() == ErrorClass::io_error) storage_suspended = true;
-              json problem = storage_suspended && outcome.error ? protocol::problem_from_error(*outcome.error).to_json() : json(nullptr);
+              // the disk refused the run's start here or, in the engine, its last step's commit (both carry the
+              // io_error; a shutdown's carries none).
+              const bool storage_suspended = outcome.error && outcome.error->cls() == ErrorClass::io_error;
+              json problem = storage_suspended ? protocol::problem_from_error(*outcome.error).to_json() : json(nullptr);
               json document{{"category", storage_suspended ? "storage" : "shutdown"}};
               if (!problem.is_null()) document["problem"] = problem;
               store_.set_execution_status(record, ExecutionStatus::suspended, outcome.reason, nullptr, document);

@@ -15,6 +15,7 @@
 namespace colorlab::store {
 
 inline constexpr std::chrono::microseconds kBusyRetryInterval{250};
+inline constexpr std::chrono::milliseconds kBusyTimeout{5000};  // the store's connections' longest wait for one lock
 
 // Installs the handler on this connection, replacing busy_timeout's. After `timeout` of waiting for one lock the
 // statement fails with SQLITE_BUSY (Database::fail: an io_error saying the database is locked).

@@ -5,7 +5,6 @@
 // that is always mid-read (a console polling, an event stream) can keep the writer from ever starting
 // over, and then the WAL grows with every commit: bound_wal() notices the file over its limit after a
 // commit and checkpoints with RESTART, so the next commit starts over once those readers are done.
-#include <chrono>
 #include <cstdint>
 #include <filesystem>
 
@@ -15,7 +14,6 @@ namespace colorlab::store {
 
 inline constexpr int kWalAutocheckpointPages = 1000;                      // 4 MiB at SQLite's 4 KiB pages
 inline constexpr std::int64_t kJournalSizeLimitBytes = 16 * 1024 * 1024;  // the WAL's size once reset
-inline constexpr std::chrono::milliseconds kBusyTimeout{5000};            // a writer's longest wait (busy_retry.hpp)
 
 // The writer connection's WAL settings (journal_mode itself is set by the store).
 void apply_wal_policy(Database& db);
