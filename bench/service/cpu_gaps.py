@@ -22,7 +22,8 @@ import os
 import time
 
 
-def watch(cpu, seconds, gap_ns, sleep_s, out):
+def watch(cpu, seconds, gap_ns, sleep_s, out, stop=None):
+    """Watches one CPU for `seconds`, or until `stop` (a multiprocessing Event) is set when given."""
     os.sched_setaffinity(0, {cpu})
     try:
         os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(50))
@@ -32,18 +33,67 @@ def watch(cpu, seconds, gap_ns, sleep_s, out):
     gc.disable()
     clock = time.clock_gettime_ns
     mono = time.CLOCK_MONOTONIC
-    gaps = []
+    gaps, ends = [], []
     start = last = clock(mono)
-    end = start + int(seconds * 1e9)
+    end = start + int(seconds * 1e9) if seconds else None
     sleep_ns = int(sleep_s * 1e9)
-    while last < end:
+    loops = 0
+    while (end is None or last < end) and not (stop is not None and loops % 100 == 0 and stop.is_set()):
+        loops += 1
         if sleep_s:
             time.sleep(sleep_s)
         now = clock(mono)
         if now - last - sleep_ns > gap_ns:
             gaps.append(now - last - sleep_ns)
+            ends.append(now)
         last = now
-    out.put({"cpu": cpu, "policy": policy, "seconds": (last - start) / 1e9, "gaps_ms": [g / 1e6 for g in gaps]})
+    # ends_s: when each late wake-up came (CLOCK_MONOTONIC, the clock of time.monotonic() and time.perf_counter()
+    # on Linux), so a stall can be set beside what else was timed meanwhile (stall_within).
+    out.put({"cpu": cpu, "policy": policy, "seconds": (last - start) / 1e9, "gaps_ms": [g / 1e6 for g in gaps],
+             "ends_s": [e / 1e9 for e in ends]})
+
+
+class MachineWatch:
+    """One watcher per CPU, each sleeping `sleep_ms` and recording every wake-up later than `gap_ms`, from start()
+    until stop(), which returns their results (as --json writes them)."""
+
+    def __init__(self, cpus=None, gap_ms=2.0, sleep_ms=1.0):
+        self.cpus = sorted(cpus if cpus is not None else os.sched_getaffinity(0))
+        ctx = multiprocessing.get_context("fork")
+        self.stop_event, self.out = ctx.Event(), ctx.Queue()
+        self.procs = [ctx.Process(target=watch, args=(c, None, int(gap_ms * 1e6), sleep_ms / 1000.0, self.out,
+                                                      self.stop_event), daemon=True) for c in self.cpus]
+
+    def start(self):
+        for p in self.procs:
+            p.start()
+        return self
+
+    def stop(self):
+        self.stop_event.set()
+        results = sorted((self.out.get(timeout=60) for _ in self.procs), key=lambda r: r["cpu"])
+        for p in self.procs:
+            p.join(timeout=10)
+        return results
+
+
+def stall_within(results, t0, t1):
+    """How much of [t0, t1] (CLOCK_MONOTONIC s) a CPU spent stalled, in ms: the most on any one CPU. A late wake-up
+    of `gap` ms ending at `end` is taken as a stall over [end - gap, end]."""
+    most = 0.0
+    for r in results:
+        on_this_cpu = 0.0
+        for gap_ms, end in zip(r["gaps_ms"], r["ends_s"]):
+            begin = end - gap_ms / 1000.0
+            on_this_cpu += max(0.0, min(end, t1) - max(begin, t0))
+        most = max(most, on_this_cpu * 1000.0)
+    return most
+
+
+def stalls_between(results, t0, t1, over_ms):
+    """The stalls longer than over_ms that ended in [t0, t1], all CPUs: (how many, the longest in ms)."""
+    longer = [g for r in results for g, end in zip(r["gaps_ms"], r["ends_s"]) if t0 <= end <= t1 and g > over_ms]
+    return len(longer), max(longer, default=0.0)
 
 
 def main():
