@@ -35,7 +35,7 @@ def watch(cpu, seconds, gap_ns, sleep_s, out, stop=None):
     mono = time.CLOCK_MONOTONIC
     gaps, ends = [], []
     start = last = clock(mono)
-    end = start + int(seconds * 1e9) if seconds else None
+    end = start + int(seconds * 1e9) if seconds is not None else None
     sleep_ns = int(sleep_s * 1e9)
     loops = 0
     while (end is None or last < end) and not (stop is not None and loops % 100 == 0 and stop.is_set()):

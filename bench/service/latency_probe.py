@@ -14,7 +14,10 @@ resumes an execution (POST /v1/requests/{id}, /v1/executions/{id}/pause, /resume
 holds the night's queue, so these go to `probe-ask` (a campaign of this probe's, touching no instrument, run
 once before the phases and answered): its request is no longer open (404) and it has ended (409). The same
 handlers on the same main thread find and refuse them: what they measure is the wait behind other work there. Every answer's time is from the request sent to the whole answer read.
-Each client's first round (it opens the client's connection, in a process just started) is reported apart.
+Each client makes one round of its requests before the phase begins (its warm-up: the connection opened, in a process
+just started), and the phase — its clock, and in the busy phase the study — starts once all three have, so every
+answer the phase counts is a poll of a client that was already polling, as a console open before the night is.
+The warm-up's answers are reported apart, with their slowest.
 
 Reports per route and phase: count, p50, p99 and the slowest answer (ms), and the machine's load average.
 Target (issue 27): the slowest answer of every route <= 50 ms in the busy phase.
@@ -222,35 +225,37 @@ def timed(session, times, route, method, url, clock=None, **kw):
 class Records:
     """A client process's answers, sent to the parent at the end: (route, ms, status, Server-Timing, client, sent at).
 
-    The client's first round is kept apart (`first_round`): it opens the client's connection in a process just
-    forked, beside the other clients doing the same, and its requests took 70-120 ms of the client's own time (on a
-    CPU and waiting for one) with colorlabd's part <= 2.3 ms, the machine not stalled (2026-11-30, C2 in
-    docs/PERFORMANCE.md). A console that polls has long done that; the target is about its polls."""
+    The client's first round is its warm-up (`warm_up`), made before the phase begins (`ready`, probe()): a process
+    just forked opening its connection, beside the other clients doing the same. Counted inside the phase (C2 in
+    docs/PERFORMANCE.md), each client's first request took 74-118 ms, of it 74-116 ms the client's own time (on a CPU
+    and waiting for one), colorlabd's part <= 2.3 ms, the machine not stalled."""
 
-    def __init__(self):
+    def __init__(self, ready=None):
         self.rows = []
-        self.first_round = []
-        self._warm = False
+        self.warm_up = []
+        self._ready = ready
 
     def add(self, route, ms, status, timing, client=None, at=None):
-        (self.rows if self._warm else self.first_round).append((route, ms, status, timing, client, at))
+        (self.rows if self._ready is None else self.warm_up).append((route, ms, status, timing, client, at))
 
     def round_done(self):
-        self._warm = True
+        if self._ready is not None:
+            self._ready.put(os.getpid())
+            self._ready = None
 
 
-def client_process(target, args, stop, out, client_nice=None):
+def client_process(target, args, stop, out, client_nice=None, ready=None):
     """One client in a process of its own: its thread's wait for a CPU is then its own, not a GIL's."""
     if client_nice is not None:
         # Raising the clients above the study (root only) takes their own scheduling out of the answer times, so
         # what is left is the daemon's: the separation the quiet-machine A/B of issue 27 needs.
         os.setpriority(os.PRIO_PROCESS, 0, client_nice)
-    records = Records()
+    records = Records(ready)
     gc.disable()  # collected between requests instead (between_requests)
     try:
         target(*args[:1], records, stop, *args[1:], clock=ClientClock())
     finally:
-        out.put((records.rows, records.first_round))
+        out.put((records.rows, records.warm_up))
 
 
 _PAUSES = itertools.count(1)
@@ -403,26 +408,31 @@ def probe(url, until, label, ended_id, pid=None, log_path=None, slow_ms=50.0, cl
     ctx = multiprocessing.get_context("fork")
     stop = ctx.Event()
     out = ctx.Queue()
-    clients = [ctx.Process(target=client_process, args=(reader, (url, [""]), stop, out, client_nice)) for _ in range(2)]
-    clients.append(ctx.Process(target=client_process, args=(operator, (url, ended_id), stop, out, client_nice)))
-    load0 = os.getloadavg()
-    sched0 = main_thread_schedstat(pid) if pid else None
-    groups0 = thread_groups(pid) if pid else {}
-    log0 = os.path.getsize(log_path) if log_path else 0
-    t0 = time.monotonic()
+    ready = ctx.Queue()
+    clients = [ctx.Process(target=client_process, args=(reader, (url, [""]), stop, out, client_nice, ready))
+               for _ in range(2)]
+    clients.append(ctx.Process(target=client_process, args=(operator, (url, ended_id), stop, out, client_nice, ready)))
     for c in clients:
         c.start()
     try:
+        for _ in clients:
+            ready.get(timeout=120)  # every client has made its warm-up round: the phase begins
+        load0 = os.getloadavg()
+        sched0 = main_thread_schedstat(pid) if pid else None
+        groups0 = thread_groups(pid) if pid else {}
+        log0 = os.path.getsize(log_path) if log_path else 0
+        t0 = time.monotonic()
         until()
     finally:
         stop.set()
         # Drained before joining: a child blocks on exit until its rows have gone through the pipe.
-        first_round = []
+        warm_up = []
         for _ in clients:
-            rows, first = out.get(timeout=120)
+            rows, warm = out.get(timeout=120)
             for row in rows:
                 times.add(*row)
-            first_round += [{"route": r[0], "ms": r[1], "status": r[2]} for r in first]
+            warm_up += [{"route": r[0], "ms": r[1], "status": r[2], "split": split_answer(r[1], r[3], r[4]), "at": r[5]}
+                        for r in warm]
         for c in clients:
             c.join(timeout=60)
     wall = time.monotonic() - t0
@@ -441,8 +451,9 @@ def probe(url, until, label, ended_id, pid=None, log_path=None, slow_ms=50.0, cl
             "handler_cpu": times.handler_cpu, "slow_answers": attribution(times),
             "missing_server_timing": times.missing_timing, "main_thread": main_thread, "io_thread_log": io_log,
             "daemon_threads": threads, "client_own": client_own(times),
-            "first_round": {"answers": len(first_round), "max_ms": max((r["ms"] for r in first_round), default=0.0),
-                            "slowest": sorted(first_round, key=lambda r: -r["ms"])[:3]},
+            "warm_up": {"answers": len(warm_up), "max_ms": max((r["ms"] for r in warm_up), default=0.0),
+                        "errors": sum(1 for r in warm_up if r["status"] == 0 or r["status"] >= 500),
+                        "slowest": sorted(warm_up, key=lambda r: -r["ms"])[:3]},
             "slowest_within_limit": max((ms for v in times.by_route.values() for ms in v if ms <= slow_ms), default=0.0)}
 
 
@@ -454,8 +465,9 @@ def add_machine_stalls(phase, watched, slow_ms):
     t0, t1 = phase["window"]
     n, longest = cpu_gaps.stalls_between(watched, t0, t1, slow_ms)
     less = phase["slowest_within_limit"]
-    for a in phase["slow_answers"]["each"]:
+    for a in phase["slow_answers"]["each"] + phase["warm_up"]["slowest"]:
         a["machine_stall_ms"] = cpu_gaps.stall_within(watched, a["at"], a["at"] + a["ms"] / 1000.0)
+    for a in phase["slow_answers"]["each"]:
         less = max(less, a["ms"] - a["machine_stall_ms"])
     phase["machine"] = {"stalls_over_limit": n, "longest_stall_ms": longest,
                         "slowest_less_its_stall_ms": less,
@@ -512,10 +524,13 @@ def print_attribution(phase):
               f"the limit, longest {m['longest_stall_ms']:.1f} ms; answers beyond the limit only by a stall within "
               f"them: {m['beyond_limit_only_by_a_stall']} of {s['answers']}; slowest answer less the stall within "
               f"it: {m['slowest_less_its_stall_ms']:.1f} ms")
-    f = phase.get("first_round")
-    if f:
-        print(f"  each client's first round (its connection, in a process just started; apart from the figures above): "
-              f"{f['answers']} answers, slowest {f['max_ms']:.1f} ms")
+    w = phase.get("warm_up")
+    if w:
+        print(f"  the clients' warm-up rounds, before the phase began (not in the figures above): {w['answers']} "
+              f"answers, {w['errors']} errors, slowest {w['max_ms']:.1f} ms")
+        for a in w["slowest"]:
+            stall = f"; the machine stalled {a['machine_stall_ms']:.1f} of it" if "machine_stall_ms" in a else ""
+            print(f"    {a['route']:34s} {a['ms']:7.1f}: {fmt(a['split'])}{stall}")
     c = phase.get("client_own")
     if c:
         print(f"  the clients' own wait for a CPU: {c['waited_over_10ms']} of {c['answers']} answers over 10 ms, "
@@ -558,6 +573,7 @@ def main():
                          "machine's own stalls, per phase and within each answer beyond the limit")
     a = ap.parse_args()
     watch = cpu_gaps.MachineWatch().start() if a.watch_machine else None
+    watched = None
     with tempfile.TemporaryDirectory(prefix="latency-probe-") as state:
         proc, url, log_path = start_daemon(a.build, state, a.time_scale, a.log, a.stage_ms, a.priority)
         try:
@@ -570,8 +586,13 @@ def main():
         finally:
             proc.terminate()
             proc.wait(timeout=60)
-            watched = watch.stop() if watch else None
+            if watch:
+                try:
+                    watched = watch.stop()
+                except Exception as e:  # never hide what ended the run
+                    print(f"the machine's watchers gave no result: {e!r}", file=sys.stderr)
     if watched:
+        print("machine watchers: " + ", ".join(f"cpu {r['cpu']} {r['policy']}" for r in watched))
         for phase in (idle, busy):
             add_machine_stalls(phase, watched, a.slow_ms)
     result = {"time_scale": a.time_scale, "priority": a.priority, "client_nice": a.client_nice, "phases": [idle, busy], "study_state": study.get("state"),
