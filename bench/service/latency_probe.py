@@ -505,8 +505,17 @@ def run_study(url):
         time.sleep(1)
 
 
+def fmt(split):
+    return ", ".join(f"{k} {v:.1f}" for k, v in split.items() if v >= 0.05) or "-"
+
+
+def print_answer(a):
+    """One slow answer: its route, time and split, and the machine's stall within it when watched."""
+    stall = f"; the machine stalled {a['machine_stall_ms']:.1f} of it" if "machine_stall_ms" in a else ""
+    print(f"    {a['route']:34s} {a['ms']:7.1f}: {fmt(a['split'])}{stall}")
+
+
 def print_attribution(phase):
-    fmt = lambda split: ", ".join(f"{k} {v:.1f}" for k, v in split.items() if v >= 0.05) or "-"
     print(f"  each route's slowest answer, split (ms; Server-Timing):")
     for route, (ms, split) in sorted(phase["worst"].items()):
         print(f"    {route:34s} {ms:7.1f}: {fmt(split)}")
@@ -516,8 +525,7 @@ def print_attribution(phase):
     print(f"  answers beyond the limit: {s['answers']}; ms summed by part: {fmt(s['ms_by_part'])}; "
           f"dominated by: " + ", ".join(f"{k} {v}" for k, v in s["dominated_by"].items() if v))
     for a in s["each"][:20]:
-        stall = f"; the machine stalled {a['machine_stall_ms']:.1f} of it" if "machine_stall_ms" in a else ""
-        print(f"    {a['route']:34s} {a['ms']:7.1f}: {fmt(a['split'])}{stall}")
+        print_answer(a)
     m = phase.get("machine")
     if m:
         print(f"  the machine's own stalls (a SCHED_FIFO watcher per CPU, cpu_gaps.py): {m['stalls_over_limit']} over "
@@ -529,8 +537,7 @@ def print_attribution(phase):
         print(f"  the clients' warm-up rounds, before the phase began (not in the figures above): {w['answers']} "
               f"answers, {w['errors']} errors, slowest {w['max_ms']:.1f} ms")
         for a in w["slowest"]:
-            stall = f"; the machine stalled {a['machine_stall_ms']:.1f} of it" if "machine_stall_ms" in a else ""
-            print(f"    {a['route']:34s} {a['ms']:7.1f}: {fmt(a['split'])}{stall}")
+            print_answer(a)
     c = phase.get("client_own")
     if c:
         print(f"  the clients' own wait for a CPU: {c['waited_over_10ms']} of {c['answers']} answers over 10 ms, "
