@@ -54,14 +54,15 @@ def watch(cpu, seconds, gap_ns, sleep_s, out, stop=None):
 
 
 class MachineWatch:
-    """One watcher per CPU, each sleeping `sleep_ms` and recording every wake-up later than `gap_ms`, from start()
-    until stop(), which returns their results (as --json writes them)."""
+    """One watcher per CPU, each sleeping `sleep_ms` (0: busy-looping) and recording every wake-up later than
+    `gap_ms`, from start() for `seconds` (join() waits for them) or until stop(); both return their results (as
+    --json writes them)."""
 
-    def __init__(self, cpus=None, gap_ms=2.0, sleep_ms=1.0):
+    def __init__(self, cpus=None, gap_ms=2.0, sleep_ms=1.0, seconds=None):
         self.cpus = sorted(cpus if cpus is not None else os.sched_getaffinity(0))
         ctx = multiprocessing.get_context("fork")
         self.stop_event, self.out = ctx.Event(), ctx.Queue()
-        self.procs = [ctx.Process(target=watch, args=(c, None, int(gap_ms * 1e6), sleep_ms / 1000.0, self.out,
+        self.procs = [ctx.Process(target=watch, args=(c, seconds, int(gap_ms * 1e6), sleep_ms / 1000.0, self.out,
                                                       self.stop_event), daemon=True) for c in self.cpus]
 
     def start(self):
@@ -71,7 +72,10 @@ class MachineWatch:
 
     def stop(self):
         self.stop_event.set()
-        results = sorted((self.out.get(timeout=60) for _ in self.procs), key=lambda r: r["cpu"])
+        return self.join(timeout=60)
+
+    def join(self, timeout=None):
+        results = sorted((self.out.get(timeout=timeout) for _ in self.procs), key=lambda r: r["cpu"])
         for p in self.procs:
             p.join(timeout=10)
         return results
@@ -104,14 +108,7 @@ def main():
     ap.add_argument("--cpus", default=",".join(str(c) for c in sorted(os.sched_getaffinity(0))))
     ap.add_argument("--json")
     a = ap.parse_args()
-    out = multiprocessing.Queue()
-    procs = [multiprocessing.Process(target=watch, args=(int(c), a.seconds, int(a.gap_ms * 1e6), a.sleep_ms / 1000.0, out))
-             for c in a.cpus.split(",")]
-    for p in procs:
-        p.start()
-    results = sorted((out.get() for _ in procs), key=lambda r: r["cpu"])
-    for p in procs:
-        p.join()
+    results = MachineWatch([int(c) for c in a.cpus.split(",")], a.gap_ms, a.sleep_ms, a.seconds).start().join()
     bins = [2, 5, 10, 20, 50, 100, 200, float("inf")]
     for r in results:
         g = r["gaps_ms"]
