@@ -235,7 +235,7 @@ Daemon::Daemon(DaemonConfig config) : impl_(std::make_unique<Impl>()) {
   });
   // Fits, analyses and dry runs' analyses: off the io thread (worker_pool.hpp).
   d.workers = std::make_unique<WorkerPool>(d.io.get_executor(), with_test_hooks(WorkerPoolOptions{.nice = d.config.priority.heavy_work_nice}));
-  d.committer = std::make_unique<StepCommitter>(d.io.get_executor(), d.config.database_path());
+  d.committer = std::make_unique<StepCommitter>(d.io.get_executor(), d.config.database_path(), d.store.get());
   ExecutionOptions execution_options;
   execution_options.workers = d.workers.get();
   // The latency probe's A/B switch (bench/service/latency_probe.py): the same binary committing on the io

@@ -8,6 +8,7 @@
 // says what it waited for.
 #include <atomic>
 #include <chrono>
+#include <filesystem>
 #include <fstream>
 #include <future>
 #include <map>
@@ -169,6 +170,48 @@ TEST(ThreadServices, TwoWritersCommitWhileTheHubWakesStreamsOnPoolThreadsAndEach
   pool.join();
   committer.shutdown();
   hub.stop();
+}
+
+// The io thread's connection hands the WAL's checkpoints to the committer (step_committer.hpp): through more commits
+// on the io thread than the WAL holds before its threshold, that connection copies nothing itself and the committer's
+// checkpoint does; once the committer has shut down, the io thread's connection checkpoints by itself again.
+TEST(ThreadServices, TheIoThreadsConnectionLeavesTheWalsCheckpointsToTheCommitter) {
+  TempDir dir;
+  const auto db = dir / "colorlab.db";
+  Store writer(db);
+  const auto e = new_execution(writer, "a");
+  const auto before = std::filesystem::file_size(db);
+  IoThread main;  // the first writer's only user from here on
+  StepCommitter committer(main.io.get_executor(), db, &writer);
+  // 96 KiB a step: about 24 pages of the WAL, so 80 steps (7.5 MiB) cross the 1000-page threshold.
+  auto big_step = [](int i) {
+    auto step = step_of(i);
+    step.measurements.front().data = {{"spectrum", std::string(96 * 1024, 'x')}};
+    return step;
+  };
+  auto commit_on_io_thread = [&](int from, int to) {
+    return asio::co_spawn(
+        main.io,
+        [&, from, to]() -> asio::awaitable<std::uint64_t> {
+          for (int i = from; i < to; ++i) writer.commit_step(e, big_step(i));
+          co_return writer.wal_checkpoints_run();
+        },
+        asio::use_future);
+  };
+  auto first = commit_on_io_thread(0, 80);
+  ASSERT_EQ(first.wait_for(120s), std::future_status::ready) << "80 commits did not end within 120 s";
+  EXPECT_EQ(first.get(), 0u) << "the io thread's connection checkpointed the WAL itself";
+  auto deadline = std::chrono::steady_clock::now() + 60s;
+  while (std::filesystem::file_size(db) < before + 3 * 1024 * 1024 && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(5ms);
+  }
+  EXPECT_GT(std::filesystem::file_size(db), before + 3 * 1024 * 1024)
+      << "no checkpoint on the committer's thread copied the WAL within 60 s";
+
+  committer.shutdown();
+  auto second = commit_on_io_thread(80, 160);
+  ASSERT_EQ(second.wait_for(120s), std::future_status::ready) << "80 more commits did not end within 120 s";
+  EXPECT_GE(second.get(), 1u) << "without the committer, the io thread's connection no longer checkpoints";
 }
 
 TEST(ThreadServices, StoppingTheHubWakesAStreamThatWaitsOnAnotherThread) {

@@ -4,9 +4,13 @@
 
 namespace colorlab::daemon {
 
-StepCommitter::StepCommitter(boost::asio::any_io_executor io, const std::filesystem::path& database_path)
+StepCommitter::StepCommitter(boost::asio::any_io_executor io, const std::filesystem::path& database_path,
+                             store::Store* io_thread_store)
     : store_(std::make_unique<store::Store>(database_path, store::Store::SecondWriter{})),
-      thread_(std::make_unique<WorkerPool>(std::move(io), WorkerPoolOptions{1, 0, {}, 0, "committer"})) {}
+      thread_(std::make_unique<WorkerPool>(std::move(io), WorkerPoolOptions{1, 0, {}, 0, "committer"})),
+      io_thread_store_(io_thread_store) {
+  if (io_thread_store_) io_thread_store_->hand_wal_checkpoints_to([this] { checkpoint_soon(); });
+}
 
 StepCommitter::~StepCommitter() { shutdown(); }
 
@@ -19,7 +23,27 @@ boost::asio::awaitable<void> StepCommitter::commit(store::ExecutionRecord execut
   co_await thread_->run("a step's commit", std::move(job), Admission::always);
 }
 
+void StepCommitter::checkpoint_soon() {
+  if (checkpoint_queued_.exchange(true)) return;
+  try {
+    thread_->submit(
+        "a checkpoint of the WAL",
+        [this]() -> nlohmann::json {
+          checkpoint_queued_ = false;  // a commit from now on may ask for the next one
+          store_->checkpoint_wal();
+          return nullptr;
+        },
+        [](std::exception_ptr, nlohmann::json) {}, Admission::always);
+  } catch (const Error&) {
+    checkpoint_queued_ = false;  // shutting down: the Store checkpoints by itself again
+  }
+}
+
 void StepCommitter::shutdown() {
+  if (io_thread_store_) {
+    io_thread_store_->hand_wal_checkpoints_to({});
+    io_thread_store_ = nullptr;
+  }
   if (thread_) thread_->shutdown();
 }
 

@@ -35,13 +35,16 @@ Database::~Database() {
   if (db_) sqlite3_close_v2(db_);
 }
 
-Database::Database(Database&& o) noexcept : db_(o.db_), path_(std::move(o.path_)) { o.db_ = nullptr; }
+Database::Database(Database&& o) noexcept : db_(o.db_), path_(std::move(o.path_)), wal_hook_(std::move(o.wal_hook_)) {
+  o.db_ = nullptr;
+}
 
 Database& Database::operator=(Database&& o) noexcept {
   if (this != &o) {
     if (db_) sqlite3_close_v2(db_);
     db_ = o.db_;
     path_ = std::move(o.path_);
+    wal_hook_ = std::move(o.wal_hook_);  // the hook's state goes with the connection it was installed on
     o.db_ = nullptr;
   }
   return *this;
@@ -186,12 +189,15 @@ Transaction::~Transaction() {
 }
 
 void Transaction::commit() {
+  const WalHookState* hook = db_.wal_hook_state();
+  const std::uint64_t commits_before = hook ? hook->commits : 0;
   {
     WriterWaitTimer timed;
     db_.exec("COMMIT");
   }
   done_ = true;
-  const std::chrono::duration<double, std::milli> held = std::chrono::steady_clock::now() - holding_since_;
+  const auto released = hook && hook->commits != commits_before ? hook->last_commit : std::chrono::steady_clock::now();
+  const std::chrono::duration<double, std::milli> held = released - holding_since_;
   if (held >= kLongWriteLockHold) {
     char thread[16] = "?";
     pthread_getname_np(pthread_self(), thread, sizeof thread);

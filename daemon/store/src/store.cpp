@@ -151,6 +151,15 @@ Store::Store(const fs::path& database_path, SecondWriter) {
   db_.exec("PRAGMA temp_store = MEMORY");
 }
 
+void Store::hand_wal_checkpoints_to(std::function<void()> ask) { hand_checkpoints_elsewhere(db_, std::move(ask)); }
+
+void Store::checkpoint_wal() noexcept { checkpoint_passive(db_); }
+
+std::uint64_t Store::wal_checkpoints_run() const {
+  const auto* state = db_.wal_hook_state();
+  return state ? state->checkpoints : 0;
+}
+
 Store::Created Store::create_execution(const NewRun& run) {
   if (run.idempotency_key) {
     if (auto existing = execution_with_idempotency_key(*run.idempotency_key)) return {*existing, false};

@@ -10,9 +10,14 @@
 // announces what is not on disk), and one execution's steps commit in order (it waits for each). Steps of
 // two executions are ordered by SQLite's write lock, so the event log's seq stays the commit order.
 //
+// The WAL's checkpoints run here too: the io thread's own connection (the daemon's Store) hands them over
+// (store::Store::hand_wal_checkpoints_to), so that the copy of the WAL into the database and its fsync, which
+// SQLite runs inside whichever COMMIT crosses the threshold, never hold up the io thread.
+//
 // Threads and locks: one thread (a WorkerPool of one, its queue unbounded: each execution waits for its
-// own step, so no more than the executions running are ever queued). The connection is used on that
-// thread only.
+// own step, so no more than the executions running are ever queued, and at most one checkpoint waits). The
+// connection is used on that thread only; checkpoint_queued_ is the one flag both threads touch.
+#include <atomic>
 #include <filesystem>
 #include <memory>
 
@@ -27,8 +32,10 @@ class WorkerPool;
 
 class StepCommitter {
  public:
-  // Opens the second writer's connection to the database a Store has already opened.
-  StepCommitter(boost::asio::any_io_executor io, const std::filesystem::path& database_path);
+  // Opens the second writer's connection to the database a Store has already opened. With `io_thread_store`
+  // (that Store, used on the io thread), its checkpoints are handed here until shutdown(); it must outlive this.
+  StepCommitter(boost::asio::any_io_executor io, const std::filesystem::path& database_path,
+                store::Store* io_thread_store = nullptr);
   ~StepCommitter();
   StepCommitter(const StepCommitter&) = delete;
   StepCommitter& operator=(const StepCommitter&) = delete;
@@ -37,12 +44,18 @@ class StepCommitter {
   // durable, or throws what the store threw (Error{io_error} for a disk that refused it: nothing stored).
   boost::asio::awaitable<void> commit(store::ExecutionRecord execution, store::StepRecord step);
 
-  // Commits still queued end with Error{aborted}; the running one finishes. Then joins.
+  // A checkpoint of the WAL on the committer's thread, soon; never blocks, and one already waiting suffices.
+  void checkpoint_soon();
+
+  // The io thread's Store checkpoints by itself again; commits still queued end with Error{aborted}; the
+  // running one finishes. Then joins.
   void shutdown();
 
  private:
   std::unique_ptr<store::Store> store_;
   std::unique_ptr<WorkerPool> thread_;
+  store::Store* io_thread_store_ = nullptr;
+  std::atomic<bool> checkpoint_queued_{false};
 };
 
 }  // namespace colorlab::daemon

@@ -3,6 +3,8 @@
 // disk-level trouble (full, read-only, I/O), conflict for constraint violations, internal otherwise.
 #include <chrono>
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -13,6 +15,18 @@ struct sqlite3_stmt;
 namespace colorlab::store {
 
 class Statement;
+
+// What a writer connection's WAL hook (wal_policy.cpp) keeps. SQLite calls the hook once a commit is durable and
+// its write lock released; a checkpoint it then runs happens inside the same COMMIT call, on the same thread, with
+// other writers free to go on. On the heap, so that a moved Database keeps the address the hook was given.
+struct WalHookState {
+  std::uint64_t commits = 0;                             // commits seen by the hook on this connection
+  std::chrono::steady_clock::time_point last_commit{};  // when the last of them released the write lock
+  std::uint64_t checkpoints = 0;                         // checkpoints this connection ran (its hook's, or asked)
+  // Set: this connection never checkpoints itself; past the threshold it calls this instead, which must not
+  // block (colorlabd's io thread hands its checkpoints to the step committer's thread).
+  std::function<void()> checkpoint_elsewhere;
+};
 
 class Database {
  public:
@@ -31,9 +45,14 @@ class Database {
   sqlite3* handle() const { return db_; }
   [[noreturn]] void fail(int rc, std::string_view what) const;
 
+  // The WAL hook's state, once apply_wal_policy() has installed it (nullptr before, and on read-only connections).
+  WalHookState* wal_hook_state() const { return wal_hook_.get(); }
+  void keep_wal_hook_state(std::unique_ptr<WalHookState> state) { wal_hook_ = std::move(state); }
+
  private:
   sqlite3* db_ = nullptr;
   std::string path_;
+  std::unique_ptr<WalHookState> wal_hook_;
 };
 
 class Statement {
@@ -97,7 +116,8 @@ class Transaction {
  private:
   Database& db_;
   bool done_ = false;
-  // From BEGIN IMMEDIATE's return: a commit that held the write lock long is logged, since every other writer —
+  // From BEGIN IMMEDIATE's return to the commit's release of the lock (the WAL hook's time: a checkpoint SQLite
+  // runs after it, in the same call, holds up this thread only): a long hold is logged, since every other writer —
   // the io thread among them — waited that long (busy_retry.hpp).
   std::chrono::steady_clock::time_point holding_since_;
 };

@@ -5,6 +5,7 @@
 // survives power loss), busy_timeout, foreign keys, quick_check at open.
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <optional>
 #include <set>
@@ -172,6 +173,15 @@ class Store {
   // waits up to the busy timeout), so the event log's seq is still the commit order.
   struct SecondWriter {};
   Store(const std::filesystem::path& database_path, SecondWriter);
+
+  // The WAL's checkpoints (wal_policy.hpp): this connection's commits stop checkpointing it themselves and call
+  // `ask` instead, which must not block; empty: they checkpoint again. colorlabd's io thread hands them to the step
+  // committer (daemon/core step_committer.hpp), whose connection then runs them (checkpoint_wal).
+  void hand_wal_checkpoints_to(std::function<void()> ask);
+  // A PASSIVE checkpoint on this connection now. Never throws (logged; asked again after a later commit).
+  void checkpoint_wal() noexcept;
+  // How many checkpoints this connection has run (after its commits, or checkpoint_wal); 0 for a reader's.
+  std::uint64_t wal_checkpoints_run() const;
 
   // Creates a run and its execution in one transaction. With an idempotency key already used,
   // returns the existing execution and created = false (a retried POST must not start a campaign twice).
