@@ -2,11 +2,13 @@
 """What a COMMIT that crosses SQLite's auto-checkpoint threshold costs the thread that made it, and whether the
 write lock is held meanwhile (issue 27).
 
-colorlabd's store sets `PRAGMA wal_autocheckpoint = 1000` (daemon/store wal_policy.cpp) on each writer connection, so the
-commit that brings the WAL to 1000 pages checkpoints it, inside that COMMIT's call, on whichever thread made it —
-the step committer's or the io thread's. Its Transaction::commit logs the whole call as the time it "held the write
+Until 2026-11-30 colorlabd's store set `PRAGMA wal_autocheckpoint = 1000` on each writer connection, so the commit
+that brought the WAL to 1000 pages checkpointed it, inside that COMMIT's call, on whichever thread made it — the step
+committer's or the io thread's — and its Transaction::commit logged the whole call as the time it "held the write
 lock; other writers waited as long". This bench measures both halves of that sentence with the same SQLite library
-colorlabd links (Python's sqlite3 module over Debian's libsqlite3):
+colorlabd links (Python's sqlite3 module over Debian's libsqlite3). Since then the store's own WAL hook runs the
+same PASSIVE checkpoint on the committer's connection only (daemon/store wal_policy.hpp), and the io thread's hands
+it over:
 
 - per trial, a writer `a` makes one commit of --rows rows of 4 KB after the WAL has been filled to just below the
   threshold by another connection `b`; `a` runs with the threshold (as colorlabd) and without it

@@ -235,14 +235,16 @@ Daemon::Daemon(DaemonConfig config) : impl_(std::make_unique<Impl>()) {
   });
   // Fits, analyses and dry runs' analyses: off the io thread (worker_pool.hpp).
   d.workers = std::make_unique<WorkerPool>(d.io.get_executor(), with_test_hooks(WorkerPoolOptions{.nice = d.config.priority.heavy_work_nice}));
-  d.committer = std::make_unique<StepCommitter>(d.io.get_executor(), d.config.database_path(), d.store.get());
+  // The latency probe's A/B switch (bench/service/latency_ab.sh): the same binary committing steps and
+  // checkpointing the WAL on the io thread as before, for a before/after in one run. Never for a lab: durability is
+  // the same, latency is not.
+  const char* on_io = std::getenv("COLORLAB_BENCH_COMMIT_ON_IO_THREAD");
+  const bool commit_on_io_thread = on_io && std::string(on_io) == "1";
+  d.committer = std::make_unique<StepCommitter>(d.io.get_executor(), d.config.database_path(),
+                                                commit_on_io_thread ? nullptr : d.store.get());
   ExecutionOptions execution_options;
   execution_options.workers = d.workers.get();
-  // The latency probe's A/B switch (bench/service/latency_probe.py): the same binary committing on the io
-  // thread as before, for a before/after in one run. Never for a lab: durability is the same, latency is not.
-  if (const char* on_io = std::getenv("COLORLAB_BENCH_COMMIT_ON_IO_THREAD"); !on_io || std::string(on_io) != "1") {
-    execution_options.committer = d.committer.get();
-  }
+  if (!commit_on_io_thread) execution_options.committer = d.committer.get();
   execution_options.crash_loop = {cc.max_resume_attempts, cc.crash_loop_backoff_s, cc.crash_loop_backoff_max_s,
                                   cc.crash_loop_retries};
   execution_options.state_dir = d.config.state_dir;

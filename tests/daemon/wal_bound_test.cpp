@@ -78,8 +78,7 @@ namespace {
 StepRecord big_step(int i) {
   StepRecord step;
   step.journal.push_back({i, "meter.measure", json::array(), {{"luminance", 100.0 + i}}});
-  step.measurements.push_back({"reading/" + std::to_string(i), "ls110", true, "luminance", 100.0 + i, "cd/m2",
-                               {{"spectrum", std::string(96 * 1024, 'x')}}});
+  step.measurements.push_back({"reading/" + std::to_string(i), "ls110", true, "luminance", 100.0 + i, "cd/m2", {{"spectrum", std::string(96 * 1024, 'x')}}});
   step.step = "reading/" + std::to_string(i);
   return step;
 }

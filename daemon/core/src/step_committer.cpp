@@ -34,8 +34,8 @@ void StepCommitter::checkpoint_soon() {
           return nullptr;
         },
         [](std::exception_ptr, nlohmann::json) {}, Admission::always);
-  } catch (const Error&) {
-    checkpoint_queued_ = false;  // shutting down: the Store checkpoints by itself again
+  } catch (...) {
+    checkpoint_queued_ = false;  // not queued (shutting down, or no memory): the next commit past the threshold asks again
   }
 }
 

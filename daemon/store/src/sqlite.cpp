@@ -202,7 +202,7 @@ void Transaction::commit() {
     char thread[16] = "?";
     pthread_getname_np(pthread_self(), thread, sizeof thread);
     log::warning("store", "a transaction held the write lock " + std::to_string(std::lround(held.count())) +
-                              " ms (thread " + thread + "); other writers waited as long");
+                              " ms (thread " + thread + "); other writers waited up to that long");
   }
 }
 

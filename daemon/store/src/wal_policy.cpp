@@ -17,27 +17,40 @@ namespace {
 // As long as the API's target for an answer (issue 27): a thread held this long by a checkpoint is worth a line.
 constexpr std::chrono::milliseconds kLongCheckpoint{50};
 
-void checkpoint_passive_on(sqlite3* db, WalHookState* state) noexcept {
-  if (state) ++state->checkpoints;
+void checkpoint_passive_on(sqlite3* db, const char* schema, WalHookState* state) noexcept {
   const auto start = std::chrono::steady_clock::now();
-  int log_frames = 0, checkpointed = 0;
+  int wal_frames = 0, in_database = 0;
   // PASSIVE never calls the busy handler: what a reader still needs is left for the next checkpoint.
-  const int rc = sqlite3_wal_checkpoint_v2(db, nullptr, SQLITE_CHECKPOINT_PASSIVE, &log_frames, &checkpointed);
+  const int rc = sqlite3_wal_checkpoint_v2(db, schema, SQLITE_CHECKPOINT_PASSIVE, &wal_frames, &in_database);
   const std::chrono::duration<double, std::milli> took = std::chrono::steady_clock::now() - start;
-  if (rc != SQLITE_OK && rc != SQLITE_BUSY) {
-    log::warning("store", std::string("cannot checkpoint the WAL: ") + sqlite3_errstr(rc) + "; tried again later");
-  } else if (took >= kLongCheckpoint) {
+  // BUSY: another checkpoint runs; LOCKED: a statement of this connection is still stepping (SQLite's own hook
+  // ignores both too). Either way the next commit past the threshold tries again.
+  if (rc == SQLITE_BUSY || rc == SQLITE_LOCKED) return;
+  if (rc != SQLITE_OK) {
+    if (state && state->checkpoint_failures++ % 100 == 0) {
+      log::warning("store", std::string("cannot checkpoint the WAL: ") + sqlite3_errmsg(db) + " (failure " +
+                                std::to_string(state->checkpoint_failures) + " in a row); tried again after later commits");
+    }
+    return;
+  }
+  if (!state) return;
+  if (state->checkpoint_failures > 0) {
+    log::info("store", "the WAL is checkpointed again after " + std::to_string(state->checkpoint_failures) + " failures");
+    state->checkpoint_failures = 0;
+  }
+  ++state->checkpoints;
+  if (took >= kLongCheckpoint && wal_frames >= 0) {
     char thread[16] = "?";
     pthread_getname_np(pthread_self(), thread, sizeof thread);
-    log::info("store", "a checkpoint of the WAL (" + std::to_string(checkpointed) + " of " + std::to_string(log_frames) +
-                           " pages) took " + std::to_string(std::lround(took.count())) + " ms (thread " + thread +
-                           "); writers were not held");
+    log::info("store", "a checkpoint of the WAL took " + std::to_string(std::lround(took.count())) + " ms (thread " +
+                           thread + "; " + std::to_string(in_database) + " of " + std::to_string(wal_frames) +
+                           " frames now in the database); other connections could write meanwhile");
   }
 }
 
 // SQLite calls this after each commit on the connection, the commit durable and the write lock released. An error
 // returned would fail the COMMIT statement that already succeeded, so it always answers SQLITE_OK.
-int after_commit(void* state_ptr, sqlite3* db, const char* /*schema*/, int wal_pages) {
+int after_commit(void* state_ptr, sqlite3* db, const char* schema, int wal_pages) {
   auto* state = static_cast<WalHookState*>(state_ptr);
   state->last_commit = std::chrono::steady_clock::now();
   ++state->commits;
@@ -49,7 +62,7 @@ int after_commit(void* state_ptr, sqlite3* db, const char* /*schema*/, int wal_p
       // Asked again after the next commit; the WAL meanwhile grows toward bound_wal()'s limit at most.
     }
   } else {
-    checkpoint_passive_on(db, state);
+    checkpoint_passive_on(db, schema, state);
   }
   return SQLITE_OK;
 }
@@ -68,7 +81,7 @@ void hand_checkpoints_elsewhere(Database& db, std::function<void()> ask) {
   if (auto* state = db.wal_hook_state()) state->checkpoint_elsewhere = std::move(ask);
 }
 
-void checkpoint_passive(Database& db) noexcept { checkpoint_passive_on(db.handle(), db.wal_hook_state()); }
+void checkpoint_passive(Database& db) noexcept { checkpoint_passive_on(db.handle(), nullptr, db.wal_hook_state()); }
 
 std::int64_t wal_bytes(const std::filesystem::path& database_path) {
   std::error_code ec;

@@ -12,7 +12,9 @@
 //
 // The WAL's checkpoints run here too: the io thread's own connection (the daemon's Store) hands them over
 // (store::Store::hand_wal_checkpoints_to), so that the copy of the WAL into the database and its fsync, which
-// SQLite runs inside whichever COMMIT crosses the threshold, never hold up the io thread.
+// SQLite runs inside whichever COMMIT crosses the threshold, never hold up the io thread. A checkpoint is a job of
+// this thread like a step's commit: a step queued behind one waits for it (the committer's own commits ran theirs
+// inline before, so its steps waited as long).
 //
 // Threads and locks: one thread (a WorkerPool of one, its queue unbounded: each execution waits for its
 // own step, so no more than the executions running are ever queued, and at most one checkpoint waits). The
@@ -33,7 +35,8 @@ class WorkerPool;
 class StepCommitter {
  public:
   // Opens the second writer's connection to the database a Store has already opened. With `io_thread_store`
-  // (that Store, used on the io thread), its checkpoints are handed here until shutdown(); it must outlive this.
+  // (that Store, used on the io thread), its checkpoints are handed here until shutdown(); it must outlive this,
+  // and this constructor and shutdown() must run where that Store is used (the io thread), or while it is not.
   StepCommitter(boost::asio::any_io_executor io, const std::filesystem::path& database_path,
                 store::Store* io_thread_store = nullptr);
   ~StepCommitter();

@@ -20,9 +20,10 @@ class Statement;
 // its write lock released; a checkpoint it then runs happens inside the same COMMIT call, on the same thread, with
 // other writers free to go on. On the heap, so that a moved Database keeps the address the hook was given.
 struct WalHookState {
-  std::uint64_t commits = 0;                             // commits seen by the hook on this connection
+  std::uint64_t commits = 0;                            // commits seen by the hook on this connection
   std::chrono::steady_clock::time_point last_commit{};  // when the last of them released the write lock
-  std::uint64_t checkpoints = 0;                         // checkpoints this connection ran (its hook's, or asked)
+  std::uint64_t checkpoints = 0;                        // checkpoints this connection ran (SQLITE_OK)
+  std::uint64_t checkpoint_failures = 0;                // in a row (a full disk): logged at the first and every 100th
   // Set: this connection never checkpoints itself; past the threshold it calls this instead, which must not
   // block (colorlabd's io thread hands its checkpoints to the step committer's thread).
   std::function<void()> checkpoint_elsewhere;

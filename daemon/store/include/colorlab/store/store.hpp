@@ -176,11 +176,13 @@ class Store {
 
   // The WAL's checkpoints (wal_policy.hpp): this connection's commits stop checkpointing it themselves and call
   // `ask` instead, which must not block; empty: they checkpoint again. colorlabd's io thread hands them to the step
-  // committer (daemon/core step_committer.hpp), whose connection then runs them (checkpoint_wal).
+  // committer (daemon/core step_committer.hpp), whose connection then runs them (checkpoint_wal). Call it on the
+  // thread that uses this Store, or while that thread is not committing: the hook reads `ask` there.
   void hand_wal_checkpoints_to(std::function<void()> ask);
   // A PASSIVE checkpoint on this connection now. Never throws (logged; asked again after a later commit).
   void checkpoint_wal() noexcept;
-  // How many checkpoints this connection has run (after its commits, or checkpoint_wal); 0 for a reader's.
+  // How many checkpoints this connection has run to completion of their call (after its commits, or checkpoint_wal;
+  // SQLITE_OK, whether or not a reader left frames uncopied); 0 for a reader's.
   std::uint64_t wal_checkpoints_run() const;
 
   // Creates a run and its execution in one transaction. With an idempotency key already used,
