@@ -17,17 +17,36 @@ using colorlab::store::Store;
 using colorlab::testing::TempDir;
 using nlohmann::json;
 
-TEST(WalPolicy, TheWalStaysWithinItsLimitThroughManyCommitsWhileAReaderKeepsReading) {
-  TempDir dir;
-  const auto db = dir / "colorlab.db";
-  Store store(db);
+namespace {
+
+// A step of one 96 KiB spectrum: about 24 pages of the WAL, so some 42 of them cross its checkpoint threshold.
+StepRecord big_step(int i) {
+  StepRecord step;
+  step.journal.push_back({i, "meter.measure", json::array(), {{"luminance", 100.0 + i}}});
+  step.measurements.push_back({"reading/" + std::to_string(i), "ls110", true, "luminance", 100.0 + i, "cd/m2", {{"spectrum", std::string(96 * 1024, 'x')}}});
+  step.step = "reading/" + std::to_string(i);
+  return step;
+}
+
+colorlab::store::ExecutionRecord an_execution(Store& store) {
   colorlab::store::NewRun run;
   run.campaign = "luminance-spot";
   run.simulated = true;
   run.instruments = json::array({{{"id", "ls110"}}});
   run.script_sha256 = "s1";
   run.script_source = "x";
-  const auto e = store.create_execution(run).execution;
+  return store.create_execution(run).execution;
+}
+
+std::uintmax_t database_bytes(const std::filesystem::path& db) { return std::filesystem::file_size(db); }
+
+}  // namespace
+
+TEST(WalPolicy, TheWalStaysWithinItsLimitThroughManyCommitsWhileAReaderKeepsReading) {
+  TempDir dir;
+  const auto db = dir / "colorlab.db";
+  Store store(db);
+  const auto e = an_execution(store);
 
   // A few spectra per step: 400 of them write more than twice the limit into the log.
   constexpr int kSteps = 400;
@@ -71,31 +90,6 @@ TEST(WalPolicy, TheWalStaysWithinItsLimitThroughManyCommitsWhileAReaderKeepsRead
             static_cast<std::int64_t>(kSteps * kPayload))
       << "the commits did not reach the database";
 }
-
-namespace {
-
-// A step of one 96 KiB spectrum: about 24 pages of the WAL, so some 42 of them cross its checkpoint threshold.
-StepRecord big_step(int i) {
-  StepRecord step;
-  step.journal.push_back({i, "meter.measure", json::array(), {{"luminance", 100.0 + i}}});
-  step.measurements.push_back({"reading/" + std::to_string(i), "ls110", true, "luminance", 100.0 + i, "cd/m2", {{"spectrum", std::string(96 * 1024, 'x')}}});
-  step.step = "reading/" + std::to_string(i);
-  return step;
-}
-
-colorlab::store::ExecutionRecord an_execution(Store& store) {
-  colorlab::store::NewRun run;
-  run.campaign = "luminance-spot";
-  run.simulated = true;
-  run.instruments = json::array({{{"id", "ls110"}}});
-  run.script_sha256 = "s1";
-  run.script_source = "x";
-  return store.create_execution(run).execution;
-}
-
-std::uintmax_t database_bytes(const std::filesystem::path& db) { return std::filesystem::file_size(db); }
-
-}  // namespace
 
 // SQLite checkpoints inside the COMMIT that crosses the threshold, on the committing thread; the io thread's
 // connection must never do that (wal_policy.hpp). A connection as is checkpoints after its crossing commit; one that
