@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <iostream>
+#include <map>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -17,17 +18,33 @@ using nlohmann::json;
 
 namespace {
 
-// `kill_at_ms` = 0 runs uninterrupted; otherwise the daemon is killed that long after the start.
+// What the moment of a kill found the run doing: its capture (killed), already ended, or not yet started.
+enum class KillLanded {
+  not_asked,
+  mid_capture,
+  after_the_end,
+  before_the_start
+};
+
+struct FrameAverageRun {
+  json run;
+  KillLanded landed = KillLanded::not_asked;
+  int run_ms = 0;  // from the request to the finished status, as polled
+};
+
+// `kill_at_ms` = 0 runs uninterrupted; otherwise the daemon is killed that long after the start, if the
+// run is then running.
 // `region` = null lets the campaign choose its window (on the first frame, by its spread: with noise,
 // two runs can choose windows of different levels, whose noise differs by more than the estimate's).
-json run_frame_average(int kill_at_ms, int& kills_done, int* run_ms = nullptr, const json& region = nullptr) {
+FrameAverageRun run_frame_average(int kill_at_ms, const json& region = nullptr) {
   TempDir dir;
   DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), 4, 1, "", true));  // the same lab every time
   auto api = api_for(daemon);
   bool have_camera = false;
   json instruments = api.get("/v1/instruments");
   for (const auto& i : instruments["items"]) have_camera = have_camera || i["kind"] == "genicam";
-  if (!have_camera) return json{{"skip", true}};
+  if (!have_camera) return {json{{"skip", true}}};
+  FrameAverageRun out;
   const auto posted = std::chrono::steady_clock::now();
   json params{{"frames", 8}};
   if (!region.is_null()) params["region"] = region;
@@ -37,32 +54,34 @@ json run_frame_average(int kill_at_ms, int& kills_done, int* run_ms = nullptr, c
     auto before = api.get("/v1/executions/" + e["id"].get<std::string>());
     if (before["status"] == "running") {
       daemon.kill9();
-      ++kills_done;
+      out.landed = KillLanded::mid_capture;
       EXPECT_EQ(integrity_check(daemon.state_dir()), "ok");
       daemon.start();
       api = api_for(daemon);
+    } else {
+      out.landed = before["status"] == "waiting" ? KillLanded::before_the_start : KillLanded::after_the_end;
     }
   }
   auto done = wait_terminal(api, e["id"]);
   EXPECT_EQ(done["status"], "finished_ok") << done.dump();
-  if (run_ms) {
-    *run_ms = static_cast<int>(
-        std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - posted).count());
-  }
-  return colorlab::client::fetch_run(api, e["run_id"].get<std::string>());
+  out.run_ms = static_cast<int>(
+      std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - posted).count());
+  out.run = colorlab::client::fetch_run(api, e["run_id"].get<std::string>());
+  return out;
 }
 
 }  // namespace
 
 TEST(KillNineFrameAverage, ResumesWithTheUninterruptedRunsRowsOverSixSeeds) {
-  int unused = 0;
-  int uninterrupted_ms = 0;
-  json reference = run_frame_average(0, unused, &uninterrupted_ms);
-  // The capture is CPU-bound, so its length depends on the machine: the kills are placed at fractions of
-  // this machine's own uninterrupted run (from the request to the finished status, as polled), not at
-  // fixed delays that a faster machine outruns.
-  std::cout << "[kill -9] frame-average uninterrupted: " << uninterrupted_ms << " ms\n";
+  const FrameAverageRun uninterrupted = run_frame_average(0);
+  const json& reference = uninterrupted.run;
   if (reference.contains("skip")) GTEST_SKIP() << "the simulated lab could not start its GigE Vision camera on 127.0.0.1";
+  // The capture is CPU-bound, so its length depends on the machine and on what else it is doing: the kills
+  // are placed at fractions of this machine's own uninterrupted run, not at fixed delays that a faster
+  // machine outruns. Under a loaded suite that reference can be several times a later run's length (4.7 s
+  // against runs that ended before 58 % of it), so a kill that finds the run ended is tried again earlier,
+  // and one that finds it not yet started, later: the count below is of kills that landed in a capture.
+  std::cout << "[kill -9] frame-average uninterrupted: " << uninterrupted.run_ms << " ms\n";
   std::map<std::string, double> ref;
   for (const auto& m : reference["measurements"]) ref[m["step"]] = m["value"];
   ASSERT_EQ(ref.size(), 12u);  // subsets 1, 2, 4, 8 × R, G, B
@@ -73,16 +92,26 @@ TEST(KillNineFrameAverage, ResumesWithTheUninterruptedRunsRowsOverSixSeeds) {
   for (std::uint64_t seed = 1; seed <= 6; ++seed) {
     SCOPED_TRACE("seed " + std::to_string(seed));
     // Seeds 1..6 kill at 10 %, 26 %, 42 %, 58 %, 74 %, 90 % of the uninterrupted run.
-    const int kill_at_ms = std::max(20, static_cast<int>(uninterrupted_ms * (0.1 + 0.16 * static_cast<double>(seed - 1))));
-    json run = run_frame_average(kill_at_ms, kills, nullptr, region);
-    std::map<std::string, double> got;
-    for (const auto& m : run["measurements"]) {
-      EXPECT_TRUE(got.emplace(m["step"], m["value"]).second) << m["step"] << " stored twice";
-    }
-    ASSERT_EQ(got.size(), ref.size());
-    for (const auto& [step, value] : ref) {
-      ASSERT_TRUE(got.count(step)) << step;
-      EXPECT_NEAR(got[step], value, 0.3 * value) << step;
+    int kill_at_ms = std::max(20, static_cast<int>(uninterrupted.run_ms * (0.1 + 0.16 * static_cast<double>(seed - 1))));
+    for (int attempt = 1; attempt <= 3; ++attempt) {
+      const FrameAverageRun killed = run_frame_average(kill_at_ms, region);
+      std::map<std::string, double> got;
+      for (const auto& m : killed.run["measurements"]) {
+        EXPECT_TRUE(got.emplace(m["step"], m["value"]).second) << m["step"] << " stored twice";
+      }
+      ASSERT_EQ(got.size(), ref.size());
+      for (const auto& [step, value] : ref) {
+        ASSERT_TRUE(got.count(step)) << step;
+        EXPECT_NEAR(got[step], value, 0.3 * value) << step;
+      }
+      if (killed.landed == KillLanded::mid_capture) {
+        ++kills;
+        break;
+      }
+      const bool late = killed.landed == KillLanded::after_the_end;
+      std::cout << "[kill -9] seed " << seed << ": the kill at " << kill_at_ms << " ms found the run "
+                << (late ? "ended" : "not yet started") << " (it took " << killed.run_ms << " ms)\n";
+      kill_at_ms = std::max(20, late ? kill_at_ms / 2 : kill_at_ms * 3 / 2);
     }
   }
   EXPECT_GE(kills, 3) << "most kills must land mid-capture";
