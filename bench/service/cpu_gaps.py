@@ -55,15 +55,18 @@ def watch(cpu, seconds, gap_ns, sleep_s, out, stop=None):
 
 class MachineWatch:
     """One watcher per CPU, each sleeping `sleep_ms` (0: busy-looping) and recording every wake-up later than
-    `gap_ms`, from start() for `seconds` (join() waits for them) or until stop(); both return their results (as
-    --json writes them)."""
+    `gap_ms`: from start() for `seconds`, then join() returns their results (as --json writes them); or, without
+    `seconds`, until stop(), which returns them (join() alone would then wait for ever)."""
 
     def __init__(self, cpus=None, gap_ms=2.0, sleep_ms=1.0, seconds=None):
         self.cpus = sorted(cpus if cpus is not None else os.sched_getaffinity(0))
         ctx = multiprocessing.get_context("fork")
         self.stop_event, self.out = ctx.Event(), ctx.Queue()
+        # Given a duration, the watchers are not handed the stop event: Event.is_set() takes a lock all of them
+        # share, and a busy-looping watcher would time its neighbour's stall while that one held it.
+        stop = self.stop_event if seconds is None else None
         self.procs = [ctx.Process(target=watch, args=(c, seconds, int(gap_ms * 1e6), sleep_ms / 1000.0, self.out,
-                                                      self.stop_event), daemon=True) for c in self.cpus]
+                                                      stop), daemon=True) for c in self.cpus]
 
     def start(self):
         for p in self.procs:
