@@ -72,9 +72,12 @@ class FollowTest(unittest.TestCase):
 
         def stream(h):
             h.start_chunked()
-            h.chunk(b"id: 10\nevent: snapshot\ndata: " + json.dumps(
-                {"last_seq": 10, "executions": [], "requests": self.waiting}).encode() + b"\n\n")
+            snapshot = b"id: 10\nevent: snapshot\ndata: " + json.dumps(
+                {"last_seq": 10, "executions": [], "requests": self.waiting}).encode() + b"\n\n"
+            # Set once the snapshot is taken, before it is sent: set after, a client that read the execution as
+            # soon as the snapshot arrived (as it should) could be answered before this thread ran again.
             snapshot_sent.set()
+            h.chunk(snapshot)
             # Wait until follow() has read the execution, as a real run would go on meanwhile.
             for _ in range(2000):
                 if fake.requests_to("GET", f"/v1/executions/{EID}"):
