@@ -2,13 +2,13 @@
 
 #include <time.h>
 
-#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 
 #include <boost/asio/steady_timer.hpp>
 
 #include "colorlab/core/log.hpp"
+#include "colorlab/core/thread_account.hpp"
 
 namespace colorlab::daemon {
 
@@ -53,37 +53,17 @@ IoStage::~IoStage() {
                                 ms_text(cpu) + " ms (limit " + ms_text(io_slow_threshold()) + " ms)");
 }
 
-namespace {
-
-// The io thread's own account (Linux /proc/thread-self/schedstat): ns on a CPU, ns runnable but waiting for
-// one. What a late tick's interval holds beyond the two, the thread spent blocked (a disk, a lock).
-struct SchedStat {
-  long long on_cpu_ns = 0, waiting_ns = 0;
-  bool ok = false;
-};
-
-SchedStat read_schedstat() {
-  SchedStat s;
-  if (FILE* f = std::fopen("/proc/thread-self/schedstat", "r")) {
-    s.ok = std::fscanf(f, "%lld %lld", &s.on_cpu_ns, &s.waiting_ns) == 2;
-    std::fclose(f);
-  }
-  return s;
-}
-
-}  // namespace
-
 struct IoLagMonitor::State {
   explicit State(boost::asio::any_io_executor io) : timer(io) {}
   boost::asio::steady_timer timer;
   std::chrono::milliseconds tick{0};
   Clock::time_point armed, due;
-  SchedStat at_arming;
+  ThreadAccount at_arming;  // the io thread's own account when the tick was armed
   bool stopped = false;
 
   static void schedule(const std::shared_ptr<State>& self) {
     self->armed = Clock::now();
-    self->at_arming = read_schedstat();
+    self->at_arming = this_thread_account();
     self->due = self->armed + self->tick;
     self->timer.expires_at(self->due);
     self->timer.async_wait([weak = std::weak_ptr<State>(self)](boost::system::error_code ec) {
@@ -92,19 +72,10 @@ struct IoLagMonitor::State {
       const auto now = Clock::now();
       const auto late = std::chrono::duration_cast<std::chrono::microseconds>(now - s->due);
       if (late > io_slow_threshold()) {
-        std::string split;
-        const SchedStat at_firing = read_schedstat();
-        if (s->at_arming.ok && at_firing.ok) {
-          // Over the whole interval (tick + lateness): working, waiting for a CPU, or blocked.
-          const auto interval = std::chrono::duration_cast<std::chrono::microseconds>(now - s->armed);
-          const std::chrono::microseconds cpu((at_firing.on_cpu_ns - s->at_arming.on_cpu_ns) / 1000);
-          const std::chrono::microseconds queued((at_firing.waiting_ns - s->at_arming.waiting_ns) / 1000);
-          const auto blocked = std::max(std::chrono::microseconds(0), interval - cpu - queued);
-          split = " (of its " + ms_text(interval) + " ms: on a CPU " + ms_text(cpu) + ", waiting for a CPU " +
-                  ms_text(queued) + ", blocked " + ms_text(blocked) + ")";
-        }
+        // Over the whole interval (tick + lateness): working, waiting for a CPU, or blocked.
+        const std::string split = split_of_interval(now - s->armed, s->at_arming, this_thread_account());
         log::warning("io-thread", "the io thread was busy: a " + std::to_string(s->tick.count()) + " ms tick fired " +
-                                      ms_text(late) + " ms late" + split);
+                                      ms_text(late) + " ms late" + (split.empty() ? "" : " (" + split + ")"));
       }
       schedule(s);
     });

@@ -176,6 +176,7 @@ Transaction::Transaction(Database& db) : db_(db) {
   WriterWaitTimer timed;
   db_.exec("BEGIN IMMEDIATE");
   holding_since_ = std::chrono::steady_clock::now();
+  account_at_begin_ = this_thread_account();
 }
 
 Transaction::~Transaction() {
@@ -201,8 +202,13 @@ void Transaction::commit() {
   if (held >= kLongWriteLockHold) {
     char thread[16] = "?";
     pthread_getname_np(pthread_self(), thread, sizeof thread);
+    // The account now, not at the release: what the thread did after it (a checkpoint in the same call) is
+    // in it, so the split is of BEGIN to now, said as such.
+    const auto until_now = std::chrono::steady_clock::now() - holding_since_;
+    const std::string split = split_of_interval(until_now, account_at_begin_, this_thread_account());
     log::warning("store", "a transaction held the write lock " + std::to_string(std::lround(held.count())) +
-                              " ms (thread " + thread + "); other writers waited up to that long");
+                              " ms (thread " + thread + (split.empty() ? "" : "; from BEGIN to its end, " + split) +
+                              "); other writers waited up to that long");
   }
 }
 

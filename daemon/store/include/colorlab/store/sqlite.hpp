@@ -9,6 +9,8 @@
 #include <string>
 #include <string_view>
 
+#include "colorlab/core/thread_account.hpp"
+
 struct sqlite3;
 struct sqlite3_stmt;
 
@@ -121,6 +123,9 @@ class Transaction {
   // runs after it, in the same call, holds up this thread only): a long hold is logged, since every other writer —
   // the io thread among them — waited that long (busy_retry.hpp).
   std::chrono::steady_clock::time_point holding_since_;
+  // The holding thread's own account at BEGIN: a long hold is split into its CPU, its wait for a CPU and the
+  // rest (blocked: the WAL's fsync, a lock), which says whether the disk or the scheduler made it long.
+  ThreadAccount account_at_begin_;
 };
 
 }  // namespace colorlab::store

@@ -1,0 +1,22 @@
+#pragma once
+// What the calling thread has spent so far by the kernel's own account (Linux /proc/thread-self/schedstat): time
+// on a CPU, and time runnable but waiting for one. Two readings around an interval, taken from its wall time,
+// leave what the thread spent blocked (a disk, a lock, a sleep).
+#include <chrono>
+#include <string>
+
+namespace colorlab {
+
+struct ThreadAccount {
+  std::chrono::nanoseconds on_cpu{0};
+  std::chrono::nanoseconds waiting_for_cpu{0};
+  bool known = false;  // no schedstat (a kernel without CONFIG_SCHED_INFO): nothing above is meaningful
+};
+
+ThreadAccount this_thread_account() noexcept;
+
+// "of its W ms: on a CPU C, waiting for a CPU Q, blocked B" for an interval of `wall` between two readings of the
+// same thread; empty when either reading is unknown.
+std::string split_of_interval(std::chrono::nanoseconds wall, const ThreadAccount& before, const ThreadAccount& after);
+
+}  // namespace colorlab
