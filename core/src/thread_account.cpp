@@ -1,7 +1,12 @@
 #include "colorlab/core/thread_account.hpp"
 
+#include <fcntl.h>
+#include <time.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 
 namespace colorlab {
 
@@ -13,17 +18,51 @@ std::string ms_text(std::chrono::nanoseconds d) {
   return buf;
 }
 
+// Opened by the thread that reads it: /proc/thread-self names that thread for as long as the descriptor lives.
+class OwnSchedstat {
+ public:
+  OwnSchedstat() : fd_(::open("/proc/thread-self/schedstat", O_RDONLY | O_CLOEXEC)) {}
+  ~OwnSchedstat() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  OwnSchedstat(const OwnSchedstat&) = delete;
+  OwnSchedstat& operator=(const OwnSchedstat&) = delete;
+
+  // The second field, nanoseconds runnable but not running; -1 when unreadable.
+  long long waiting_ns() const {
+    if (fd_ < 0) return -1;
+    char text[96];
+    const ssize_t n = ::pread(fd_, text, sizeof text - 1, 0);
+    if (n <= 0) return -1;
+    text[n] = '\0';
+    char* end = nullptr;
+    std::strtoll(text, &end, 10);  // run time: taken from the thread's CPU clock instead
+    if (end == text) return -1;
+    char* after = nullptr;
+    const long long waiting = std::strtoll(end, &after, 10);
+    return after == end ? -1 : waiting;
+  }
+
+ private:
+  int fd_;
+};
+
 }  // namespace
 
+std::chrono::nanoseconds this_thread_cpu_time() noexcept {
+  timespec ts{};
+  ::clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return std::chrono::seconds(ts.tv_sec) + std::chrono::nanoseconds(ts.tv_nsec);
+}
+
 ThreadAccount this_thread_account() noexcept {
+  thread_local const OwnSchedstat schedstat;
   ThreadAccount a;
-  if (FILE* f = std::fopen("/proc/thread-self/schedstat", "r")) {
-    long long on_cpu_ns = 0, waiting_ns = 0;
-    a.known = std::fscanf(f, "%lld %lld", &on_cpu_ns, &waiting_ns) == 2;
-    std::fclose(f);
-    a.on_cpu = std::chrono::nanoseconds(on_cpu_ns);
-    a.waiting_for_cpu = std::chrono::nanoseconds(waiting_ns);
-  }
+  const long long waiting = schedstat.waiting_ns();
+  if (waiting < 0) return a;
+  a.known = true;
+  a.on_cpu = this_thread_cpu_time();
+  a.waiting_for_cpu = std::chrono::nanoseconds(waiting);
   return a;
 }
 

@@ -18,6 +18,7 @@
 #include "colorlab/core/error.hpp"
 #include "colorlab/core/ids.hpp"
 #include "colorlab/core/log.hpp"
+#include "colorlab/core/thread_account.hpp"
 #include "colorlab/core/thread_priority.hpp"
 #include "colorlab/campaigns/catalogue.hpp"
 #include "colorlab/campaigns/lab.hpp"
@@ -103,13 +104,13 @@ class HandlerTiming {
   explicit HandlerTiming(AnswerTiming& timing)
       : timing_(timing),
         start_(std::chrono::steady_clock::now()),
-        cpu_(thread_cpu_time()),
+        cpu_(this_thread_cpu_time()),
         store_us_(store::writer_wait_us_this_thread()) {
     timing_.queue = std::chrono::duration_cast<std::chrono::microseconds>(start_ - timing_.received);
   }
   ~HandlerTiming() {
     timing_.handler = std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - start_);
-    timing_.cpu = thread_cpu_time() - cpu_;
+    timing_.cpu = std::chrono::duration_cast<std::chrono::microseconds>(this_thread_cpu_time() - cpu_);
     timing_.store = std::chrono::microseconds(store::writer_wait_us_this_thread() - store_us_);
   }
   HandlerTiming(const HandlerTiming&) = delete;
@@ -118,7 +119,7 @@ class HandlerTiming {
  private:
   AnswerTiming& timing_;
   std::chrono::steady_clock::time_point start_;
-  std::chrono::microseconds cpu_;
+  std::chrono::nanoseconds cpu_;
   std::int64_t store_us_;
 };
 

@@ -40,8 +40,9 @@ PRODUCTION_ROOT = "colorlabd"
 NETWORK_HEADERS = re.compile(r"^(boost/asio|boost/beast|asio\.hpp|asio/|sys/socket\.h|netinet/|arpa/|netdb\.h|sys/un\.h)")
 CORE_EXTERNAL_HEADERS = {"nlohmann/json.hpp", "toml++/toml.h"}  # header-only; no library behind them
 # The C library's POSIX headers core/ may use: they add no library to a link line (every program links libc), and
-# a thread's name and CPU priority (core/thread_priority.hpp, shared by the daemon, campaigns and drivers) need them.
-CORE_LIBC_HEADERS = {"pthread.h", "sys/resource.h", "sys/syscall.h", "unistd.h"}
+# a thread's name and CPU priority (core/thread_priority.hpp, shared by the daemon, campaigns and drivers) and its
+# own account of its time (core/thread_account.hpp: its CPU clock, its schedstat file kept open) need them.
+CORE_LIBC_HEADERS = {"fcntl.h", "pthread.h", "sys/resource.h", "sys/syscall.h", "time.h", "unistd.h"}
 INCLUDE = re.compile(r'^\s*#\s*include\s*([<"])([^>"]+)[>"]', re.M)
 
 

@@ -317,7 +317,7 @@ class ScriptRun final : public LabCallSink {
       std::string reason = *cause + ": " + failure->what();
       log::warning(script_.name, "suspended at " + c.call + ": " + reason);
       sink_.suspended(reason, *failure);
-      json how = co_await lab_.await_recovery(c.call, *failure, control_);
+      json how = co_await lab_.await_recovery(c.call, c.args, *failure, control_);
       log::info(script_.name, "condition cleared (" + how.dump() + "); measuring the interrupted step again");
       sink_.resumed(how);
     }

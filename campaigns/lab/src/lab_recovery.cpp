@@ -9,6 +9,7 @@
 #include "colorlab/campaigns/roles.hpp"
 #include "colorlab/core/error.hpp"
 #include "colorlab/core/log.hpp"
+#include "colorlab/drivers/camera/camera_instrument.hpp"
 #include "colorlab/drivers/lab_capabilities.hpp"
 
 namespace colorlab::campaigns {
@@ -27,6 +28,35 @@ std::optional<Capability> capability_for(const std::string& call) {
 }
 
 bool is_lamp_condition(const Error& e) { return e.info().device_code.rfind("lamp:", 0) == 0; }
+
+bool is_down(drivers::InstrumentState s) {
+  return s == drivers::InstrumentState::disconnected || s == drivers::InstrumentState::fault;
+}
+
+// The instrument a failed call was using, to bring back: the camera it named ({camera = id or kind}, on a lab with
+// two), else of those offering the call's capability the one that is down, else the first. A lab with a GigE and a
+// DSLR camera otherwise reconnected the GigE for a DSLR that had gone, reported the condition cleared, and failed
+// again at every retry.
+std::shared_ptr<drivers::Instrument> instrument_of_call(const InstrumentSet& instruments, const std::string& call,
+                                                        const json& args) {
+  if (args.is_array() && !args.empty() && args[0].is_object() && args[0].contains("camera")) {
+    try {
+      return select_camera(instruments, args[0]["camera"]);
+    } catch (const Error&) {
+      // A camera no instrument is: the call refuses it itself when made again.
+    }
+  }
+  const auto capability = capability_for(call);
+  if (!capability) return nullptr;
+  std::shared_ptr<drivers::Instrument> first;
+  for (const auto& i : instruments.all()) {
+    const auto offered = i->capabilities();
+    if (std::find(offered.begin(), offered.end(), *capability) == offered.end()) continue;
+    if (is_down(i->state())) return i;
+    if (!first) first = i;
+  }
+  return first;
+}
 
 }  // namespace
 
@@ -120,7 +150,8 @@ void Lab::check_dropout(double luminance, const std::string& unit) const {
   throw Error(std::move(info));
 }
 
-asio::awaitable<json> Lab::await_recovery(const std::string& call, const Error& cause, const ExecutionControl& control) {
+asio::awaitable<json> Lab::await_recovery(const std::string& call, const json& args, const Error& cause,
+                                          const ExecutionControl& control) {
   const auto& p = options_.suspend;
   auto wall = [&](double lab_s) {
     auto d = std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(lab_s / options_.time_scale));
@@ -179,18 +210,12 @@ asio::awaitable<json> Lab::await_recovery(const std::string& call, const Error& 
         resumed_note_ = how;
         co_return how;
       }
-      auto capability = capability_for(call);
-      std::shared_ptr<drivers::Instrument> instrument;
-      for (const auto& i : instruments_.all()) {
-        for (auto c : i->capabilities()) {
-          if (capability && c == *capability && !instrument) instrument = i;
-        }
-      }
+      auto instrument = instrument_of_call(instruments_, call, args);
       if (!instrument) {
         // Nothing offers it any more (a Spectrolino that lost its table): connect every instrument that
         // is down and look again.
         for (const auto& i : instruments_.all()) {
-          if (i->state() == drivers::InstrumentState::disconnected || i->state() == drivers::InstrumentState::fault) {
+          if (is_down(i->state())) {
             instrument = i;
             break;
           }
@@ -201,7 +226,7 @@ asio::awaitable<json> Lab::await_recovery(const std::string& call, const Error& 
       // Hysteresis: a link that flaps must stay up for the settle time before measuring again.
       co_await sleep_wall(wall(p.settle_s), control);
       auto s = instrument->state();
-      if (s == drivers::InstrumentState::disconnected || s == drivers::InstrumentState::fault) continue;
+      if (is_down(s)) continue;
       co_return json{{"condition", "instrument"}, {"instrument", instrument->id()}, {"checks", checks}};
     } catch (const Error& e) {
       if (e.cls() == ErrorClass::aborted && control.requested()) throw;

@@ -1,6 +1,5 @@
 #include "colorlab/daemon/io_watch.hpp"
 
-#include <time.h>
 
 #include <cstdio>
 #include <cstdlib>
@@ -32,23 +31,17 @@ std::string ms_text(std::chrono::microseconds us) {
 
 }  // namespace
 
-std::chrono::microseconds thread_cpu_time() {
-  timespec ts{};
-  ::clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return std::chrono::microseconds(static_cast<long long>(ts.tv_sec) * 1000000 + ts.tv_nsec / 1000);
-}
-
 std::chrono::microseconds io_slow_threshold() {
   static const std::chrono::microseconds threshold = std::chrono::milliseconds(env_ms("COLORLAB_IO_SLOW_MS", 50));
   return threshold;
 }
 
-IoStage::IoStage(std::string_view stage) : stage_(stage), start_(Clock::now()), cpu_start_(thread_cpu_time()) {}
+IoStage::IoStage(std::string_view stage) : stage_(stage), start_(Clock::now()), cpu_start_(this_thread_cpu_time()) {}
 
 IoStage::~IoStage() {
   const auto took = std::chrono::duration_cast<std::chrono::microseconds>(Clock::now() - start_);
   if (took <= io_slow_threshold()) return;
-  const auto cpu = thread_cpu_time() - cpu_start_;
+  const auto cpu = std::chrono::duration_cast<std::chrono::microseconds>(this_thread_cpu_time() - cpu_start_);
   log::warning("io-thread", "slow stage '" + std::string(stage_) + "' took " + ms_text(took) + " ms, on a CPU " +
                                 ms_text(cpu) + " ms (limit " + ms_text(io_slow_threshold()) + " ms)");
 }

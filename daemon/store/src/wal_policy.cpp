@@ -54,6 +54,10 @@ int after_commit(void* state_ptr, sqlite3* db, const char* schema, int wal_pages
   auto* state = static_cast<WalHookState*>(state_ptr);
   state->last_commit = std::chrono::steady_clock::now();
   ++state->commits;
+  const bool long_hold = state->write_lock_since != std::chrono::steady_clock::time_point{} &&
+                         state->last_commit - state->write_lock_since >= kLongWriteLockHold;
+  state->account_at_release = long_hold ? this_thread_account() : ThreadAccount{};
+  state->write_lock_since = {};
   if (wal_pages < kWalAutocheckpointPages) return SQLITE_OK;
   if (state->checkpoint_elsewhere) {
     try {

@@ -84,9 +84,10 @@ class Lab {
   // nullopt for a failure no waiting mends (a bad argument, a script error, a device error code).
   static std::optional<std::string> suspend_cause(const Error& e);
   // Returns once the condition behind `cause` has cleared and stayed clear for the settle time;
-  // Error{aborted} when `control` asks, or `cause` again after SuspendPolicy::max_s.
-  boost::asio::awaitable<nlohmann::json> await_recovery(const std::string& call, const Error& cause,
-                                                        const ExecutionControl& control);
+  // Error{aborted} when `control` asks, or `cause` again after SuspendPolicy::max_s. `args` are the failed
+  // call's: an instrument is brought back as that call chose it (a camera named by id or kind).
+  boost::asio::awaitable<nlohmann::json> await_recovery(const std::string& call, const nlohmann::json& args,
+                                                        const Error& cause, const ExecutionControl& control);
   // One retry interval of a suspension (for conditions the engine checks itself, a full disk).
   boost::asio::awaitable<void> wait_retry(const ExecutionControl& control);
   // Brings the instruments to `desired`; returns what it did, for the event log.

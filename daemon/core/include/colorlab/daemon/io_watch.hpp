@@ -21,9 +21,6 @@ namespace colorlab::daemon {
 
 std::chrono::microseconds io_slow_threshold();
 
-// The calling thread's CPU time so far (CLOCK_THREAD_CPUTIME_ID): how much of a stretch of wall time was work.
-std::chrono::microseconds thread_cpu_time();
-
 class IoStage {
  public:
   explicit IoStage(std::string_view stage);
@@ -34,7 +31,7 @@ class IoStage {
  private:
   std::string_view stage_;
   std::chrono::steady_clock::time_point start_;
-  std::chrono::microseconds cpu_start_;  // a slow stage's line says how much of it was work
+  std::chrono::nanoseconds cpu_start_;  // a slow stage's line says how much of it was work
 };
 
 // The same, for a stage whose name is made at run time (a route's method and pattern).

@@ -18,14 +18,22 @@ namespace colorlab::store {
 
 class Statement;
 
+// A transaction that holds the write lock this long is logged: every other writer, the io thread among them, waited.
+inline constexpr std::chrono::milliseconds kLongWriteLockHold{50};
+
 // What a writer connection's WAL hook (wal_policy.cpp) keeps. SQLite calls the hook once a commit is durable and
 // its write lock released; a checkpoint it then runs happens inside the same COMMIT call, on the same thread, with
 // other writers free to go on. On the heap, so that a moved Database keeps the address the hook was given.
 struct WalHookState {
   std::uint64_t commits = 0;                            // commits seen by the hook on this connection
   std::chrono::steady_clock::time_point last_commit{};  // when the last of them released the write lock
-  std::uint64_t checkpoints = 0;                        // checkpoints this connection ran (SQLITE_OK)
-  std::uint64_t checkpoint_failures = 0;                // in a row (a full disk): logged at the first and every 100th
+  // Set by a Transaction at BEGIN. A commit that releases the lock kLongWriteLockHold or more after it takes the
+  // thread's account at the release, before a checkpoint in the same call, so that the logged hold is split up to
+  // the release and no further (account_at_release, unknown for any other commit).
+  std::chrono::steady_clock::time_point write_lock_since{};
+  ThreadAccount account_at_release;
+  std::uint64_t checkpoints = 0;          // checkpoints this connection ran (SQLITE_OK)
+  std::uint64_t checkpoint_failures = 0;  // in a row (a full disk): logged at the first and every 100th
   // Set: this connection never checkpoints itself; past the threshold it calls this instead, which must not
   // block (colorlabd's io thread hands its checkpoints to the step committer's thread).
   std::function<void()> checkpoint_elsewhere;
