@@ -21,15 +21,18 @@ std::string ms_text(std::chrono::nanoseconds d) {
 // Opened by the thread that reads it: /proc/thread-self names that thread for as long as the descriptor lives.
 class OwnSchedstat {
  public:
-  OwnSchedstat() : fd_(::open("/proc/thread-self/schedstat", O_RDONLY | O_CLOEXEC)) {}
+  OwnSchedstat() = default;
   ~OwnSchedstat() {
     if (fd_ >= 0) ::close(fd_);
+    fd_ = -1;
   }
   OwnSchedstat(const OwnSchedstat&) = delete;
   OwnSchedstat& operator=(const OwnSchedstat&) = delete;
 
-  // The second field, nanoseconds runnable but not running; -1 when unreadable.
-  long long waiting_ns() const {
+  // The second field, nanoseconds runnable but not running; -1 when unreadable. An open that failed (descriptors
+  // exhausted for a moment) is tried again at the next reading, so a long-lived thread does not lose its account.
+  long long waiting_ns() {
+    if (fd_ < 0) fd_ = ::open("/proc/thread-self/schedstat", O_RDONLY | O_CLOEXEC);
     if (fd_ < 0) return -1;
     char text[96];
     const ssize_t n = ::pread(fd_, text, sizeof text - 1, 0);
@@ -44,7 +47,7 @@ class OwnSchedstat {
   }
 
  private:
-  int fd_;
+  int fd_ = -1;
 };
 
 }  // namespace
@@ -56,7 +59,7 @@ std::chrono::nanoseconds this_thread_cpu_time() noexcept {
 }
 
 ThreadAccount this_thread_account() noexcept {
-  thread_local const OwnSchedstat schedstat;
+  thread_local OwnSchedstat schedstat;
   ThreadAccount a;
   const long long waiting = schedstat.waiting_ns();
   if (waiting < 0) return a;

@@ -298,7 +298,7 @@ TEST(SuspendNotFail, ACameraTheCallNamedThatGoesAwayIsTheOneBroughtBack) {
   std::filesystem::create_directories(dir / "state" / "campaigns");
   std::ofstream(dir / "state" / "campaigns" / "named_dslr.lua") << kNamedDslr;
   auto api = api_for(daemon);
-  auto e = api.post("/v1/executions", {{"campaign", "named_dslr"}, {"params", {{"rounds", 20}}}});
+  auto e = api.post("/v1/executions", {{"campaign", "named_dslr"}, {"params", {{"rounds", 40}}}});
   wait_for_measurements(api, e, 3);
   control(daemon, {{"cmd", "fault"}, {"instrument", "dslr"}, {"faults", {{"disconnect", true}}}});
   std::string reason = wait_suspended(api, e, std::chrono::seconds(30));
@@ -311,7 +311,7 @@ TEST(SuspendNotFail, ACameraTheCallNamedThatGoesAwayIsTheOneBroughtBack) {
   control(daemon, {{"cmd", "fault"}, {"instrument", "dslr"}, {"faults", {{"disconnect", false}}}});
   auto done = wait_terminal(api, e["id"], std::chrono::seconds(120));
   ASSERT_EQ(done["status"], "finished_ok") << done.dump(2);
-  EXPECT_EQ(measurements_of(api, e), 20u);
+  EXPECT_EQ(measurements_of(api, e), 40u);
 
   int suspensions = 0;
   json how;

@@ -39,15 +39,16 @@ bool is_down(drivers::InstrumentState s) {
 // again at every retry.
 std::shared_ptr<drivers::Instrument> instrument_of_call(const InstrumentSet& instruments, const std::string& call,
                                                         const json& args) {
-  if (args.is_array() && !args.empty() && args[0].is_object() && args[0].contains("camera")) {
+  const auto capability = capability_for(call);
+  if (!capability) return nullptr;
+  if (*capability == Capability::camera && args.is_array() && !args.empty() && args[0].is_object() &&
+      args[0].contains("camera")) {
     try {
       return select_camera(instruments, args[0]["camera"]);
     } catch (const Error&) {
       // A camera no instrument is: the call refuses it itself when made again.
     }
   }
-  const auto capability = capability_for(call);
-  if (!capability) return nullptr;
   std::shared_ptr<drivers::Instrument> first;
   for (const auto& i : instruments.all()) {
     const auto offered = i->capabilities();

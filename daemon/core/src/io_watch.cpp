@@ -1,6 +1,5 @@
 #include "colorlab/daemon/io_watch.hpp"
 
-
 #include <cstdio>
 #include <cstdlib>
 

@@ -56,7 +56,8 @@ int after_commit(void* state_ptr, sqlite3* db, const char* schema, int wal_pages
   ++state->commits;
   const bool long_hold = state->write_lock_since != std::chrono::steady_clock::time_point{} &&
                          state->last_commit - state->write_lock_since >= kLongWriteLockHold;
-  state->account_at_release = long_hold ? this_thread_account() : ThreadAccount{};
+  // Only where it is wanted: an ATTACHed schema's second call of the hook in the same COMMIT must not wipe it.
+  if (long_hold) state->account_at_release = this_thread_account();
   state->write_lock_since = {};
   if (wal_pages < kWalAutocheckpointPages) return SQLITE_OK;
   if (state->checkpoint_elsewhere) {

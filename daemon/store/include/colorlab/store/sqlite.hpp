@@ -18,7 +18,8 @@ namespace colorlab::store {
 
 class Statement;
 
-// A transaction that holds the write lock this long is logged: every other writer, the io thread among them, waited.
+// A transaction that holds the write lock this long is logged: every other writer, the io thread among them, waited
+// that long, and it is the API's target for an answer (issue 27).
 inline constexpr std::chrono::milliseconds kLongWriteLockHold{50};
 
 // What a writer connection's WAL hook (wal_policy.cpp) keeps. SQLite calls the hook once a commit is durable and
@@ -29,7 +30,7 @@ struct WalHookState {
   std::chrono::steady_clock::time_point last_commit{};  // when the last of them released the write lock
   // Set by a Transaction at BEGIN. A commit that releases the lock kLongWriteLockHold or more after it takes the
   // thread's account at the release, before a checkpoint in the same call, so that the logged hold is split up to
-  // the release and no further (account_at_release, unknown for any other commit).
+  // the release and no further (account_at_release, cleared by the Transaction before its COMMIT).
   std::chrono::steady_clock::time_point write_lock_since{};
   ThreadAccount account_at_release;
   std::uint64_t checkpoints = 0;          // checkpoints this connection ran (SQLITE_OK)
