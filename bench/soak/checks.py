@@ -1,7 +1,8 @@
 """What the soak concludes from its nights and samples.
 
 ``compare_nights``: every night's runs against night 1's (never killed): same steps, each run's rows and shape
-digest equal, seqs 1..N, no step key twice. ``growth``: per series, the per-night medians, the slope per simulated
+digest equal, seqs 1..N, no step key twice; and what each kill left committed (every run's rows then, values
+and data included) still there unchanged at the night's end (ledger.check_kept). ``growth``: per series, the per-night medians, the slope per simulated
 night and per wall hour after night 1, and the spread after night 1 against night 1's own level."""
 from __future__ import annotations
 
@@ -24,7 +25,15 @@ def compare_nights(nights: list[dict]) -> dict:
         n = night["night"]
         if night["state"] != "done":
             problems.append(f"night {n} ended {night['state']}: {night['items']}")
-        row = {"night": n, "kills": len(night["kills"]), "rows": 0, "runs_equal_to_night_1": 0, "runs": 0}
+        row = {"night": n, "kills": len(night["kills"]), "rows": 0, "runs_equal_to_night_1": 0, "runs": 0,
+               "committed_rows_checked_after_kills": 0}
+        for k, kill in enumerate(night["kills"], 1):
+            kept = kill.get("kept_check")
+            if kept is None:
+                problems.append(f"night {n} kill {k}: what it left committed was not checked")
+                continue
+            row["committed_rows_checked_after_kills"] += kept["rows"]
+            problems += [f"night {n} kill {k}: {c}" for c in kept["changed"]]
         if set(night["ledger"]) != set(ref):
             problems.append(f"night {n} has steps {sorted(night['ledger'])}, night 1 {sorted(ref)}")
         for step, led in night["ledger"].items():

@@ -17,6 +17,7 @@ sys.path.insert(0, str(SOURCE_DIR / "client" / "python" / "tests" / "integration
 import colorlab  # noqa: E402
 import daemon_fixture  # noqa: E402
 from daemon_fixture import Daemon, free_port  # noqa: E402
+from ledger import committed_values  # noqa: E402
 
 BIN_DIR = daemon_fixture.BIN_DIR
 
@@ -73,14 +74,21 @@ class Lab:
                         f"{self.daemon.log_text()}")
 
     def kill_and_restart(self, why: dict) -> dict:
-        """kill -9 of colorlabd, then the same daemon started again on the same state and port."""
+        """kill -9 of colorlabd, then the same daemon started again on the same state and port. Between the two, what
+        the dead daemon had committed is read from its file (``kept``: every run's rows and values digest), for
+        ledger.check_kept once the night has ended; ``restart_s`` counts from the kill to the new daemon's answer
+        without that read."""
         with self.lock:
             old = self.pid
             t0 = time.monotonic()
             self.daemon.kill9()
+            killed = time.monotonic()
+            kept = committed_values(self.state / "colorlab.db")
+            read_s = time.monotonic() - killed
             self.daemon.start()
             self.starts += 1
-            kill = {**why, "killed_pid": old, "new_pid": self.pid, "restart_s": round(time.monotonic() - t0, 3)}
+            kill = {**why, "killed_pid": old, "new_pid": self.pid,
+                    "restart_s": round(time.monotonic() - t0 - read_s, 3), "kept": kept}
         self.kills.append(kill)
         return kill
 

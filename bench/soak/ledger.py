@@ -6,7 +6,12 @@
   doubled measurement" check the soak can make honestly.
 - ``values``: sha256 over the whole rows (values and data too). The simulated lab's noise comes from one random
   stream per simulator process, which a kill -9 restarts (and which runs on from night to night), so values are
-  not expected to match between nights; the digest is recorded so a re-run of the same seed can be compared."""
+  not expected to match between nights; the digest is recorded so a re-run of the same seed can be compared.
+
+What values can be compared across a kill is what was committed before it: ``committed_values`` reads every run's
+rows from the file the killed daemon left (before it is started again), and ``check_kept`` finds, once the night has
+ended, each of those runs' first rows unchanged — the same seqs with the same whole rows, values and data included.
+A resume that lost, rewrote or re-recorded a committed measurement fails there."""
 from __future__ import annotations
 
 import hashlib
@@ -15,19 +20,29 @@ import sqlite3
 from pathlib import Path
 
 
-def run_ledger(db: Path, run_id: str) -> dict:
+ROW_COLUMNS = "seq, step, instrument_id, quantity, unit, value, data"
+
+
+def _read(db: Path, sql: str, args=()) -> list[tuple]:
     con = sqlite3.connect(f"file:{db}?mode=ro", uri=True, timeout=10)
     try:
-        rows = con.execute("SELECT seq, step, instrument_id, quantity, unit, value, data FROM measurements "
-                           "WHERE run_id = ? ORDER BY seq", (run_id,)).fetchall()
+        return con.execute(sql, args).fetchall()
     finally:
         con.close()
+
+
+def _row_bytes(row: tuple) -> bytes:
+    return json.dumps(list(row)).encode()
+
+
+def run_ledger(db: Path, run_id: str) -> dict:
+    rows = _read(db, f"SELECT {ROW_COLUMNS} FROM measurements WHERE run_id = ? ORDER BY seq", (run_id,))
     shape, values = hashlib.sha256(), hashlib.sha256()
     seen: set[str] = set()
     repeated: list[str] = []
     for seq, step, instrument, quantity, unit, value, data in rows:
         shape.update(json.dumps([seq, step, instrument, quantity, unit]).encode())
-        values.update(json.dumps([seq, step, instrument, quantity, unit, value, data]).encode())
+        values.update(_row_bytes((seq, step, instrument, quantity, unit, value, data)))
         if step in seen:
             repeated.append(step)
         seen.add(step)
@@ -46,3 +61,38 @@ def group_ledger(db: Path, group: dict) -> dict:
         else:
             out[item["step"]] = {"run_id": None, "rows": 0, "state": item["state"]}
     return out
+
+
+def committed_values(db: Path) -> dict:
+    """{run_id: {"rows": n, "last_seq": s, "values": digest}} over every run's rows in the file as it is now."""
+    digests: dict[str, dict] = {}
+    for row in _read(db, f"SELECT run_id, {ROW_COLUMNS} FROM measurements ORDER BY run_id, seq"):
+        entry = digests.setdefault(row[0], {"rows": 0, "last_seq": 0, "hash": hashlib.sha256()})
+        entry["rows"] += 1
+        entry["last_seq"] = row[1]
+        entry["hash"].update(_row_bytes(row[1:]))
+    return {run: {"rows": e["rows"], "last_seq": e["last_seq"], "values": e["hash"].hexdigest()}
+            for run, e in digests.items()}
+
+
+def check_kept(db: Path, kept: dict) -> dict:
+    """Each run of ``kept`` (committed_values at a kill) against the file now: its rows up to the seq it had then
+    must be the same rows, whole. Returns {"runs", "rows", "changed": [what differs]}."""
+    changed = []
+    for run_id, then in kept.items():
+        rows = _read(db, f"SELECT {ROW_COLUMNS} FROM measurements WHERE run_id = ? AND seq <= ? ORDER BY seq",
+                     (run_id, then["last_seq"]))
+        digest = hashlib.sha256()
+        for row in rows:
+            digest.update(_row_bytes(row))
+        if (len(rows), digest.hexdigest()) != (then["rows"], then["values"]):
+            now = "other values in them" if len(rows) == then["rows"] else f"{len(rows)} rows there"
+            changed.append(f"run {run_id}: {then['rows']} rows up to seq {then['last_seq']} at the kill, now {now}")
+    return {"runs": len(kept), "rows": sum(e["rows"] for e in kept.values()), "changed": changed}
+
+
+def check_kills(db: Path, kills: list[dict]) -> None:
+    """Replaces each kill's ``kept`` (what was committed when it fell) with ``kept_check`` against the file now."""
+    for kill in kills:
+        if "kept" in kill:
+            kill["kept_check"] = check_kept(db, kill.pop("kept"))

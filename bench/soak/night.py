@@ -7,7 +7,7 @@ import time
 import uuid
 
 from lab import Lab, SoakError
-from ledger import group_ledger
+from ledger import check_kills, group_ledger
 
 ENDED = ("done", "failed")
 
@@ -50,7 +50,8 @@ def status(lab: Lab, queued: dict) -> dict:
 
 def run_night(lab: Lab, night: int, queued: dict, kill_at: list[float], *, timeout: float,
               on_kill=None) -> dict:
-    """Follows the night to its end, killing the daemon at each moment of ``kill_at`` that comes before it."""
+    """Follows the night to its end, killing the daemon at each moment of ``kill_at`` that comes before it; at the
+    end, checks that what every kill left committed is still there unchanged (ledger.check_kills)."""
     t0 = time.monotonic()
     pending = sorted(kill_at)
     kills = []
@@ -78,6 +79,7 @@ def run_night(lab: Lab, night: int, queued: dict, kill_at: list[float], *, timeo
             break
         time.sleep(0.5)
     wall = time.monotonic() - t0
+    check_kills(lab.state / "colorlab.db", kills)
     return {"night": night, "state": doc["state"], "wall_s": round(wall, 1), "kills": kills,
             "missed_kills": pending, "items": [{k: i.get(k) for k in ("step", "campaign", "state", "run_id", "reason")}
                                                for i in doc["items"]],

@@ -326,8 +326,7 @@ TEST(BlobApi, KillNineBetweenFileAndRowLeavesAnOrphanTheNextStartReports) {
   for (int attempt = 0; attempt < 3; ++attempt) {
     TempDir dir;
     write_dslr_lab(dir.path());
-    std::filesystem::create_directories(dir / "state" / "campaigns");
-    std::ofstream(dir / "state" / "campaigns" / "capture-then-think.lua") << R"lua(
+    write_campaign(dir.path(), "capture-then-think.lua", R"lua(
 return {
   description = "test: a capture, then a long computation before the next lab call",
   needs = { "camera" },
@@ -340,7 +339,7 @@ return {
     return { x = x, blobs = #t.blobs }
   end,
 }
-)lua";
+)lua");
     std::set<std::string> at_kill;
     {
       DaemonProcess daemon(dir / "state", dir / "colorlabd.toml", dir / "colorlabd.log");
@@ -378,8 +377,7 @@ return {
 TEST(BlobApi, AResumedRunKeepsTheBlobsItsJournalNames) {
   TempDir dir;
   write_dslr_lab(dir.path());
-  std::filesystem::create_directories(dir / "state" / "campaigns");
-  std::ofstream(dir / "state" / "campaigns" / "capture-then-ask.lua") << R"lua(
+  write_campaign(dir.path(), "capture-then-ask.lua", R"lua(
 return {
   description = "test: a capture, then an operator request the test answers after a kill -9",
   needs = { "camera" },
@@ -391,7 +389,7 @@ return {
     return { blobs = t.blobs, answer = a.answer }
   end,
 }
-)lua";
+)lua");
   json before;
   std::string execution_id, run_id;
   {

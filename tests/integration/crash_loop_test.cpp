@@ -56,8 +56,7 @@ struct GuardLab {
   std::unique_ptr<DaemonProcess> daemon;
   explicit GuardLab(const std::string& campaigns_toml, const std::string& extra = {}) {
     auto config = write_daemon_config(dir.path(), kTimeScale, 3, "[campaigns]\n" + campaigns_toml + extra);
-    std::filesystem::create_directories(dir / "state" / "campaigns");
-    std::ofstream(dir / "state" / "campaigns" / "lit.lua") << kLit;
+    write_campaign(dir.path(), "lit.lua", kLit);
     daemon = std::make_unique<DaemonProcess>(dir / "state", config, dir / "colorlabd.log");
   }
   client::ApiClient api() const { return api_for(*daemon); }
@@ -389,7 +388,7 @@ TEST(CrashLoopGuard, AFailedRunNotifiesAndAnUnreachableWebhookHoldsNothing) {
   const auto file = out / "notifications.jsonl";
   // Port 9 (discard) on loopback: nothing listens there in a test machine; the POST fails at once.
   GuardLab lab("", notify_toml(file, "http://127.0.0.1:9/hooks/secret-token"));
-  std::ofstream(lab.dir / "state" / "campaigns" / "dirty.lua") << R"lua(
+  write_campaign(lab.dir.path(), "dirty.lua", R"lua(
 return {
   needs = { "luminance_meter" },
   run = function(p)
@@ -398,7 +397,7 @@ return {
     error("the tile is dirty")
   end,
 }
-)lua";
+)lua");
   auto api = lab.api();
   auto e = api.post("/v1/executions", {{"campaign", "dirty"}, {"params", json::object()}});
   auto done = wait_terminal(api, e["id"]);

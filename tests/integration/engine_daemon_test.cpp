@@ -57,7 +57,7 @@ TEST(EngineInDaemon, AScriptDroppedIntoTheCampaignsDirectoryAppearsAndRunsWithou
     return out;
   };
   EXPECT_EQ(names().count("twice"), 0u);
-  std::ofstream(dir / "state" / "campaigns" / "twice.lua") << R"lua(
+  write_campaign(dir.path(), "twice.lua", R"lua(
 return {
   description = "two readings, their difference",
   needs = { "luminance_meter" },
@@ -70,7 +70,7 @@ return {
     return { difference = b.luminance - a.luminance }
   end,
 }
-)lua";
+)lua");
   ASSERT_TRUE(std::filesystem::exists(dir / "state" / "campaigns" / "twice.lua"));
   auto listed = names();
   ASSERT_EQ(listed.count("twice"), 1u) << api.get("/v1/campaigns")["broken"].dump() << " " << listed.size();
@@ -103,7 +103,6 @@ return {
 TEST(EngineInDaemon, MisbehavingScriptsEndInTypedErrorsWhileTheDaemonKeepsServing) {
   TempDir dir;
   NotifySocket systemd(dir / "notify.sock");
-  std::filesystem::create_directories(dir / "state" / "campaigns");
   struct Case {
     const char* name;
     const char* body;
@@ -117,9 +116,9 @@ TEST(EngineInDaemon, MisbehavingScriptsEndInTypedErrorsWhileTheDaemonKeepsServin
       {"fails", "lab.progress(0.2, 'spot/r1c2')\n\nerror('the tile is dirty')", "the tile is dirty", 6},
   };
   for (const auto& c : cases) {
-    std::ofstream(dir / "state" / "campaigns" / (std::string(c.name) + ".lua"))
-        << "return {\n  limits = { memory_mib = 16 },\n  run = function(p)\n"
-        << c.body << "\n  end,\n}\n";
+    write_campaign(dir.path(), std::string(c.name) + ".lua",
+                   "return {\n  limits = { memory_mib = 16 },\n  run = function(p)\n" + std::string(c.body) +
+                       "\n  end,\n}\n");
   }
   ::setenv("NOTIFY_SOCKET", systemd.path().c_str(), 1);
   ::setenv("WATCHDOG_USEC", "400000", 1);
@@ -254,8 +253,7 @@ TEST(EngineInDaemon, AnotherUnitOnResumePausesForTheOperator) {
   // A short stability window: the relit lamp's warm-up is part of the restore.
   auto config = write_daemon_config(dir.path(), 20, 1, "[campaigns]\nstable_window_s = 20\n");
   std::ofstream(dir / "lab.toml") << "[genicam]\nenabled = false\n[dmx]\nserial = 11111111\n";
-  std::filesystem::create_directories(dir / "state" / "campaigns");
-  std::ofstream(dir / "state" / "campaigns" / "lit.lua") << R"lua(
+  write_campaign(dir.path(), "lit.lua", R"lua(
 return {
   needs = { "lamps", "luminance_meter" },
   run = function(p)
@@ -269,7 +267,7 @@ return {
     end
   end,
 }
-)lua";
+)lua");
   DaemonProcess daemon(dir / "state", config);
   auto api = api_for(daemon);
   auto e = start(api, "lit", json::object());
@@ -300,7 +298,7 @@ return {
 TEST(EngineInDaemon, WaitStableWaitsOutALampsWarmUp) {
   TempDir dir;
   DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), 40, 1));
-  std::ofstream(dir / "state" / "campaigns" / "warm.lua") << R"lua(
+  write_campaign(dir.path(), "warm.lua", R"lua(
 return {
   needs = { "lamps", "dimmer", "luminance_meter" },
   run = function(p)
@@ -315,7 +313,7 @@ return {
     return { cold = cold.luminance, warm = warm.luminance, waited_s = s.waited_s, drift_pct = s.drift_pct }
   end,
 }
-)lua";
+)lua");
   auto api = api_for(daemon);
   auto e = start(api, "warm", json::object());
   auto done = wait_terminal(api, e["id"], std::chrono::seconds(120));
@@ -352,7 +350,7 @@ return {
   auto run_it = [&](bool kill) {
     TempDir dir;
     DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), 10, 1));
-    std::ofstream(dir / "state" / "campaigns" / "patches.lua") << script;
+    write_campaign(dir.path(), "patches.lua", script);
     auto api = api_for(daemon);
     auto e = start(api, "patches", json::object());
     if (kill) {

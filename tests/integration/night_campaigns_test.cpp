@@ -164,8 +164,7 @@ constexpr const char* kAskingScript = R"(return {
 TEST(NightCampaigns, OperatorRequestAnsweredThroughTheApiAndOneLeftToItsDefault) {
   TempDir dir;
   DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), 1000, kSeed));
-  std::filesystem::create_directories(dir / "state" / "campaigns");
-  std::ofstream(dir / "state" / "campaigns" / "ask.lua") << kAskingScript;
+  write_campaign(dir.path(), "ask.lua", kAskingScript);
   auto api = api_for(daemon);
   auto e = api.post("/v1/executions", {{"campaign", "ask"}, {"params", json::object()}});
   json pending;

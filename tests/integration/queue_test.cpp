@@ -189,7 +189,7 @@ TEST(queue_daemon, ItemsRunOneAfterAnotherInOrderAndTheQueueEmpties) {
 TEST(queue_daemon, AFailedItemWithStopHaltsTheQueueUntilAnOperatorStartsItAgain) {
   TempDir dir;
   DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), 20, 1));
-  std::ofstream(dir / "state" / "campaigns" / "dirty-tile.lua") << kDirtyTile;
+  write_campaign(dir.path(), "dirty-tile.lua", kDirtyTile);
   auto api = api_for(daemon);
   std::string first = enqueue(api, "luminance-spot", spot(2))["id"];
   std::string failing = enqueue(api, "dirty-tile", json::object(), "stop")["id"];
@@ -222,7 +222,7 @@ TEST(queue_daemon, AFailedItemWithStopHaltsTheQueueUntilAnOperatorStartsItAgain)
 TEST(queue_daemon, AFailedItemWithContinueLetsTheQueueGoOn) {
   TempDir dir;
   DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), 20, 1));
-  std::ofstream(dir / "state" / "campaigns" / "dirty-tile.lua") << kDirtyTile;
+  write_campaign(dir.path(), "dirty-tile.lua", kDirtyTile);
   auto api = api_for(daemon);
   std::string failing = enqueue(api, "dirty-tile", json::object(), "continue")["id"];
   std::string next = enqueue(api, "luminance-spot", spot(2))["id"];
@@ -292,7 +292,7 @@ TEST(queue_daemon, AutostartStartsTheQueueWithTheDaemonButNotAfterAHalt) {
   TempDir dir;
   auto config = write_daemon_config(dir.path(), 20, 1, "[queue]\nautostart = true\n");
   DaemonProcess daemon(dir / "state", config);
-  std::ofstream(dir / "state" / "campaigns" / "dirty-tile.lua") << kDirtyTile;
+  write_campaign(dir.path(), "dirty-tile.lua", kDirtyTile);
   auto api = api_for(daemon);
   auto q = queue_of(api);
   EXPECT_EQ(q["state"], "running");
@@ -392,8 +392,7 @@ TEST(queue_daemon, EnqueueIsValidatedExactlyAsADirectStartAndErrorsStoreNothing)
   // A lab without the spectrophotometer, for a campaign that needs one.
   std::ofstream(dir / "lab.toml") << "[genicam]\nenabled = false\n[spectrolino]\nenabled = false\n";
   DaemonProcess daemon(dir / "state", config);
-  std::ofstream(dir / "state" / "campaigns" / "chart.lua")
-      << "return { needs = { \"spectrophotometer\" }, run = function(p) lab.spectro.calibrate() end }\n";
+  write_campaign(dir.path(), "chart.lua", "return { needs = { \"spectrophotometer\" }, run = function(p) lab.spectro.calibrate() end }\n");
   auto api = api_for(daemon);
   // The same request refused the same way by POST /v1/executions and POST /v1/queue.
   const json requests[] = {
@@ -527,7 +526,7 @@ std::string recorded_source_run(const ApiClient& api, const json& item) {
 TEST(queue_references, AnItemGetsTheRunOfTheItemItReferencesWhenItComesUp) {
   TempDir dir;
   DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), 20, 1));
-  std::ofstream(dir / "state" / "campaigns" / "takes-run.lua") << kTakesRun;
+  write_campaign(dir.path(), "takes-run.lua", kTakesRun);
   auto api = api_for(daemon);
   std::string first = enqueue(api, "luminance-spot", spot(2))["id"];
   std::string other = enqueue(api, "luminance-spot", spot(1))["id"];
@@ -549,8 +548,8 @@ TEST(queue_references, AnItemGetsTheRunOfTheItemItReferencesWhenItComesUp) {
 TEST(queue_references, AnItemWhoseReferenceFailedDoesNotStartAndTheItemsPolicyApplies) {
   TempDir dir;
   DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), 20, 1));
-  std::ofstream(dir / "state" / "campaigns" / "dirty-tile.lua") << kDirtyTile;
-  std::ofstream(dir / "state" / "campaigns" / "takes-run.lua") << kTakesRun;
+  write_campaign(dir.path(), "dirty-tile.lua", kDirtyTile);
+  write_campaign(dir.path(), "takes-run.lua", kTakesRun);
   auto api = api_for(daemon);
   std::string failing = enqueue(api, "dirty-tile", json::object(), "continue")["id"];
   std::string taker = enqueue(api, "takes-run", run_of_item(failing), "stop")["id"];
@@ -586,7 +585,7 @@ TEST(queue_references, AnItemWhoseReferenceFailedDoesNotStartAndTheItemsPolicyAp
 TEST(queue_references, ABadReferenceAndAReorderBeforeTheReferenceAreRefusedWithTypedCodes) {
   TempDir dir;
   DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), 20, 1));
-  std::ofstream(dir / "state" / "campaigns" / "takes-run.lua") << kTakesRun;
+  write_campaign(dir.path(), "takes-run.lua", kTakesRun);
   auto api = api_for(daemon);
   auto unknown = problem_of([&] { enqueue(api, "takes-run", run_of_item("0190aaaa-0000-7000-8000-000000000000")); });
   EXPECT_EQ(unknown.status, 409);
@@ -617,7 +616,7 @@ TEST(queue_references, ABadReferenceAndAReorderBeforeTheReferenceAreRefusedWithT
 TEST(queue_references, TheReferenceSurvivesKillNineDuringAndBetweenTheItems) {
   TempDir dir;
   DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), 4, 1));
-  std::ofstream(dir / "state" / "campaigns" / "takes-run.lua") << kTakesRun;
+  write_campaign(dir.path(), "takes-run.lua", kTakesRun);
   auto api = api_for(daemon);
   std::string first = enqueue(api, "luminance-spot", spot(8, 1))["id"];
   std::string taker = enqueue(api, "takes-run", run_of_item(first))["id"];
@@ -679,8 +678,8 @@ return {
 TEST(queue_sequences, ASequenceIsQueuedAtOnceAsAGroupAndItsRunsAreListed) {
   TempDir dir;
   DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), 20, 1));
-  std::ofstream(dir / "state" / "campaigns" / "takes-run.lua") << kTakesRun;
-  std::ofstream(dir / "state" / "campaigns" / "pair.sequence.lua") << kPairSequence;
+  write_campaign(dir.path(), "takes-run.lua", kTakesRun);
+  write_campaign(dir.path(), "pair.sequence.lua", kPairSequence);
   auto api = api_for(daemon);
   json listed;
   const json catalogue = api.get("/v1/campaigns");
@@ -762,8 +761,8 @@ TEST(queue_sequences, ASequenceIsQueuedAtOnceAsAGroupAndItsRunsAreListed) {
 TEST(queue_sequences, TheCliRunsASequenceToItsEndAndListsIt) {
   TempDir dir;
   DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), 20, 1));
-  std::ofstream(dir / "state" / "campaigns" / "takes-run.lua") << kTakesRun;
-  std::ofstream(dir / "state" / "campaigns" / "pair.sequence.lua") << kPairSequence;
+  write_campaign(dir.path(), "takes-run.lua", kTakesRun);
+  write_campaign(dir.path(), "pair.sequence.lua", kPairSequence);
   auto cli = [&](std::vector<std::string> args) {
     std::vector<std::string> argv{bin_path("colorlab"), "--socket", daemon.unix_socket()};
     argv.insert(argv.end(), args.begin(), args.end());

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <stdexcept>
 #include <random>
 #include <thread>
 
@@ -32,6 +33,15 @@ client::ApiClient api_for(const DaemonProcess& daemon) {
   client::Endpoint socket;
   socket.unix_socket = daemon.unix_socket();
   return client::ApiClient(socket, std::chrono::seconds(30));
+}
+
+void write_campaign(const std::filesystem::path& dir, const std::string& file_name, std::string_view source) {
+  const auto folder = dir / "state" / "campaigns";
+  std::filesystem::create_directories(folder);
+  std::ofstream out(folder / file_name, std::ios::binary | std::ios::trunc);
+  out.write(source.data(), static_cast<std::streamsize>(source.size()));
+  out.close();
+  if (!out) throw std::runtime_error("could not write the campaign script " + (folder / file_name).string());
 }
 
 nlohmann::json wait_terminal(const client::ApiClient& api, const std::string& execution_id, std::chrono::seconds timeout) {

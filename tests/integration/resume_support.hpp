@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <string_view>
 
 #include <nlohmann/json.hpp>
 
@@ -22,6 +23,9 @@ namespace colorlab::testing {
 std::filesystem::path write_daemon_config(const std::filesystem::path& dir, double time_scale, std::uint64_t seed,
                                           const std::string& extra = {}, bool camera = false);
 client::ApiClient api_for(const DaemonProcess& daemon);
+// Installs a campaign script as <dir>/state/campaigns/<file_name>, where the daemon of write_daemon_config(dir, …)
+// finds it. Throws when it cannot be written: a test would otherwise fail later, at a campaign the daemon lacks.
+void write_campaign(const std::filesystem::path& dir, const std::string& file_name, std::string_view source);
 // Polls the execution until it is terminal; returns its last state.
 nlohmann::json wait_terminal(const client::ApiClient& api, const std::string& execution_id,
                              std::chrono::seconds timeout = std::chrono::seconds(90));

@@ -2,60 +2,23 @@
 // answering (the simulator's LS-110 goes silent), a lamp that goes out (the simulator's cabinet
 // drops D65 for a while), a lamp that drifts (D65's output sags and comes back) — suspends it with the
 // right reason; it goes on by itself once the condition has cleared, and the run equals an undisturbed
-// one: every step once, in order, every reading within the simulator's noise. On a lab with two cameras, the one
-// a call named is the one brought back. A disk that fills or fails: disk_fault_test.cpp, under the fault shim (no
-// privileges needed).
+// one: every step once, in order, every reading within the simulator's noise. The camera a call named, on a lab with
+// two: suspend_camera_test.cpp. A disk that fills or fails: disk_fault_test.cpp, under the fault shim (no privileges
+// needed).
 #include <cmath>
 #include <fstream>
 #include <thread>
 
 #include <gtest/gtest.h>
 
-#include "colorlab/sim/control_channel.hpp"
-#include "resume_support.hpp"
+#include "suspend_support.hpp"
 
 using namespace colorlab;
 using namespace colorlab::testing;
+using namespace colorlab::testing::suspend;
 using nlohmann::json;
 
 namespace {
-
-constexpr double kTimeScale = 100;
-// Lab seconds: 0.2 s of wall time at the time scale (the engine's floor).
-const char* kSuspendConfig = "[campaigns]\nsuspend_retry_s = 20\nsuspend_settle_s = 20\n";
-
-std::filesystem::path control_socket(const DaemonProcess& daemon) {
-  json endpoint = json::parse(std::ifstream(daemon.state_dir() / "colorlabd.endpoint"));
-  return endpoint.at("simulator_control").get<std::string>();
-}
-
-json control(const DaemonProcess& daemon, const json& command) {
-  json answer = sim::send_control_command(control_socket(daemon), command);
-  EXPECT_TRUE(answer.value("ok", false)) << answer.dump();
-  return answer;
-}
-
-std::size_t measurements_of(const client::ApiClient& api, const json& execution) {
-  return colorlab::client::fetch_run(api, execution["run_id"].get<std::string>())["measurements"].size();
-}
-
-void wait_for_measurements(const client::ApiClient& api, const json& execution, std::size_t n) {
-  for (int i = 0; i < 600 && measurements_of(api, execution) < n; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  ASSERT_GE(measurements_of(api, execution), n) << "the campaign did not get going";
-}
-
-// Polls until the execution is suspended; returns its reason ("" if it never was).
-std::string wait_suspended(const client::ApiClient& api, const json& execution, std::chrono::seconds timeout) {
-  auto deadline = std::chrono::steady_clock::now() + timeout;
-  while (std::chrono::steady_clock::now() < deadline) {
-    json e = api.get("/v1/executions/" + execution["id"].get<std::string>());
-    if (e["status"] == "suspended") return e.value("reason", std::string("(no reason)"));
-    EXPECT_NE(e["status"], "finished_error") << e.dump(2);
-    if (e["status"] == "finished_error") return "";
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
-  return "";
-}
 
 // Every step exactly once, in order, each reading within 4 σ of the LS-110's noise (plus the 1 % a
 // lamp may still be below full output when the stability criterion accepts it) of the spot's truth.
@@ -120,8 +83,7 @@ constexpr const char* kSteadyReadings = R"(return {
 TEST(SuspendNotFail, ALampThatGoesOutSuspendsTheRunUntilItIsBackAndStable) {
   TempDir dir;
   DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), kTimeScale, 3, kSuspendConfig));
-  std::filesystem::create_directories(dir / "state" / "campaigns");
-  std::ofstream(dir / "state" / "campaigns" / "steady.lua") << kSteadyReadings;
+  write_campaign(dir.path(), "steady.lua", kSteadyReadings);
   auto api = api_for(daemon);
   auto e = api.post("/v1/executions", {{"campaign", "steady"}, {"params", {{"readings", 30}}}});
   wait_for_measurements(api, e, 4);
@@ -169,8 +131,7 @@ constexpr const char* kAimedElsewhere = R"(return {
 TEST(SuspendNotFail, ADimSpotTheMeterWasAimedAtIsNotALampOutButADarkCabinetStillIs) {
   TempDir dir;
   DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), kTimeScale, 3, kSuspendConfig));
-  std::filesystem::create_directories(dir / "state" / "campaigns");
-  std::ofstream(dir / "state" / "campaigns" / "aimed.lua") << kAimedElsewhere;
+  write_campaign(dir.path(), "aimed.lua", kAimedElsewhere);
   auto api = api_for(daemon);
   auto e = api.post("/v1/executions", {{"campaign", "aimed"}, {"params", {{"readings", 30}}}});
   wait_for_measurements(api, e, 4);
@@ -276,53 +237,3 @@ TEST(SuspendNotFail, ALampThatDriftsMidGridSuspendsItUntilTheLightIsStableAndThe
 }
 
 }  // namespace
-
-// A lab with two cameras (the simulated GigE camera first, the DSLR second) and a script that names the DSLR.
-constexpr const char* kNamedDslr = R"(return {
-  description = "the DSLR's ISO, set again every 10 s",
-  needs = { "camera" },
-  parameters = { rounds = { type = "integer", default = 40, min = 1, max = 1000 } },
-  run = function(p)
-    for i = 1, p.rounds do
-      lab.camera.configure{ camera = "dslr", iso = 100 }
-      lab.record("set/" .. i, { quantity = "iso", value = 100, unit = "1" })
-      lab.wait(10)
-    end
-    return {}
-  end,
-})";
-
-TEST(SuspendNotFail, ACameraTheCallNamedThatGoesAwayIsTheOneBroughtBack) {
-  TempDir dir;
-  DaemonProcess daemon(dir / "state", write_daemon_config(dir.path(), kTimeScale, 3, kSuspendConfig, true));
-  std::filesystem::create_directories(dir / "state" / "campaigns");
-  std::ofstream(dir / "state" / "campaigns" / "named_dslr.lua") << kNamedDslr;
-  auto api = api_for(daemon);
-  auto e = api.post("/v1/executions", {{"campaign", "named_dslr"}, {"params", {{"rounds", 40}}}});
-  wait_for_measurements(api, e, 3);
-  control(daemon, {{"cmd", "fault"}, {"instrument", "dslr"}, {"faults", {{"disconnect", true}}}});
-  std::string reason = wait_suspended(api, e, std::chrono::seconds(30));
-  EXPECT_EQ(reason.rfind("instrument: ", 0), 0u) << reason;
-  // Gone for 2 s of wall time, ten retry intervals: recovery keeps trying the DSLR and the run stays in the one
-  // suspension. Reconnecting the other camera instead reported the condition cleared, and the call failed and
-  // suspended the run again at every retry.
-  std::this_thread::sleep_for(std::chrono::seconds(2));
-  EXPECT_EQ(api.get("/v1/executions/" + e["id"].get<std::string>())["status"], "suspended");
-  control(daemon, {{"cmd", "fault"}, {"instrument", "dslr"}, {"faults", {{"disconnect", false}}}});
-  auto done = wait_terminal(api, e["id"], std::chrono::seconds(120));
-  ASSERT_EQ(done["status"], "finished_ok") << done.dump(2);
-  EXPECT_EQ(measurements_of(api, e), 40u);
-
-  int suspensions = 0;
-  json how;
-  json log = api.get("/v1/events?topic=execution&limit=300");
-  for (const auto& ev : log["items"]) {
-    if (ev["payload"].value("suspended", false)) ++suspensions;
-    if (ev["payload"].contains("resumed_after_suspension")) how = ev["payload"]["resumed_after_suspension"];
-  }
-  EXPECT_EQ(suspensions, 1) << log.dump();
-  ASSERT_TRUE(how.is_object()) << log.dump();
-  EXPECT_EQ(how["condition"], "instrument");
-  EXPECT_EQ(how["instrument"], "dslr") << how.dump();
-  daemon.kill9();
-}

@@ -83,8 +83,7 @@ TEST(WatchdogWhileHeld, PingsGoOnWhileACommitIsHeldInItsSyncAndWhileAFitIsHeldOn
   TempDir dir;
   NotifySocket systemd(dir / "notify.sock");
   DiskFaults faults(dir / "state", dir / "fault");
-  std::filesystem::create_directories(dir / "state" / "campaigns");
-  std::ofstream(dir / "state" / "campaigns" / "fit.lua") << kFit;
+  write_campaign(dir.path(), "fit.lua", kFit);
   const auto latch = dir / "latch";
   std::ofstream(latch.string() + ".release") << "go\n";  // the pool's jobs pass until part 2 holds them
   std::unique_ptr<DaemonProcess> daemon;

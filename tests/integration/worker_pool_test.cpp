@@ -73,8 +73,7 @@ struct LatchEnvironment {
 TEST(WorkerPool, EveryRouteAnswersWhileAFitIsHeldOnThePool) {
   TempDir dir;
   auto config = write_daemon_config(dir.path(), 200, 5);
-  std::filesystem::create_directories(dir / "state" / "campaigns");
-  std::ofstream(dir / "state" / "campaigns" / "hold-fit.lua") << kHoldFit;
+  write_campaign(dir.path(), "hold-fit.lua", kHoldFit);
   const auto latch = dir / "latch";
   std::unique_ptr<DaemonProcess> daemon;
   {

@@ -8,6 +8,8 @@ Checked, with no timing threshold (every wait bounded, with a message):
 - the killed run resumed — the same execution, not a new one — and the night completed;
 - no measurement lost or doubled: the killed night's runs have the reference night's rows and shape digest per
   run (bench/soak/ledger.py), seqs 1..N, and the grid's keys are exactly the ones its parameters define;
+- nothing committed before the kill changed: every row in the file the killed daemon left (both nights' so far,
+  the grid's first steps among them) is there at the night's end with the same values and data;
 - the followers saw every event of the log exactly once, across the kill;
 - the restarted daemon, idle after its night, holds no more threads than the first daemon did idle after a
   whole night of the same work, and no more descriptors than that plus the browser's connections (below).
@@ -26,6 +28,7 @@ SOURCE_DIR = Path(os.environ.get("COLORLAB_SOURCE_DIR") or Path(__file__).resolv
 sys.path.insert(0, str(SOURCE_DIR / "bench" / "soak"))
 
 from checks import compare_nights  # noqa: E402
+from ledger import check_kills  # noqa: E402
 from night import enqueue, run_night, status  # noqa: E402
 from sampler import COLUMNS, proc_stats  # noqa: E402
 from soak import Soak, newest_seq, wait_followers_caught_up  # noqa: E402
@@ -114,6 +117,7 @@ class SoakNight(unittest.TestCase):
         kill = self.kill_mid_grid(queued)
         killed = run_night(self.lab, 2, queued, [], timeout=WAIT_S)
         killed["kills"] = [kill]
+        check_kills(self.lab.state / "colorlab.db", killed["kills"])
 
         # The night completed, the killed execution resumed (the same one, to its end).
         self.assertEqual([reference["state"], killed["state"]], ["done", "done"], [reference, killed])
@@ -125,6 +129,11 @@ class SoakNight(unittest.TestCase):
         # No lost or doubled measurement: the reference night's rows and shapes, and the grid's own keys.
         checks = compare_nights([reference, killed])
         self.assertEqual(checks["problems"], [], checks)
+        kept = kill["kept_check"]
+        at_kill = sum(led["rows"] for led in reference["ledger"].values()) + \
+            killed["ledger"]["frame-average"]["rows"] + kill["steps_committed"]
+        self.assertGreaterEqual(kept["rows"], at_kill, f"fewer rows in the killed daemon's file than it had "
+                                f"committed: {kept}")
         for night in (reference, killed):
             grid = night["ledger"]["cabinet-grid"]
             self.assertEqual(set(grid["steps"]), grid_keys(GRID), f"night {night['night']}: grid keys")

@@ -178,7 +178,7 @@ asio::awaitable<void> Lab::ready(drivers::Instrument& instrument) {
   auto deadline = std::chrono::steady_clock::now() + options_.connect_timeout;
   for (;;) {
     auto s = instrument.state();
-    if (s == InstrumentState::disconnected || s == InstrumentState::fault) {
+    if (drivers::needs_connect(s)) {
       co_await instrument.connect();
       co_return;
     }

@@ -29,10 +29,6 @@ std::optional<Capability> capability_for(const std::string& call) {
 
 bool is_lamp_condition(const Error& e) { return e.info().device_code.rfind("lamp:", 0) == 0; }
 
-bool is_down(drivers::InstrumentState s) {
-  return s == drivers::InstrumentState::disconnected || s == drivers::InstrumentState::fault;
-}
-
 // The instrument a failed call was using, to bring back: the camera it named ({camera = id or kind}, on a lab with
 // two), else of those offering the call's capability the one that is down, else the first. A lab with a GigE and a
 // DSLR camera otherwise reconnected the GigE for a DSLR that had gone, reported the condition cleared, and failed
@@ -53,7 +49,7 @@ std::shared_ptr<drivers::Instrument> instrument_of_call(const InstrumentSet& ins
   for (const auto& i : instruments.all()) {
     const auto offered = i->capabilities();
     if (std::find(offered.begin(), offered.end(), *capability) == offered.end()) continue;
-    if (is_down(i->state())) return i;
+    if (drivers::needs_connect(i->state())) return i;
     if (!first) first = i;
   }
   return first;
@@ -216,7 +212,7 @@ asio::awaitable<json> Lab::await_recovery(const std::string& call, const json& a
         // Nothing offers it any more (a Spectrolino that lost its table): connect every instrument that
         // is down and look again.
         for (const auto& i : instruments_.all()) {
-          if (is_down(i->state())) {
+          if (drivers::needs_connect(i->state())) {
             instrument = i;
             break;
           }
@@ -227,7 +223,7 @@ asio::awaitable<json> Lab::await_recovery(const std::string& call, const json& a
       // Hysteresis: a link that flaps must stay up for the settle time before measuring again.
       co_await sleep_wall(wall(p.settle_s), control);
       auto s = instrument->state();
-      if (is_down(s)) continue;
+      if (drivers::needs_connect(s)) continue;
       co_return json{{"condition", "instrument"}, {"instrument", instrument->id()}, {"checks", checks}};
     } catch (const Error& e) {
       if (e.cls() == ErrorClass::aborted && control.requested()) throw;

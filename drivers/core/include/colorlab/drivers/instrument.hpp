@@ -24,6 +24,11 @@ enum class InstrumentState {
 };
 std::string_view to_string(InstrumentState s);
 
+// Down: only connect() brings it back (a run's first use and a suspension's recovery both ask this).
+constexpr bool needs_connect(InstrumentState s) {
+  return s == InstrumentState::disconnected || s == InstrumentState::fault;
+}
+
 enum class Capability {
   luminance,  // spot luminance in cd/m²
   reflectance_spectrum,
