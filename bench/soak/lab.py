@@ -75,20 +75,26 @@ class Lab:
 
     def kill_and_restart(self, why: dict) -> dict:
         """kill -9 of colorlabd, then the same daemon started again on the same state and port. Between the two, what
-        the dead daemon had committed is read from its file (``kept``: every run's rows and values digest), for
-        ledger.check_kept once the night has ended; ``restart_s`` counts from the kill to the new daemon's answer
-        without that read."""
+        the dead daemon had committed is read from its file (``kept``: every run's rows and values digest; or
+        ``kept_error`` when that read failed — the daemon is started again all the same), for ledger.check_kills once
+        the night has ended. ``restart_s``: from the kill to the new daemon's endpoint file, without that read;
+        ``read_s``: the read, which the clients also wait out."""
         with self.lock:
             old = self.pid
             t0 = time.monotonic()
             self.daemon.kill9()
             killed = time.monotonic()
-            kept = committed_values(self.state / "colorlab.db")
-            read_s = time.monotonic() - killed
-            self.daemon.start()
+            kept: dict = {}
+            try:
+                kept["kept"] = committed_values(self.state / "colorlab.db")
+            except Exception as e:  # noqa: BLE001 — whatever it was, the night must go on and the check says so
+                kept["kept_error"] = f"{type(e).__name__}: {e}"
+            finally:
+                read_s = time.monotonic() - killed
+                self.daemon.start()
             self.starts += 1
             kill = {**why, "killed_pid": old, "new_pid": self.pid,
-                    "restart_s": round(time.monotonic() - t0 - read_s, 3), "kept": kept}
+                    "restart_s": round(time.monotonic() - t0 - read_s, 3), "read_s": round(read_s, 3), **kept}
         self.kills.append(kill)
         return kill
 

@@ -11,7 +11,9 @@
 What values can be compared across a kill is what was committed before it: ``committed_values`` reads every run's
 rows from the file the killed daemon left (before it is started again), and ``check_kept`` finds, once the night has
 ended, each of those runs' first rows unchanged — the same seqs with the same whole rows, values and data included.
-A resume that lost, rewrote or re-recorded a committed measurement fails there."""
+A resume that lost, rewrote or re-recorded a committed measurement fails there. The store only ever inserts
+measurements (primary key (run_id, step), seq the run's next), so this guards against a regression, not a path the
+daemon has today."""
 from __future__ import annotations
 
 import hashlib
@@ -77,7 +79,7 @@ def committed_values(db: Path) -> dict:
 
 def check_kept(db: Path, kept: dict) -> dict:
     """Each run of ``kept`` (committed_values at a kill) against the file now: its rows up to the seq it had then
-    must be the same rows, whole. Returns {"runs", "rows", "changed": [what differs]}."""
+    must be the same rows, whole. Returns {"runs", "rows", "rows_by_run", "changed": [what differs]}."""
     changed = []
     for run_id, then in kept.items():
         rows = _read(db, f"SELECT {ROW_COLUMNS} FROM measurements WHERE run_id = ? AND seq <= ? ORDER BY seq",
@@ -88,7 +90,8 @@ def check_kept(db: Path, kept: dict) -> dict:
         if (len(rows), digest.hexdigest()) != (then["rows"], then["values"]):
             now = "other values in them" if len(rows) == then["rows"] else f"{len(rows)} rows there"
             changed.append(f"run {run_id}: {then['rows']} rows up to seq {then['last_seq']} at the kill, now {now}")
-    return {"runs": len(kept), "rows": sum(e["rows"] for e in kept.values()), "changed": changed}
+    return {"runs": len(kept), "rows": sum(e["rows"] for e in kept.values()),
+            "rows_by_run": {run: e["rows"] for run, e in kept.items()}, "changed": changed}
 
 
 def check_kills(db: Path, kills: list[dict]) -> None:

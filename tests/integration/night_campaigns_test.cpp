@@ -3,7 +3,6 @@
 // the simulator's seed), the chart read's L*a*b* against the chart's true reflectances, operator
 // requests answered and left to their default, and kill -9 at random moments of each campaign.
 #include <cmath>
-#include <fstream>
 #include <map>
 #include <random>
 #include <thread>

@@ -6,7 +6,6 @@
 // two: suspend_camera_test.cpp. A disk that fills or fails: disk_fault_test.cpp, under the fault shim (no privileges
 // needed).
 #include <cmath>
-#include <fstream>
 #include <thread>
 
 #include <gtest/gtest.h>

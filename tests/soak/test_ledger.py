@@ -3,7 +3,9 @@ whole at the night's end — rows added after it are fine, a lost, rewritten or 
 from __future__ import annotations
 
 import os
+import signal
 import sqlite3
+import subprocess
 import sys
 import tempfile
 import unittest
@@ -41,7 +43,8 @@ class KillCheck(unittest.TestCase):
     def test_rows_after_the_kill_are_not_a_change(self):
         self.add("r1", 3, "L/D65/r0c2", 98.0)
         self.add("r2", 1, "frame-1", 0.25)
-        self.assertEqual(check_kept(self.db, self.kept), {"runs": 2, "rows": 3, "changed": []})
+        self.assertEqual(check_kept(self.db, self.kept), {"runs": 2, "rows": 3, "rows_by_run": {"r0": 1, "r1": 2},
+                                                        "changed": []})
 
     def test_a_rewritten_value_is_found(self):
         self.con.execute("UPDATE measurements SET value = 101.26 WHERE run_id = 'r1' AND seq = 1")
@@ -71,7 +74,32 @@ class KillCheck(unittest.TestCase):
     def test_check_kills_replaces_the_snapshot_with_its_verdict(self):
         kills = [{"at_s": 3.0, "kept": self.kept}, {"at_s": 4.0}]
         check_kills(self.db, kills)
-        self.assertEqual(kills, [{"at_s": 3.0, "kept_check": {"runs": 2, "rows": 3, "changed": []}}, {"at_s": 4.0}])
+        verdict = {"runs": 2, "rows": 3, "rows_by_run": {"r0": 1, "r1": 2}, "changed": []}
+        self.assertEqual(kills, [{"at_s": 3.0, "kept_check": verdict}, {"at_s": 4.0}])
+
+
+class AfterAKill(unittest.TestCase):
+    def test_a_wal_file_left_by_a_killed_writer_is_read_with_its_commits(self):
+        """As the soak reads it: a WAL database whose writer died by SIGKILL with its commits still in the -wal file
+        (no checkpoint, no close), opened read-only."""
+        with tempfile.TemporaryDirectory() as d:
+            db = Path(d) / "colorlab.db"
+            writer = (f"import os, signal, sqlite3\ncon = sqlite3.connect({str(db)!r})\n"
+                      "con.execute('PRAGMA journal_mode=WAL')\ncon.execute('PRAGMA wal_autocheckpoint=0')\n"
+                      f"con.execute({SCHEMA!r})\ncon.commit()\n"
+                      "for seq in range(1, 4):\n"
+                      "    con.execute(\"INSERT INTO measurements VALUES ('r1', ?, ?, 'ls110', 'luminance', ?, "
+                      "'cd/m2', NULL)\", (seq, f'spot/{seq}', 100.0 + seq))\n"
+                      "    con.commit()\n"
+                      "con.execute(\"INSERT INTO measurements VALUES ('r1', 4, 'spot/4', 'ls110', 'luminance', 0, "
+                      "'cd/m2', NULL)\")\n"  # begun, never committed: not a row the kill left
+                      "os.kill(os.getpid(), signal.SIGKILL)\n")
+            died = subprocess.run([sys.executable, "-c", writer])
+            self.assertEqual(died.returncode, -signal.SIGKILL)
+            self.assertGreater(Path(f"{db}-wal").stat().st_size, 0, "the commits should still be in the WAL")
+            kept = committed_values(db)
+            self.assertEqual({run: e["rows"] for run, e in kept.items()}, {"r1": 3})
+            self.assertEqual(check_kept(db, kept)["changed"], [])
 
 
 if __name__ == "__main__":
