@@ -43,8 +43,9 @@ def main(out: Path) -> int:
         print(f"\n{UNITS[key][0]}, bytes per measurement row kept at each night's end: "
               + " / ".join(f"{v:.0f}" for _n, v in sorted(per.items(), key=lambda kv: int(kv[0]))))
     print()
-    print("| night | wall | kills (s after start: item) | state | rows | runs equal to night 1 (rows + shape) |")
-    print("|---|---|---|---|---|---|")
+    print("| night | wall | kills (s after start: item) | state | rows | runs equal to night 1 (rows + shape) | "
+          "committed at the kills, found unchanged at the end (rows) |")
+    print("|---|---|---|---|---|---|---|")
     by = {c["night"]: c for c in s["checks"]["nights"]}
     for n in nights:
         kills = ", ".join(f"{k['at_s']:.0f} s: {k.get('item') or 'between items'}"
@@ -52,8 +53,11 @@ def main(out: Path) -> int:
         if n.get("missed_kills"):
             kills += "; drawn but after the night's end: " + ", ".join(f"{t:.0f} s" for t in n["missed_kills"])
         c = by.get(n["night"], {})
+        checked = [k["kept_check"] for k in n["kills"] if "kept_check" in k]
+        kept = " + ".join(f"all {k['rows']}" if not k["changed"] else f"{k['rows']}, {len(k['changed'])} runs changed"
+                          for k in checked) or "–"
         print(f"| {n['night']} | {n['wall_s']:.0f} s | {kills} | {n['state']} | {c.get('rows')} | "
-              f"{c.get('runs_equal_to_night_1')} of {c.get('runs')} |")
+              f"{c.get('runs_equal_to_night_1')} of {c.get('runs')} | {kept} |")
     return 0
 
 
