@@ -79,7 +79,7 @@ def main(argv=None) -> int:
             queued = enqueue(soak.lab, sequence=a.sequence, small=a.small)
             print(f"soak: night {n} queued (group {queued['group_id']}); kills at {kill_at or 'none'} s", flush=True)
             result = run_night(soak.lab, n, queued, kill_at, timeout=a.night_timeout,
-                               on_kill=lambda k: print(f"soak: kill -9 {k}", flush=True))
+                               on_kill=lambda k: print(f"soak: kill -9 {dict((x, v) for x, v in k.items() if x != 'kept')}", flush=True))
             nights.append(result)
             write_json(a.out / "nights.json", {"meta": meta, "nights": nights})
             print(f"soak: night {n} {result['state']} in {result['wall_s']} s; rows "
