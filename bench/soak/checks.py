@@ -2,8 +2,9 @@
 
 ``compare_nights``: every night's runs against night 1's (never killed): same steps, each run's rows and shape
 digest equal, seqs 1..N, no step key twice; and what each kill left committed (every run's rows then, values
-and data included) still there unchanged at the night's end (ledger.check_kept). ``growth``: per series, the per-night medians, the slope per simulated
-night and per wall hour after night 1, and the spread after night 1 against night 1's own level."""
+and data included) still there unchanged at the night's end (ledger.check_kept). ``growth``: per series, the
+per-night medians, the slope per simulated night and per wall hour after night 1, and the spread after night 1
+against night 1's own level."""
 from __future__ import annotations
 
 from pathlib import Path
