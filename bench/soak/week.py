@@ -45,6 +45,11 @@ def parse(argv):
     return a
 
 
+def without_kept(kill: dict) -> dict:
+    """A kill as printed: its re-read of every run's rows is for the check, not the console."""
+    return {k: v for k, v in kill.items() if k != "kept"}
+
+
 def stop_by(hhmm: str | None) -> float | None:
     if not hhmm:
         return None
@@ -79,7 +84,7 @@ def main(argv=None) -> int:
             queued = enqueue(soak.lab, sequence=a.sequence, small=a.small)
             print(f"soak: night {n} queued (group {queued['group_id']}); kills at {kill_at or 'none'} s", flush=True)
             result = run_night(soak.lab, n, queued, kill_at, timeout=a.night_timeout,
-                               on_kill=lambda k: print(f"soak: kill -9 {dict((x, v) for x, v in k.items() if x != 'kept')}", flush=True))
+                               on_kill=lambda k: print(f"soak: kill -9 {without_kept(k)}", flush=True))
             nights.append(result)
             write_json(a.out / "nights.json", {"meta": meta, "nights": nights})
             print(f"soak: night {n} {result['state']} in {result['wall_s']} s; rows "
