@@ -168,7 +168,8 @@ class SoakNight(unittest.TestCase):
         self.assertEqual({r["daemon_pid"] for r in rows if r["daemon_starts"] == 2}, {kill["new_pid"]})
         print(f"soak night: {len(rows)} samples, {probes['poller_rounds']} poller rounds, kill at "
               f"{kill['rows_seen']} grid rows ({kept['rows']} rows of {kept['runs']} runs re-read unchanged), "
-              f"idle threads {base['threads']} -> {after['threads']}, fds {base['fds']} -> {after['fds']}; {time.monotonic() - started:.1f} s", flush=True)
+              f"idle threads {base['threads']} -> {after['threads']}, fds {base['fds']} -> {after['fds']}; "
+              f"{time.monotonic() - started:.1f} s", flush=True)
 
 
 if __name__ == "__main__":
