@@ -10,7 +10,8 @@
 
 What values can be compared across a kill is what was committed before it: ``committed_values`` reads every run's
 rows from the file the killed daemon left (before it is started again), and ``check_kept`` finds, once the night has
-ended, each of those runs' first rows unchanged — the same seqs with the same whole rows, values and data included.
+ended, each of those runs' first rows unchanged — the same seqs with every column the same (KEPT_COLUMNS: values,
+data and the time measured included).
 A resume that lost, rewrote or re-recorded a committed measurement fails there. The store only ever inserts
 measurements (primary key (run_id, step), seq the run's next), so this guards against a regression, not a path the
 daemon has today."""
@@ -23,6 +24,10 @@ from pathlib import Path
 
 
 ROW_COLUMNS = "seq, step, instrument_id, quantity, unit, value, data"
+# What a kill's re-read compares: every column of a row but its run (daemon/store/src/schema.cpp's measurements), the
+# time it was measured and whether it was simulated among them. Since 2026-11-30 23:10; the two weeks of that evening
+# compared ROW_COLUMNS' seven.
+KEPT_COLUMNS = "seq, step, instrument_id, simulated, quantity, value, unit, data, measured_at"
 
 
 def _read(db: Path, sql: str, args=()) -> list[tuple]:
@@ -68,7 +73,7 @@ def group_ledger(db: Path, group: dict) -> dict:
 def committed_values(db: Path) -> dict:
     """{run_id: {"rows": n, "last_seq": s, "values": digest}} over every run's rows in the file as it is now."""
     digests: dict[str, dict] = {}
-    for row in _read(db, f"SELECT run_id, {ROW_COLUMNS} FROM measurements ORDER BY run_id, seq"):
+    for row in _read(db, f"SELECT run_id, {KEPT_COLUMNS} FROM measurements ORDER BY run_id, seq"):
         entry = digests.setdefault(row[0], {"rows": 0, "last_seq": 0, "hash": hashlib.sha256()})
         entry["rows"] += 1
         entry["last_seq"] = row[1]
@@ -82,7 +87,7 @@ def check_kept(db: Path, kept: dict) -> dict:
     must be the same rows, whole. Returns {"runs", "rows", "rows_by_run", "changed": [what differs]}."""
     changed = []
     for run_id, then in kept.items():
-        rows = _read(db, f"SELECT {ROW_COLUMNS} FROM measurements WHERE run_id = ? AND seq <= ? ORDER BY seq",
+        rows = _read(db, f"SELECT {KEPT_COLUMNS} FROM measurements WHERE run_id = ? AND seq <= ? ORDER BY seq",
                      (run_id, then["last_seq"]))
         digest = hashlib.sha256()
         for row in rows:
@@ -95,7 +100,12 @@ def check_kept(db: Path, kept: dict) -> dict:
 
 
 def check_kills(db: Path, kills: list[dict]) -> None:
-    """Replaces each kill's ``kept`` (what was committed when it fell) with ``kept_check`` against the file now."""
+    """Replaces each kill's ``kept`` (what was committed when it fell) with ``kept_check`` against the file now, or
+    with ``kept_error`` when the file cannot be read: the soak goes on and its checks report the kill unchecked."""
     for kill in kills:
         if "kept" in kill:
-            kill["kept_check"] = check_kept(db, kill.pop("kept"))
+            kept = kill.pop("kept")
+            try:
+                kill["kept_check"] = check_kept(db, kept)
+            except Exception as e:  # noqa: BLE001 — any failure to read leaves this kill unchecked, said so
+                kill["kept_error"] = f"{type(e).__name__}: {e}"

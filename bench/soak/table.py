@@ -23,6 +23,14 @@ def fmt(v, scale=1.0) -> str:
     return f"{v:.0f}" if abs(v) >= 100 else f"{v:.1f}" if abs(v) >= 1 else f"{v:.2f}"
 
 
+def kept_cell(kill: dict) -> str:
+    """What a kill left committed, as found at its night's end (ledger.check_kills)."""
+    check = kill.get("kept_check")
+    if check is None:
+        return "not checked" + (f" ({kill['kept_error']})" if kill.get("kept_error") else "")
+    return f"all {check['rows']}" if not check["changed"] else f"{check['rows']}, {len(check['changed'])} runs changed"
+
+
 def main(out: Path) -> int:
     s = json.loads((out / "summary.json").read_text())
     nights = json.loads((out / "nights.json").read_text())["nights"]
@@ -53,9 +61,7 @@ def main(out: Path) -> int:
         if n.get("missed_kills"):
             kills += "; drawn but after the night's end: " + ", ".join(f"{t:.0f} s" for t in n["missed_kills"])
         c = by.get(n["night"], {})
-        checked = [k["kept_check"] for k in n["kills"] if "kept_check" in k]
-        kept = " + ".join(f"all {k['rows']}" if not k["changed"] else f"{k['rows']}, {len(k['changed'])} runs changed"
-                          for k in checked) or "–"
+        kept = " + ".join(kept_cell(k) for k in n["kills"]) or "–"
         print(f"| {n['night']} | {n['wall_s']:.0f} s | {kills} | {n['state']} | {c.get('rows')} | "
               f"{c.get('runs_equal_to_night_1')} of {c.get('runs')} | {kept} |")
     return 0

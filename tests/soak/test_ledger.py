@@ -18,8 +18,8 @@ from ledger import check_kept, check_kills, committed_values  # noqa: E402
 
 # The columns the ledger reads, as daemon/store/src/schema.cpp names them.
 SCHEMA = ("CREATE TABLE measurements (run_id TEXT NOT NULL, seq INTEGER NOT NULL, step TEXT NOT NULL, "
-          "instrument_id TEXT NOT NULL, quantity TEXT NOT NULL, value REAL, unit TEXT, data TEXT, "
-          "PRIMARY KEY (run_id, step))")
+          "instrument_id TEXT NOT NULL, simulated INTEGER NOT NULL, quantity TEXT NOT NULL, value REAL, unit TEXT, "
+          "data TEXT, measured_at TEXT NOT NULL, PRIMARY KEY (run_id, step))")
 
 
 class KillCheck(unittest.TestCase):
@@ -36,8 +36,8 @@ class KillCheck(unittest.TestCase):
         self.kept = committed_values(self.db)
 
     def add(self, run, seq, step, value):
-        self.con.execute("INSERT INTO measurements VALUES (?, ?, ?, 'ls110', 'luminance', ?, 'cd/m2', ?)",
-                         (run, seq, step, value, f'{{"n":{seq}}}'))
+        self.con.execute("INSERT INTO measurements VALUES (?, ?, ?, 'ls110', 1, 'luminance', ?, 'cd/m2', ?, ?)",
+                         (run, seq, step, value, f'{{"n":{seq}}}', f"2026-11-30T22:00:{seq:02d}.000Z"))
         self.con.commit()
 
     def test_rows_after_the_kill_are_not_a_change(self):
@@ -52,6 +52,18 @@ class KillCheck(unittest.TestCase):
         changed = check_kept(self.db, self.kept)["changed"]
         self.assertEqual(len(changed), 1, changed)
         self.assertIn("run r1", changed[0])
+
+    def test_a_rewritten_measuring_time_is_found(self):
+        self.con.execute("UPDATE measurements SET measured_at = '2026-11-30T23:00:01.000Z' WHERE run_id = 'r1' "
+                         "AND seq = 1")
+        self.con.commit()
+        self.assertEqual(len(check_kept(self.db, self.kept)["changed"]), 1)
+
+    def test_an_unreadable_file_leaves_the_kill_unchecked_not_the_soak_ended(self):
+        kills = [{"at_s": 3.0, "kept": self.kept}]
+        check_kills(Path(self.dir.name) / "gone.db", kills)
+        self.assertEqual(list(kills[0]), ["at_s", "kept_error"])
+        self.assertIn("OperationalError", kills[0]["kept_error"])
 
     def test_rewritten_data_is_found(self):
         self.con.execute("UPDATE measurements SET data = '{\"n\":9}' WHERE run_id = 'r0'")
@@ -88,11 +100,11 @@ class AfterAKill(unittest.TestCase):
                       "con.execute('PRAGMA journal_mode=WAL')\ncon.execute('PRAGMA wal_autocheckpoint=0')\n"
                       f"con.execute({SCHEMA!r})\ncon.commit()\n"
                       "for seq in range(1, 4):\n"
-                      "    con.execute(\"INSERT INTO measurements VALUES ('r1', ?, ?, 'ls110', 'luminance', ?, "
-                      "'cd/m2', NULL)\", (seq, f'spot/{seq}', 100.0 + seq))\n"
+                      "    con.execute(\"INSERT INTO measurements VALUES ('r1', ?, ?, 'ls110', 1, 'luminance', ?, "
+                      "'cd/m2', NULL, '2026-11-30T22:00:00Z')\", (seq, f'spot/{seq}', 100.0 + seq))\n"
                       "    con.commit()\n"
-                      "con.execute(\"INSERT INTO measurements VALUES ('r1', 4, 'spot/4', 'ls110', 'luminance', 0, "
-                      "'cd/m2', NULL)\")\n"  # begun, never committed: not a row the kill left
+                      "con.execute(\"INSERT INTO measurements VALUES ('r1', 4, 'spot/4', 'ls110', 1, 'luminance', 0, "
+                      "'cd/m2', NULL, '2026-11-30T22:00:00Z')\")\n"  # begun, never committed: not a row the kill left
                       "os.kill(os.getpid(), signal.SIGKILL)\n")
             died = subprocess.run([sys.executable, "-c", writer])
             self.assertEqual(died.returncode, -signal.SIGKILL)
