@@ -70,31 +70,37 @@ def group_ledger(db: Path, group: dict) -> dict:
     return out
 
 
-def committed_values(db: Path) -> dict:
-    """{run_id: {"rows": n, "last_seq": s, "values": digest}} over every run's rows in the file as it is now."""
+def _run_digests(db: Path, up_to: dict[str, int] | None = None) -> dict:
+    """{run_id: {"rows": n, "last_seq": s, "values": digest of KEPT_COLUMNS}} in one pass over the file; with
+    ``up_to`` ({run_id: seq}), only those runs and of each only its rows up to that seq."""
     digests: dict[str, dict] = {}
     for row in _read(db, f"SELECT run_id, {KEPT_COLUMNS} FROM measurements ORDER BY run_id, seq"):
-        entry = digests.setdefault(row[0], {"rows": 0, "last_seq": 0, "hash": hashlib.sha256()})
+        run, seq = row[0], row[1]
+        if up_to is not None and (run not in up_to or seq > up_to[run]):
+            continue
+        entry = digests.setdefault(run, {"rows": 0, "last_seq": 0, "hash": hashlib.sha256()})
         entry["rows"] += 1
-        entry["last_seq"] = row[1]
+        entry["last_seq"] = seq
         entry["hash"].update(_row_bytes(row[1:]))
     return {run: {"rows": e["rows"], "last_seq": e["last_seq"], "values": e["hash"].hexdigest()}
             for run, e in digests.items()}
 
 
+def committed_values(db: Path) -> dict:
+    """{run_id: {"rows": n, "last_seq": s, "values": digest}} over every run's rows in the file as it is now."""
+    return _run_digests(db)
+
+
 def check_kept(db: Path, kept: dict) -> dict:
     """Each run of ``kept`` (committed_values at a kill) against the file now: its rows up to the seq it had then
     must be the same rows, whole. Returns {"runs", "rows", "rows_by_run", "changed": [what differs]}."""
+    now = _run_digests(db, {run: then["last_seq"] for run, then in kept.items()})
     changed = []
     for run_id, then in kept.items():
-        rows = _read(db, f"SELECT {KEPT_COLUMNS} FROM measurements WHERE run_id = ? AND seq <= ? ORDER BY seq",
-                     (run_id, then["last_seq"]))
-        digest = hashlib.sha256()
-        for row in rows:
-            digest.update(_row_bytes(row))
-        if (len(rows), digest.hexdigest()) != (then["rows"], then["values"]):
-            now = "other values in them" if len(rows) == then["rows"] else f"{len(rows)} rows there"
-            changed.append(f"run {run_id}: {then['rows']} rows up to seq {then['last_seq']} at the kill, now {now}")
+        found = now.get(run_id, {"rows": 0, "values": None})
+        if (found["rows"], found["values"]) != (then["rows"], then["values"]):
+            what = "other values in them" if found["rows"] == then["rows"] else f"{found['rows']} rows there"
+            changed.append(f"run {run_id}: {then['rows']} rows up to seq {then['last_seq']} at the kill, now {what}")
     return {"runs": len(kept), "rows": sum(e["rows"] for e in kept.values()),
             "rows_by_run": {run: e["rows"] for run, e in kept.items()}, "changed": changed}
 

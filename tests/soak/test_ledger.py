@@ -76,6 +76,12 @@ class KillCheck(unittest.TestCase):
         changed = check_kept(self.db, self.kept)["changed"]
         self.assertEqual(changed, ["run r1: 2 rows up to seq 2 at the kill, now 1 rows there"])
 
+    def test_a_run_gone_whole_is_found(self):
+        self.con.execute("DELETE FROM measurements WHERE run_id = 'r0'")
+        self.con.commit()
+        self.assertEqual(check_kept(self.db, self.kept)["changed"],
+                         ["run r0: 1 rows up to seq 1 at the kill, now 0 rows there"])
+
     def test_a_step_recorded_again_under_its_seq_is_found(self):
         # A resume that re-measured a committed step and stored it over the old row keeps the count and the shape;
         # only the values tell.
