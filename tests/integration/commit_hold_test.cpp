@@ -123,7 +123,7 @@ TEST(CommitOffIoThread, MainRoutesAnswerWhileAStepsSyncIsHeldAndTheStepAppearsOn
 TEST(CommitOffIoThread, MainRoutesAnswerWhileARunsLastStepIsHeldInItsSync) {
   TempDir dir;
   DiskFaults faults(dir / "state", dir / "fault");
-  write_last_step_campaign(dir / "state");
+  write_last_step_campaign(dir.path());
   auto daemon = faults.start(write_daemon_config(dir.path(), 100, 3));
   auto api = api_for(*daemon);
   const json e = api.post("/v1/executions", {{"campaign", "last-step"}, {"params", json::object()}});

@@ -140,7 +140,7 @@ void commit_through(const std::string& how, const std::string& cause_text) {
 TEST(DiskFaults, AFullDiskAtTheRunsLastStepSuspendsItUntilThereIsRoomAndTheStepIsKept) {
   TempDir dir;
   DiskFaults faults(dir / "state", dir / "fault");
-  write_last_step_campaign(dir / "state");
+  write_last_step_campaign(dir.path());
   auto daemon = faults.start(write_daemon_config(dir.path(), kTimeScale, 3, kSuspendConfig));
   auto api = api_for(*daemon);
   const json e = api.post("/v1/executions", {{"campaign", "last-step"}, {"params", json::object()}});

@@ -3,14 +3,14 @@
 // 100, in which a test sets a disk fault), then the measurement and the end, so that its step is committed only
 // once the script has ended (commit_hold_test.cpp, disk_fault_test.cpp).
 #include <filesystem>
-#include <fstream>
+
+#include "resume_support.hpp"
 
 namespace colorlab::testing {
 
-// Writes it as `last-step` into the state directory's campaigns/.
-inline void write_last_step_campaign(const std::filesystem::path& state_dir) {
-  std::filesystem::create_directories(state_dir / "campaigns");
-  std::ofstream(state_dir / "campaigns" / "last-step.lua") << R"lua(
+// Installs it as `last-step` for the daemon of write_daemon_config(dir, …) (write_campaign).
+inline void write_last_step_campaign(const std::filesystem::path& dir) {
+  write_campaign(dir, "last-step.lua", R"lua(
 return {
   description = "test: a wait, then one measurement as the run's last step",
   needs = {},
@@ -20,7 +20,7 @@ return {
     lab.record("last", { quantity = "count", value = 1, unit = "1" })
   end,
 }
-)lua";
+)lua");
 }
 
 }  // namespace colorlab::testing
